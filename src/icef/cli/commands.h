@@ -1,0 +1,18 @@
+// Each subcommand registers its options on the app and returns the function that runs it.
+// A command returns a Status: the CLI prints a failed one on stderr and exits 1; an
+// InternalError (a bug) exits 2.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <functional>
+
+#include "icef/core/status.h"
+
+namespace icef::cli {
+
+using CommandFn = std::function<Status()>;
+
+CommandFn RegisterInfo(CLI::App& app);
+CommandFn RegisterDemo(CLI::App& app);
+
+}  // namespace icef::cli

@@ -1,0 +1,55 @@
+// icef: the command-line tool. Parses the subcommand, runs it, maps errors to exit codes:
+// 0 success, 1 user error (message on stderr), 2 internal error.
+#include <CLI/CLI.hpp>
+#include <exception>
+#include <iostream>
+#include <map>
+#include <string>
+
+#include "icef/cli/commands.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "ICEF: Identity-Consistent Expression Fields. Few-shot, expression-controllable neural head "
+      "models from K = 3-10 posed photos.",
+      "icef"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "icef 0.1.0");
+
+  using Register = icef::cli::CommandFn (*)(CLI::App&);
+  const std::pair<const char*, std::pair<const char*, Register>> commands[] = {
+      {"demo", {"Run the built-in demo end to end", icef::cli::RegisterDemo}},
+      {"info", {"Summarise and validate a dataset", icef::cli::RegisterInfo}},
+  };
+  std::map<CLI::App*, icef::cli::CommandFn> runners;
+  for (const auto& [name, entry] : commands) {
+    CLI::App* sub = app.add_subcommand(name, entry.first);
+    runners[sub] = entry.second(*sub);
+  }
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : 1;
+  }
+
+  try {
+    for (auto& [sub, run] : runners) {
+      if (!sub->parsed()) continue;
+      const icef::Status status = run();
+      if (!status.ok()) {
+        std::cerr << "icef " << sub->get_name() << ": error: " << status.message() << "\n";
+        return 1;
+      }
+    }
+    return 0;
+  } catch (const icef::InternalError& e) {
+    std::cerr << "icef: internal error (please report): " << e.what() << "\n";
+  } catch (const std::bad_alloc&) {
+    std::cerr << "icef: out of memory\n";
+  } catch (const std::exception& e) {
+    std::cerr << "icef: internal error (please report): " << e.what() << "\n";
+  }
+  return 2;
+}

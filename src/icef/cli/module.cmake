@@ -1,0 +1,10 @@
+# The command-line tool: main + one file per subcommand, each a thin adapter.
+file(GLOB icef_cli_sources CONFIGURE_DEPENDS ${CMAKE_CURRENT_LIST_DIR}/*.cc)
+add_executable(icef ${icef_cli_sources})
+target_link_libraries(icef PRIVATE icef_data)
+foreach(module synth nn render field model train eval app)
+  if(TARGET icef_${module})
+    target_link_libraries(icef PRIVATE icef_${module})
+  endif()
+endforeach()
+set_target_properties(icef PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR})

@@ -1,0 +1,1 @@
+icef_module(data DEPS icef_io)

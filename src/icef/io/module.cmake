@@ -1,0 +1,2 @@
+icef_module(io DEPS icef_math nlohmann_json::nlohmann_json)
+target_include_directories(icef_io SYSTEM PUBLIC ${STB_INCLUDE_DIR})

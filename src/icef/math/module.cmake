@@ -1,0 +1,1 @@
+icef_module(math DEPS icef_core)
