@@ -44,6 +44,9 @@ struct Dataset {
   std::vector<std::string> expression_names;  // [expression_dim], may be empty
   Vec3f background = Vec3f::Ones();  // RGB in [0,1]
   std::optional<std::string> background_file_path;  // NerFace: a background image instead
+  // Test-tier thresholds on delta: near = (0, t[0]], moderate = (t[0], t[1]], far > t[1].
+  // JSON: "tier_thresholds": [t0, t1] (optional, written by `icef synth`).
+  std::optional<std::array<double, 2>> tier_thresholds;
   std::vector<Frame> train;
   std::vector<Frame> test;
   std::vector<Frame> val;
