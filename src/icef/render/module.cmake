@@ -1,0 +1,1 @@
+icef_module(render DEPS icef_math)

@@ -1,0 +1,136 @@
+#include "icef/render/occupancy_grid.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "icef/core/rng.h"
+
+namespace icef {
+
+Status OccupancyGridOptions::Validate() const {
+  if (resolution < 1 || resolution > 1024) return Status::Error("occupancy.resolution must be in [1, 1024]");
+  if (!(decay >= 0.f && decay <= 1.f)) return Status::Error("occupancy.decay must be in [0, 1]");
+  if (!(threshold >= 0.f) || !std::isfinite(threshold)) return Status::Error("occupancy.threshold must be >= 0");
+  if (dilation < 0 || dilation > 16) return Status::Error("occupancy.dilation must be in [0, 16]");
+  if (query_batch < 1) return Status::Error("occupancy.query_batch must be >= 1");
+  return Status::Ok();
+}
+
+std::string OccupancyGridOptions::ToString() const {
+  std::ostringstream os;
+  os << "OccupancyGridOptions(resolution=" << resolution << ", decay=" << decay << ", threshold=" << threshold
+     << ", dilation=" << dilation << ", query_batch=" << query_batch << ")";
+  return os.str();
+}
+
+OccupancyGrid::OccupancyGrid(const Aabb& aabb, const OccupancyGridOptions& options)
+    : aabb_(aabb), options_(options) {
+  const Status status = options.Validate();
+  ICEF_CHECK(status.ok(), status.ToString());
+  ICEF_CHECK(aabb.IsValid(), "invalid aabb " + aabb.ToString());
+  inv_cell_size_ = Vec3f::Constant(float(options_.resolution)).cwiseQuotient(aabb_.Extent());
+  density_.assign(num_cells(), 0.f);
+  bits_.assign(num_cells(), 0);
+  Fill(true);
+}
+
+void OccupancyGrid::Fill(bool occupied) {
+  std::fill(density_.begin(), density_.end(), occupied ? std::max(2.f * options_.threshold, 1e-6f) : 0.f);
+  std::fill(bits_.begin(), bits_.end(), occupied ? 1 : 0);
+}
+
+int64_t OccupancyGrid::CellOf(const Vec3f& p) const {
+  const Vec3f q = (p - aabb_.min).cwiseProduct(inv_cell_size_);
+  const int r = options_.resolution;
+  int c[3];
+  for (int a = 0; a < 3; ++a) {
+    if (!(q[a] >= 0.f && q[a] <= float(r))) return -1;  // also rejects NaN
+    c[a] = std::min(int(q[a]), r - 1);
+  }
+  return CellIndex(c[0], c[1], c[2]);
+}
+
+bool OccupancyGrid::IsOccupied(const Vec3f& p) const {
+  const int64_t c = CellOf(p);
+  return c >= 0 && bits_[c] != 0;
+}
+
+int64_t OccupancyGrid::NumOccupied() const {
+  int64_t n = 0;
+  for (uint8_t b : bits_) n += b;
+  return n;
+}
+
+void OccupancyGrid::Update(const DensityQuery& query, uint64_t seed, int64_t step) {
+  const int r = options_.resolution;
+  const int64_t cells = num_cells();
+  const Vec3f cell_size = aabb_.Extent() / float(r);
+  const int64_t batch = std::min(options_.query_batch, cells);
+  std::vector<float> positions(batch * 3);
+  std::vector<float> sigma(batch);
+  for (int64_t begin = 0; begin < cells; begin += batch) {
+    const int64_t n = std::min(batch, cells - begin);
+    for (int64_t i = 0; i < n; ++i) {
+      const int64_t c = begin + i;
+      const int x = int(c % r), y = int((c / r) % r), z = int(c / (int64_t(r) * r));
+      Rng rng(seed, StreamId("occupancy"), uint64_t(step), uint64_t(c));
+      for (int a = 0; a < 3; ++a) {
+        const int idx = a == 0 ? x : (a == 1 ? y : z);
+        positions[3 * i + a] = aabb_.min[a] + (float(idx) + rng.Uniform()) * cell_size[a];
+      }
+    }
+    query(positions.data(), n, sigma.data());
+    for (int64_t i = 0; i < n; ++i) {
+      const float s = std::isfinite(sigma[i]) ? std::max(sigma[i], 0.f) : 0.f;
+      float& d = density_[begin + i];
+      d = std::max(d * options_.decay, s);
+    }
+  }
+  RecomputeBits();
+}
+
+void OccupancyGrid::RecomputeBits() {
+  const int r = options_.resolution;
+  const int k = options_.dilation;
+  // Separable max filter (dilation by a (2k+1)^3 box) over the thresholded bits, axis by axis.
+  std::vector<uint8_t> a(num_cells()), b(num_cells());
+  for (int64_t c = 0; c < num_cells(); ++c) a[c] = density_[c] > options_.threshold ? 1 : 0;
+  for (int axis = 0; axis < 3 && k > 0; ++axis) {
+    for (int z = 0; z < r; ++z)
+      for (int y = 0; y < r; ++y)
+        for (int x = 0; x < r; ++x) {
+          const int coord[3] = {x, y, z};
+          uint8_t v = 0;
+          for (int o = -k; o <= k && !v; ++o) {
+            const int q = coord[axis] + o;
+            if (q < 0 || q >= r) continue;
+            int cc[3] = {x, y, z};
+            cc[axis] = q;
+            v = a[CellIndex(cc[0], cc[1], cc[2])];
+          }
+          b[CellIndex(x, y, z)] = v;
+        }
+    a.swap(b);
+  }
+  bits_.swap(a);
+}
+
+Status OccupancyGrid::SetDensities(std::vector<float> densities) {
+  if (int64_t(densities.size()) != num_cells()) {
+    return Status::Error("occupancy grid: expected " + std::to_string(num_cells()) + " densities, got " +
+                         std::to_string(densities.size()));
+  }
+  density_ = std::move(densities);
+  RecomputeBits();
+  return Status::Ok();
+}
+
+std::string OccupancyGrid::ToString() const {
+  std::ostringstream os;
+  os << "OccupancyGrid(" << options_.ToString() << ", aabb=" << aabb_.ToString()
+     << ", occupied=" << OccupiedFraction() << ")";
+  return os.str();
+}
+
+}  // namespace icef

@@ -1,0 +1,75 @@
+// Occupancy grid in observation space (DESIGN.md §3): a dense density grid over the aabb whose
+// occupied cells (density above a threshold, dilated) are where the sampler puts samples. The grid
+// knows no fields: Update() takes a caller-provided density query over a batch of world positions.
+// Covering all training expressions is the caller's job (query each expression and take the max).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "icef/core/status.h"
+#include "icef/math/ray.h"
+#include "icef/math/types.h"
+
+namespace icef {
+
+struct OccupancyGridOptions {
+  int resolution = 64;       // cells per axis (resolution^3 cells over the aabb)
+  float decay = 0.95f;       // EMA: stored density <- max(decay * stored, new density) per update
+  float threshold = 0.01f;   // a cell is occupied when its stored density (sigma, 1/world units) exceeds this
+  int dilation = 1;          // occupied cells are dilated by this many cells (Chebyshev distance)
+  int64_t query_batch = 65536;  // positions per density-query call
+
+  Status Validate() const;
+  std::string ToString() const;
+};
+
+class OccupancyGrid {
+ public:
+  // Fills sigma[i] with the density at positions[3 i .. 3 i + 2] (world frame), for i in [0, n).
+  using DensityQuery = std::function<void(const float* positions, int64_t n, float* sigma)>;
+
+  // A grid over `aabb` with every cell occupied (nothing is skipped before the first update).
+  // Checks options.Validate() and aabb validity (programming errors).
+  OccupancyGrid(const Aabb& aabb, const OccupancyGridOptions& options);
+
+  // Queries one jittered point per cell (Rng keyed on (seed, "occupancy", step, cell)), folds it
+  // into the stored density with the EMA-of-max rule, then recomputes the occupied bits
+  // (threshold + dilation). Deterministic for (seed, step) and the query.
+  void Update(const DensityQuery& query, uint64_t seed, int64_t step);
+
+  // True when the cell containing p (world frame) is occupied; false outside the aabb.
+  bool IsOccupied(const Vec3f& p) const;
+  bool IsCellOccupied(int x, int y, int z) const { return bits_[CellIndex(x, y, z)] != 0; }
+  // Marks every cell occupied (or empty) and sets the stored densities to +threshold*2 (or 0).
+  void Fill(bool occupied);
+
+  int resolution() const { return options_.resolution; }
+  const Aabb& aabb() const { return aabb_; }
+  const OccupancyGridOptions& options() const { return options_; }
+  int64_t num_cells() const { return int64_t(options_.resolution) * options_.resolution * options_.resolution; }
+  int64_t NumOccupied() const;
+  double OccupiedFraction() const { return double(NumOccupied()) / double(num_cells()); }
+  // Stored densities [resolution^3], index (z * R + y) * R + x; for checkpoints.
+  const std::vector<float>& densities() const { return density_; }
+  // Restores densities saved from densities() and recomputes the bits; error on a size mismatch.
+  Status SetDensities(std::vector<float> densities);
+  // The cell index of p, or -1 outside the aabb.
+  int64_t CellOf(const Vec3f& p) const;
+  int64_t CellIndex(int x, int y, int z) const { return (int64_t(z) * options_.resolution + y) * options_.resolution + x; }
+
+  std::string ToString() const;
+
+ private:
+  void RecomputeBits();
+
+  Aabb aabb_;
+  OccupancyGridOptions options_;
+  Vec3f inv_cell_size_;
+  std::vector<float> density_;   // [R^3]
+  std::vector<uint8_t> bits_;    // [R^3] 1 = occupied (after dilation)
+};
+
+}  // namespace icef
