@@ -7,6 +7,7 @@ PACKAGES=(
   build-essential cmake ninja-build pkg-config git
   libeigen3-dev nlohmann-json3-dev libcli11-dev libstb-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  libdlib-dev libdlib-data opencv-doc python3-skimage python-matplotlib-data  # eval: face alignment, test photos
 )
 
 missing=()
@@ -23,4 +24,32 @@ if ((${#missing[@]})); then
   $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
 else
   echo "install-deps: all Debian packages present"
+fi
+
+# Face-identity network weights (dlib's ResNet face descriptor, as shipped in the npm package
+# @vladmandic/face-api@1.7.15): only the two model files are unpacked, into a fixed place the
+# program finds by default. Skipped when already present.
+FACEID_DIR=/usr/local/share/icef/face-api
+FACEID_FILES=(face_recognition_model.bin face_recognition_model-weights_manifest.json)
+if [ ! -s "$FACEID_DIR/${FACEID_FILES[0]}" ] || [ ! -s "$FACEID_DIR/${FACEID_FILES[1]}" ]; then
+  SUDO=""
+  if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+  if ! command -v npm >/dev/null; then
+    echo "install-deps: installing nodejs npm (for the face-identity model)"
+    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends nodejs npm
+  fi
+  faceid_tmp=$(mktemp -d)
+  (cd "$faceid_tmp" && npm pack --silent @vladmandic/face-api@1.7.15 >/dev/null)
+  tar xzf "$faceid_tmp/vladmandic-face-api-1.7.15.tgz" -C "$faceid_tmp" "${FACEID_FILES[@]/#/package/model/}"
+  (cd "$faceid_tmp/package/model" && sha256sum -c --quiet - <<'SUMS'
+b413e420d6840b2775fba32008db6f3cddb07d485967fb42cfcf379c16a8c589  face_recognition_model.bin
+cbaffa501b0b9275a12b63357a6843e7e30c054e1c9151e1a5f879b26e32986b  face_recognition_model-weights_manifest.json
+SUMS
+  )
+  $SUDO mkdir -p "$FACEID_DIR"
+  $SUDO cp "${FACEID_FILES[@]/#/$faceid_tmp/package/model/}" "$FACEID_DIR/"
+  rm -rf "$faceid_tmp"
+  echo "install-deps: face-identity model installed in $FACEID_DIR"
+else
+  echo "install-deps: face-identity model present in $FACEID_DIR"
 fi

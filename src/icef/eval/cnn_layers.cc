@@ -1,0 +1,158 @@
+#include "icef/eval/cnn_layers.h"
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <sstream>
+
+#include "icef/core/status.h"
+
+namespace icef::eval {
+namespace {
+
+using RowMatrix = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+int PooledSize(int in, int window, int stride) { return in < window ? 0 : (in - window) / stride + 1; }
+
+}  // namespace
+
+std::string Tensor3::ToString() const {
+  std::ostringstream s;
+  s << "Tensor3[" << h << " x " << w << " x " << c << "]";
+  return s.str();
+}
+
+std::string ConvWeights::ToString() const {
+  std::ostringstream s;
+  s << "Conv " << kh << "x" << kw << " " << cin << "->" << cout << (bias.empty() ? " (no bias)" : "");
+  return s.str();
+}
+
+Tensor3 Conv2d(const Tensor3& input, const ConvWeights& weights, int stride, const Padding& pad) {
+  ICEF_CHECK(input.c == weights.cin, "Conv2d: input has " + std::to_string(input.c) +
+                                         " channels, filters expect " + std::to_string(weights.cin));
+  ICEF_CHECK(stride >= 1);
+  ICEF_CHECK(weights.filters.size() == size_t(weights.kh) * weights.kw * weights.cin * weights.cout);
+  ICEF_CHECK(weights.bias.empty() || weights.bias.size() == size_t(weights.cout));
+  const int padded_h = input.h + pad.top + pad.bottom;
+  const int padded_w = input.w + pad.left + pad.right;
+  const int out_h = PooledSize(padded_h, weights.kh, stride);
+  const int out_w = PooledSize(padded_w, weights.kw, stride);
+  Tensor3 out(out_h, out_w, weights.cout);
+  if (out_h == 0 || out_w == 0) return out;
+
+  // im2col: one row per output pixel, columns in (i, j, c) order to match HWIO filters.
+  const int patch = weights.kh * weights.kw * weights.cin;
+  RowMatrix cols(int64_t(out_h) * out_w, patch);
+  for (int y = 0; y < out_h; ++y) {
+    for (int x = 0; x < out_w; ++x) {
+      float* row = cols.data() + (int64_t(y) * out_w + x) * patch;
+      for (int i = 0; i < weights.kh; ++i) {
+        const int sy = y * stride + i - pad.top;
+        for (int j = 0; j < weights.kw; ++j) {
+          const int sx = x * stride + j - pad.left;
+          float* dst = row + (i * weights.kw + j) * weights.cin;
+          if (sy < 0 || sy >= input.h || sx < 0 || sx >= input.w) {
+            std::fill(dst, dst + weights.cin, 0.f);
+          } else {
+            const float* src = &input.data[(size_t(sy) * input.w + sx) * input.c];
+            std::copy(src, src + weights.cin, dst);
+          }
+        }
+      }
+    }
+  }
+  Eigen::Map<const RowMatrix> filters(weights.filters.data(), patch, weights.cout);
+  Eigen::Map<RowMatrix> result(out.data.data(), int64_t(out_h) * out_w, weights.cout);
+  result.noalias() = cols * filters;
+  if (!weights.bias.empty()) {
+    Eigen::Map<const Eigen::RowVectorXf> bias(weights.bias.data(), weights.cout);
+    result.rowwise() += bias;
+  }
+  return out;
+}
+
+void ChannelAffine(Tensor3& x, const std::vector<float>& scale, const std::vector<float>& shift) {
+  ICEF_CHECK(scale.size() == size_t(x.c) && shift.size() == size_t(x.c));
+  const size_t pixels = size_t(x.h) * x.w;
+  for (size_t p = 0; p < pixels; ++p) {
+    float* v = &x.data[p * x.c];
+    for (int c = 0; c < x.c; ++c) v[c] = v[c] * scale[c] + shift[c];
+  }
+}
+
+void Relu(Tensor3& x) {
+  for (float& v : x.data) v = std::max(v, 0.f);
+}
+
+Tensor3 MaxPool(const Tensor3& input, int window, int stride) {
+  Tensor3 out(PooledSize(input.h, window, stride), PooledSize(input.w, window, stride), input.c);
+  for (int y = 0; y < out.h; ++y) {
+    for (int x = 0; x < out.w; ++x) {
+      for (int c = 0; c < input.c; ++c) {
+        float m = input.At(y * stride, x * stride, c);
+        for (int i = 0; i < window; ++i)
+          for (int j = 0; j < window; ++j) m = std::max(m, input.At(y * stride + i, x * stride + j, c));
+        out.At(y, x, c) = m;
+      }
+    }
+  }
+  return out;
+}
+
+Tensor3 AvgPool(const Tensor3& input, int window, int stride) {
+  Tensor3 out(PooledSize(input.h, window, stride), PooledSize(input.w, window, stride), input.c);
+  const float inv = 1.f / float(window * window);
+  for (int y = 0; y < out.h; ++y) {
+    for (int x = 0; x < out.w; ++x) {
+      for (int c = 0; c < input.c; ++c) {
+        float s = 0.f;
+        for (int i = 0; i < window; ++i)
+          for (int j = 0; j < window; ++j) s += input.At(y * stride + i, x * stride + j, c);
+        out.At(y, x, c) = s * inv;
+      }
+    }
+  }
+  return out;
+}
+
+Tensor3 ZeroPadTo(const Tensor3& input, int h, int w, int c) {
+  ICEF_CHECK(h >= input.h && w >= input.w && c >= input.c, "ZeroPadTo: target smaller than input");
+  Tensor3 out(h, w, c);
+  for (int y = 0; y < input.h; ++y)
+    for (int x = 0; x < input.w; ++x)
+      std::copy_n(&input.data[(size_t(y) * input.w + x) * input.c], input.c, &out.data[(size_t(y) * w + x) * c]);
+  return out;
+}
+
+void AddInPlace(Tensor3& a, const Tensor3& b) {
+  ICEF_CHECK(a.h == b.h && a.w == b.w && a.c == b.c, "AddInPlace: " + a.ToString() + " vs " + b.ToString());
+  for (size_t i = 0; i < a.data.size(); ++i) a.data[i] += b.data[i];
+}
+
+Tensor3 AddZeroExtended(const Tensor3& a, const Tensor3& b) {
+  Tensor3 out = ZeroPadTo(a, std::max(a.h, b.h), std::max(a.w, b.w), std::max(a.c, b.c));
+  for (int y = 0; y < b.h; ++y)
+    for (int x = 0; x < b.w; ++x)
+      for (int c = 0; c < b.c; ++c) out.At(y, x, c) += b.At(y, x, c);
+  return out;
+}
+
+std::vector<float> GlobalMean(const Tensor3& input) {
+  std::vector<double> sum(input.c, 0.0);
+  const size_t pixels = size_t(input.h) * input.w;
+  for (size_t p = 0; p < pixels; ++p)
+    for (int c = 0; c < input.c; ++c) sum[c] += input.data[p * input.c + c];
+  std::vector<float> mean(input.c);
+  for (int c = 0; c < input.c; ++c) mean[c] = pixels ? float(sum[c] / double(pixels)) : 0.f;
+  return mean;
+}
+
+std::vector<float> FullyConnected(const std::vector<float>& x, const std::vector<float>& weights, int out) {
+  ICEF_CHECK(out > 0 && weights.size() == x.size() * size_t(out));
+  std::vector<float> y(out, 0.f);
+  for (size_t i = 0; i < x.size(); ++i)
+    for (int o = 0; o < out; ++o) y[o] += x[i] * weights[i * out + o];
+  return y;
+}
+
+}  // namespace icef::eval

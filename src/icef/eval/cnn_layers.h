@@ -1,0 +1,74 @@
+// Forward-only convolutional layers for the pretrained evaluation networks (the face-identity
+// ResNet and LPIPS). Tensors are single images in HWC layout; filters are HWIO (TF.js / dlib
+// order), so a convolution is one GEMM of the im2col matrix [out_h * out_w, kh * kw * cin] with
+// the filter matrix [kh * kw * cin, cout]. No gradients: these networks are only evaluated.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace icef::eval {
+
+// [h, w, c] row-major, channels fastest.
+struct Tensor3 {
+  int h = 0;
+  int w = 0;
+  int c = 0;
+  std::vector<float> data;  // [h, w, c]
+
+  Tensor3() = default;
+  Tensor3(int h_, int w_, int c_, float fill = 0.f) : h(h_), w(w_), c(c_), data(size_t(h_) * w_ * c_, fill) {}
+  float& At(int y, int x, int ch) { return data[(size_t(y) * w + x) * c + ch]; }
+  float At(int y, int x, int ch) const { return data[(size_t(y) * w + x) * c + ch]; }
+  std::string ToString() const;
+};
+
+// A 2-D convolution's parameters.
+struct ConvWeights {
+  int kh = 0;
+  int kw = 0;
+  int cin = 0;
+  int cout = 0;
+  std::vector<float> filters;  // [kh, kw, cin, cout] (HWIO)
+  std::vector<float> bias;     // [cout], or empty for no bias
+  std::string ToString() const;
+};
+
+// Zero padding on each side of the input, in pixels.
+struct Padding {
+  int top = 0;
+  int left = 0;
+  int bottom = 0;
+  int right = 0;
+  static Padding Valid() { return {}; }
+  // Symmetric padding of p on every side (PyTorch `padding=p`; TF 'same' for odd kernels, stride 1).
+  static Padding Uniform(int p) { return {p, p, p, p}; }
+};
+
+// out[y, x, o] = bias[o] + sum_{i, j, c} in[y * stride + i - pad.top, x * stride + j - pad.left, c]
+//                                      * filters[i, j, c, o]   (zero outside the input).
+// Output size: (h + top + bottom - kh) / stride + 1 (floor), likewise for width.
+Tensor3 Conv2d(const Tensor3& input, const ConvWeights& weights, int stride, const Padding& pad);
+
+// x[..., c] = x[..., c] * scale[c] + shift[c] (dlib's affine layer / face-api's scale layer).
+void ChannelAffine(Tensor3& x, const std::vector<float>& scale, const std::vector<float>& shift);
+// x = max(x, 0).
+void Relu(Tensor3& x);
+// Max / average pooling over window x window with the given stride, no padding ('valid').
+// Output size: (h - window) / stride + 1 (floor).
+Tensor3 MaxPool(const Tensor3& input, int window, int stride);
+Tensor3 AvgPool(const Tensor3& input, int window, int stride);
+// Copies `input` into an [h, w, c] tensor of zeros at the top-left corner (zero padding at the
+// bottom, right and in the trailing channels). Requires h >= input.h, w >= input.w, c >= input.c.
+Tensor3 ZeroPadTo(const Tensor3& input, int h, int w, int c);
+// a += b (same shape).
+void AddInPlace(Tensor3& a, const Tensor3& b);
+// dlib's add_prev: the sum of two tensors of possibly different shapes, each zero-extended at
+// the bottom / right / trailing channels to the larger of the two in every dimension.
+Tensor3 AddZeroExtended(const Tensor3& a, const Tensor3& b);
+// Mean over all pixels: [c].
+std::vector<float> GlobalMean(const Tensor3& input);
+// y[o] = sum_i x[i] * weights[i, o]; weights [in, out] row-major.
+std::vector<float> FullyConnected(const std::vector<float>& x, const std::vector<float>& weights, int out);
+
+}  // namespace icef::eval

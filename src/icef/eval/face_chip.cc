@@ -1,0 +1,110 @@
+#include "icef/eval/face_chip.h"
+
+#include <dlib/image_processing.h>
+#include <dlib/image_processing/frontal_face_detector.h>
+#include <dlib/image_transforms.h>
+#include <dlib/serialize.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "icef/eval/face_descriptor.h"
+
+namespace icef::eval {
+namespace {
+
+dlib::matrix<dlib::rgb_pixel> ToDlib(const Image& image) {
+  dlib::matrix<dlib::rgb_pixel> out(image.height, image.width);
+  auto q = [](float v) { return static_cast<unsigned char>(std::lround(std::clamp(v, 0.f, 1.f) * 255.f)); };
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      const Vec3f rgb = image.Rgb(x, y);
+      out(y, x) = dlib::rgb_pixel(q(rgb.x()), q(rgb.y()), q(rgb.z()));
+    }
+  }
+  return out;
+}
+
+Image FromDlib(const dlib::matrix<dlib::rgb_pixel>& chip) {
+  Image out(int(chip.nc()), int(chip.nr()), 3);
+  for (int y = 0; y < out.height; ++y) {
+    for (int x = 0; x < out.width; ++x) {
+      out.At(x, y, 0) = chip(y, x).red / 255.f;
+      out.At(x, y, 1) = chip(y, x).green / 255.f;
+      out.At(x, y, 2) = chip(y, x).blue / 255.f;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+Result<Image> ExtractFaceChip(const Image& image, const std::vector<Vec2f>& landmarks) {
+  if (landmarks.size() != 68)
+    return Status::Error("face chip: expected 68 landmarks, got " + std::to_string(landmarks.size()));
+  if (image.empty()) return Status::Error("face chip: empty image");
+  std::vector<dlib::point> parts;
+  parts.reserve(landmarks.size());
+  for (size_t i = 0; i < landmarks.size(); ++i) {
+    const Vec2f& p = landmarks[i];
+    if (!std::isfinite(p.x()) || !std::isfinite(p.y()))
+      return Status::Error("face chip: landmark " + std::to_string(i) + " is not finite");
+    // dlib::point is integer-valued, as dlib's own shape predictor output is.
+    parts.emplace_back(std::lround(p.x() - 0.5f), std::lround(p.y() - 0.5f));
+  }
+  dlib::rectangle box;  // the landmarks' bounding box (get_face_chip_details uses only the parts)
+  for (const dlib::point& p : parts) box += p;
+  const dlib::full_object_detection shape(box, parts);
+  const dlib::chip_details details = dlib::get_face_chip_details(shape, kFaceChipSize, 0.25);
+  dlib::matrix<dlib::rgb_pixel> chip;
+  dlib::extract_image_chip(ToDlib(image), details, chip);
+  return FromDlib(chip);
+}
+
+struct FaceLandmarkDetector::Impl {
+  dlib::frontal_face_detector detector = dlib::get_frontal_face_detector();
+  dlib::shape_predictor predictor;
+};
+
+Result<FaceLandmarkDetector> FaceLandmarkDetector::Load(const std::filesystem::path& predictor_path) {
+  const std::filesystem::path path = predictor_path.empty() ? kDefaultShapePredictorPath : predictor_path;
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec))
+    return Status::Error(path.string() +
+                         ": 68-point shape predictor not found (Debian package libdlib-data; "
+                         "scripts/install-deps.sh installs it)");
+  FaceLandmarkDetector out;
+  out.impl_ = std::make_shared<Impl>();
+  try {
+    dlib::deserialize(path.string()) >> out.impl_->predictor;
+  } catch (const std::exception& e) {
+    return Status::Error(path.string() + ": cannot read shape predictor: " + e.what());
+  }
+  return out;
+}
+
+Result<std::vector<Vec2f>> FaceLandmarkDetector::Detect(const Image& image) const {
+  if (image.empty()) return Status::Error("face detector: empty image");
+  dlib::matrix<dlib::rgb_pixel> img = ToDlib(image);
+  bool upsampled = false;
+  std::vector<dlib::rectangle> faces = impl_->detector(img);
+  if (faces.empty()) {
+    dlib::pyramid_up(img);  // with dlib::pyramid_down<2>, whose point_down maps back
+    upsampled = true;
+    faces = impl_->detector(img);
+  }
+  if (faces.empty()) return Status::Error("no face found");
+  const auto largest = std::max_element(faces.begin(), faces.end(), [](const auto& a, const auto& b) {
+    return a.area() < b.area();
+  });
+  const dlib::full_object_detection shape = impl_->predictor(img, *largest);
+  std::vector<Vec2f> landmarks(shape.num_parts());
+  for (unsigned long i = 0; i < shape.num_parts(); ++i) {
+    dlib::dpoint p(shape.part(i));
+    if (upsampled) p = dlib::pyramid_down<2>().point_down(p);
+    landmarks[i] = Vec2f(float(p.x() + 0.5), float(p.y() + 0.5));
+  }
+  return landmarks;
+}
+
+}  // namespace icef::eval
