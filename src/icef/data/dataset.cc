@@ -1,5 +1,7 @@
 #include "icef/data/dataset.h"
 
+#include <sstream>
+
 namespace icef {
 
 const char* TierName(Tier tier) {
@@ -18,15 +20,25 @@ std::optional<Tier> ParseTier(const std::string& name) {
   return std::nullopt;
 }
 
-std::string Frame::ToString() const { return "Frame(" + file_path + ")"; }
-std::string Dataset::ToString() const { return "Dataset(" + root.string() + ")"; }
+std::string Frame::ToString() const {
+  std::ostringstream os;
+  os << "Frame(" << file_path << ", " << camera.width() << "x" << camera.height() << ", expression["
+     << expression.size() << "]";
+  if (landmarks_2d) os << ", landmarks_2d";
+  if (landmarks_3d) os << ", landmarks_3d";
+  if (delta) os << ", delta=" << *delta;
+  if (tier) os << ", tier=" << TierName(*tier);
+  os << ")";
+  return os.str();
+}
 
-Result<Dataset> LoadDataset(const std::filesystem::path& dir) {
-  return Status::Error(dir.string() + ": dataset loading is not implemented yet");
+std::string Dataset::ToString() const {
+  std::ostringstream os;
+  os << "Dataset(" << root.string() << ", train=" << train.size() << ", test=" << test.size()
+     << ", val=" << val.size() << ", expression_dim=" << expression_dim << ", aabb=" << aabb.ToString() << ")";
+  return os.str();
 }
-Status SaveDataset(const Dataset& dataset) {
-  return Status::Error(dataset.root.string() + ": dataset saving is not implemented yet");
-}
+
 Result<Image> LoadFrameImage(const Dataset& dataset, const Frame& frame) { return ReadImage(dataset.ImagePath(frame)); }
 
 }  // namespace icef

@@ -1,1 +1,1 @@
-icef_module(data DEPS icef_io)
+icef_module(data DEPS icef_io TEST_DEPS icef_testing)

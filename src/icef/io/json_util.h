@@ -14,7 +14,7 @@
 
 namespace icef {
 
-using Json = nlohmann::json;
+using Json = nlohmann::ordered_json;  // keeps keys in document order
 
 // Parses JSON text. Python's json.dump writes NaN, Infinity and -Infinity as bare literals; they
 // are accepted here as marker values that every numeric getter rejects as "non-finite", so the

@@ -1,0 +1,1 @@
+icef_module(testing DEPS icef_data)
