@@ -1,0 +1,120 @@
+#include "icef/nn/hash_grid.h"
+
+#include <cmath>
+#include <sstream>
+
+#include "icef/core/rng.h"
+
+namespace icef::nn {
+
+Status HashGridOptions::Validate() const {
+  if (num_levels < 1 || num_levels > 64) return Status::Error("hash_grid.num_levels: must be in [1, 64]");
+  if (features_per_level < 1 || features_per_level > 8) {
+    return Status::Error("hash_grid.features_per_level: must be in [1, 8]");
+  }
+  if (log2_table_size < 4 || log2_table_size > 30) {
+    return Status::Error("hash_grid.log2_table_size: must be in [4, 30]");
+  }
+  if (!(base_resolution >= 1.0)) return Status::Error("hash_grid.base_resolution: must be >= 1");
+  if (!(finest_resolution >= base_resolution) || finest_resolution > 1e6) {
+    return Status::Error("hash_grid.finest_resolution: must be in [base_resolution, 1e6]");
+  }
+  if (!(init_scale >= 0.0f)) return Status::Error("hash_grid.init_scale: must be >= 0");
+  return Status::Ok();
+}
+
+std::string HashGridOptions::ToString() const {
+  std::ostringstream s;
+  s << "HashGridOptions(L=" << num_levels << ", F=" << features_per_level << ", log2_T="
+    << log2_table_size << ", base=" << base_resolution << ", finest=" << finest_resolution
+    << ", init_scale=" << init_scale << ")";
+  return s.str();
+}
+
+HashGridLayout MakeHashGridLayout(const HashGridOptions& o) {
+  HashGridLayout g;
+  g.num_levels = o.num_levels;
+  g.features = o.features_per_level;
+  g.table_size = 1u << o.log2_table_size;
+  const double growth =
+      o.num_levels > 1 ? std::exp(std::log(o.finest_resolution / o.base_resolution) / (o.num_levels - 1)) : 1.0;
+  int64_t offset = 0;
+  for (int l = 0; l < o.num_levels; ++l) {
+    HashGridLevel lv;
+    lv.resolution = std::max(1, static_cast<int>(std::lround(o.base_resolution * std::pow(growth, l))));
+    const double dense_entries = std::pow(static_cast<double>(lv.resolution) + 1.0, 3.0);
+    lv.dense = dense_entries <= static_cast<double>(g.table_size);
+    lv.entries = lv.dense ? static_cast<int64_t>(dense_entries) : int64_t{g.table_size};
+    lv.offset = offset;
+    offset += lv.entries;
+    g.levels.push_back(lv);
+  }
+  g.total_entries = offset;
+  return g;
+}
+
+HashGridEncoding::HashGridEncoding(const HashGridOptions& options, ParameterStore* store,
+                                   const std::string& name, int group)
+    : options_(options), store_(store) {
+  const Status st = options.Validate();
+  ICEF_CHECK(st.ok(), st.message());
+  layout_ = MakeHashGridLayout(options);
+  block_ = store_->Register(name, layout_.num_params(), group);
+}
+
+void HashGridEncoding::Initialize(uint64_t seed) {
+  Rng rng(seed, StreamId("hash_grid_init"), static_cast<uint64_t>(block_));
+  float* t = table();
+  const double s = options_.init_scale;
+  for (int64_t i = 0; i < num_params(); ++i) t[i] = static_cast<float>(rng.Uniform(-s, s));
+}
+
+void HashGridEncoding::ForwardTile(int64_t n, const float* positions, float* features,
+                                   float* d_features_d_positions) const {
+  HashGridForward<float>(layout_, table(), n, positions, features, d_features_d_positions);
+}
+
+void HashGridEncoding::BackwardParamsLevels(int64_t n, const float* positions,
+                                            const float* d_features, int level_begin,
+                                            int level_end) {
+  HashGridBackwardParams<float>(layout_, n, positions, d_features, table_grads(), level_begin,
+                                level_end);
+}
+
+void HashGridEncoding::Forward(const Executor& executor, int64_t n, const float* positions,
+                               float* features, float* d_features_d_positions) const {
+  const int out = output_dims();
+  ParallelFor(executor, n, [&](int64_t begin, int64_t end, int) {
+    ForwardTile(end - begin, positions + 3 * begin, features + begin * out,
+                d_features_d_positions ? d_features_d_positions + begin * out * 3 : nullptr);
+  });
+}
+
+void HashGridEncoding::BackwardParams(const Executor& executor, int64_t n, const float* positions,
+                                      const float* d_features) {
+  const int threads = std::min(executor.num_threads(), layout_.num_levels);
+  ParallelFor(Executor(threads), threads, [&](int64_t, int64_t, int t) {
+    for (int l = t; l < layout_.num_levels; l += threads) {
+      BackwardParamsLevels(n, positions, d_features, l, l + 1);
+    }
+  });
+}
+
+void HashGridEncoding::BackwardInput(const Executor& executor, int64_t n,
+                                     const float* d_features_d_positions, const float* d_features,
+                                     float* d_positions) const {
+  const int out = output_dims();
+  ParallelFor(executor, n, [&](int64_t begin, int64_t end, int) {
+    HashGridBackwardInput<float>(layout_, end - begin, d_features_d_positions + begin * out * 3,
+                                 d_features + begin * out, d_positions + 3 * begin);
+  });
+}
+
+std::string HashGridEncoding::ToString() const {
+  std::ostringstream s;
+  s << "HashGridEncoding(" << store_->block(block_).name << ", " << options_.ToString()
+    << ", params=" << num_params() << ")";
+  return s.str();
+}
+
+}  // namespace icef::nn

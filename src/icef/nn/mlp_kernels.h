@@ -1,0 +1,166 @@
+// Single-threaded MLP kernels on one tile of n samples, templated on the scalar type (float for
+// speed, double for gradient checks). All buffers are row-major and packed.
+//
+// Network: widths w_0 (input), w_1 ... w_{L-1} (hidden, ReLU), w_L (output, MlpShape activation);
+// no bias terms (as tiny-cuda-nn). Layer l's weights are stored TRANSPOSED as Wt_l [w_l, w_{l+1}]
+// (input-major), so a layer is y = x · Wt_l. Blocks follow each other without padding in a flat
+// weight vector (offset WeightOffset(l)).
+//
+// hidden: the post-ReLU activations of the hidden layers of this tile, layer after layer, each
+// block [n, w_l] (offset n * HiddenOffset(l)); kept from the forward pass for the backward pass.
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "icef/core/status.h"
+#include "icef/nn/activation.h"
+#include "icef/nn/gemm.h"
+
+namespace icef::nn {
+
+class MlpShape {
+ public:
+  MlpShape() = default;
+  MlpShape(std::vector<int> widths, Activation output_activation);
+
+  const std::vector<int>& widths() const { return widths_; }
+  int num_layers() const { return static_cast<int>(widths_.size()) - 1; }
+  int input_dims() const { return widths_.front(); }
+  int output_dims() const { return widths_.back(); }
+  Activation output_activation() const { return output_activation_; }
+  // First float of layer l's Wt block in the flat weight vector.
+  int64_t WeightOffset(int l) const { return weight_offsets_[l]; }
+  int64_t num_params() const { return weight_offsets_.back(); }
+  // Sum of hidden widths before hidden layer l (l = 0 .. num_layers()-2): block l starts at
+  // hidden + n * HiddenOffset(l).
+  int HiddenOffset(int l) const { return hidden_offsets_[l]; }
+  // Floats of hidden activations per sample (sum of hidden widths).
+  int hidden_per_sample() const { return hidden_offsets_.back(); }
+  int max_width() const { return max_width_; }
+  // Multiply-adds per sample in the forward pass.
+  int64_t ForwardMacs() const { return num_params(); }
+  std::string ToString() const;
+
+ private:
+  std::vector<int> widths_;
+  Activation output_activation_ = Activation::kNone;
+  std::vector<int64_t> weight_offsets_;
+  std::vector<int> hidden_offsets_;
+  int max_width_ = 0;
+};
+
+// Writes W_l [w_{l+1}, w_l] (the untransposed layer) for every layer into wt_out, same offsets.
+// The backward pass multiplies by these. Call once per batch, not per tile.
+template <typename T>
+void MlpTransposeWeights(const MlpShape& s, const T* w, T* w_transposed) {
+  for (int l = 0; l < s.num_layers(); ++l) {
+    const int in = s.widths()[l], out = s.widths()[l + 1];
+    const T* src = w + s.WeightOffset(l);
+    T* dst = w_transposed + s.WeightOffset(l);
+    for (int i = 0; i < in; ++i)
+      for (int o = 0; o < out; ++o) dst[o * in + i] = src[i * out + o];
+  }
+}
+
+// x [n, w_0] -> y [n, w_L]; hidden [n * hidden_per_sample] receives the hidden activations.
+template <typename T>
+void MlpForward(const MlpShape& s, const T* w, int64_t n, const T* x, T* hidden, T* y) {
+  const T* in = x;
+  const int layers = s.num_layers();
+  for (int l = 0; l < layers; ++l) {
+    const bool last = l == layers - 1;
+    const int in_w = s.widths()[l], out_w = s.widths()[l + 1];
+    T* out = last ? y : hidden + n * s.HiddenOffset(l);
+    GemmNN<T>(n, in_w, out_w, in, w + s.WeightOffset(l), out);
+    const int64_t count = n * out_w;
+    if (!last) {
+      for (int64_t i = 0; i < count; ++i) out[i] = out[i] > T(0) ? out[i] : T(0);
+    } else if (s.output_activation() != Activation::kNone) {
+      const Activation a = s.output_activation();
+      for (int64_t i = 0; i < count; ++i) out[i] = ApplyActivation(a, out[i]);
+    }
+    in = out;
+  }
+}
+
+// Scratch floats MlpBackward needs for a tile of n samples.
+inline int64_t MlpBackwardScratch(const MlpShape& s, int64_t n) { return 2 * n * s.max_width(); }
+
+// Given dy = d loss / d y [n, w_L], ACCUMULATES d loss / d Wt into dw (flat, same layout as w) and,
+// when dx is not null, WRITES d loss / d x [n, w_0]. w_transposed from MlpTransposeWeights.
+template <typename T>
+void MlpBackward(const MlpShape& s, const T* w_transposed, int64_t n, const T* x, const T* hidden,
+                 const T* y, const T* dy, T* dw, T* dx, T* scratch) {
+  const int layers = s.num_layers();
+  T* bufs[2] = {scratch, scratch + n * s.max_width()};
+  int cur = 0;
+  T* d = bufs[cur];
+  {
+    const int64_t count = n * s.output_dims();
+    const Activation a = s.output_activation();
+    if (a == Activation::kNone) {
+      std::copy(dy, dy + count, d);
+    } else {
+      for (int64_t i = 0; i < count; ++i) d[i] = dy[i] * ActivationDerivativeFromOutput(a, y[i]);
+    }
+  }
+  for (int l = layers - 1; l >= 0; --l) {
+    const int in_w = s.widths()[l], out_w = s.widths()[l + 1];
+    const T* in = l == 0 ? x : hidden + n * s.HiddenOffset(l - 1);
+    GemmTNAcc<T>(n, in_w, out_w, in, d, dw + s.WeightOffset(l));
+    if (l == 0 && dx == nullptr) break;
+    T* dest = l == 0 ? dx : bufs[1 - cur];
+    GemmNN<T>(n, out_w, in_w, d, w_transposed + s.WeightOffset(l), dest);
+    if (l > 0) {
+      const int64_t count = n * in_w;
+      for (int64_t i = 0; i < count; ++i) dest[i] = in[i] > T(0) ? dest[i] : T(0);
+      cur = 1 - cur;
+      d = dest;
+    }
+  }
+}
+
+// Scratch floats MlpJvp needs for a tile of n samples.
+inline int64_t MlpJvpScratch(const MlpShape& s, int64_t n) { return 4 * n * s.max_width(); }
+
+// Forward-mode derivative: y = f(x) [n, w_L] and jy = J_f(x) · v [n, w_L], where the tangent v
+// [n, slice_dims] is non-zero only on input columns [slice_begin, slice_begin + slice_dims).
+template <typename T>
+void MlpJvp(const MlpShape& s, const T* w, int64_t n, const T* x, int slice_begin, int slice_dims,
+            const T* v, T* y, T* jy, T* scratch) {
+  const int layers = s.num_layers();
+  const int64_t stride = n * s.max_width();
+  T* h[2] = {scratch, scratch + stride};
+  T* t[2] = {scratch + 2 * stride, scratch + 3 * stride};
+  const T* in = x;
+  const T* tin = v;
+  int cur = 0;
+  for (int l = 0; l < layers; ++l) {
+    const bool last = l == layers - 1;
+    const int in_w = s.widths()[l], out_w = s.widths()[l + 1];
+    T* out = last ? y : h[cur];
+    T* tout = last ? jy : t[cur];
+    GemmNN<T>(n, in_w, out_w, in, w + s.WeightOffset(l), out);
+    if (l == 0) {
+      GemmNN<T>(n, slice_dims, out_w, tin, w + s.WeightOffset(0) + int64_t{slice_begin} * out_w, tout);
+    } else {
+      GemmNN<T>(n, in_w, out_w, tin, w + s.WeightOffset(l), tout);
+    }
+    const int64_t count = n * out_w;
+    const Activation a = last ? s.output_activation() : Activation::kRelu;
+    if (a != Activation::kNone) {
+      for (int64_t i = 0; i < count; ++i) {
+        out[i] = ApplyActivation(a, out[i]);
+        tout[i] *= ActivationDerivativeFromOutput(a, out[i]);
+      }
+    }
+    in = out;
+    tin = tout;
+    cur = 1 - cur;
+  }
+}
+
+}  // namespace icef::nn

@@ -1,0 +1,1 @@
+icef_module(nn DEPS icef_io)
