@@ -1,0 +1,1 @@
+icef_module(field DEPS icef_nn icef_data)
