@@ -1,0 +1,104 @@
+// The static canonical radiance field F_static(x_c, d) -> (rgb, sigma) of DESIGN.md §2: a
+// multiresolution hash grid over the aabb, a density MLP and a colour MLP fed with the density
+// MLP's output and the spherical-harmonics encoding of the view direction. It never receives the
+// expression beta (condition_dims = 0), which is what makes identity expression-invariant by
+// construction; only the entangled `nerface` baseline sets condition_dims = B, appending beta to
+// the density MLP's input.
+//
+//   features = HashGrid(aabb.Normalize(x_c))            [n, L*F]
+//   h        = DensityMlp([features, beta?])            [n, geo]   (no output activation)
+//   sigma    = exp(min(h_0, kMaxLogDensity))            [n]
+//   rgb      = ColorMlp([h, SH_4(d)])                   [n, 3]     (sigmoid)
+#pragma once
+
+#include <string>
+
+#include "icef/core/parallel.h"
+#include "icef/core/status.h"
+#include "icef/math/ray.h"
+#include "icef/nn/aligned.h"
+#include "icef/nn/hash_grid.h"
+#include "icef/nn/mlp.h"
+#include "icef/nn/parameter_store.h"
+
+namespace icef {
+
+struct StaticFieldOptions {
+  // Hash grid over the aabb (positions are normalised to [0,1]^3 before lookup).
+  nn::HashGridOptions grid;
+  // Width of the density MLP's hidden layer.
+  int density_hidden = 64;
+  // Outputs of the density MLP (the first is log-density; all feed the colour MLP).
+  int geo_features = 16;
+  // Widths of the colour MLP's hidden layers.
+  std::vector<int> color_hidden = {64, 64};
+  // Spherical-harmonics degree of the view-direction encoding (degree^2 values).
+  int sh_degree = 4;
+  // Expression dimensions appended to the density MLP input (0 = no beta; nerface only).
+  int condition_dims = 0;
+
+  Status Validate() const;
+  std::string ToString() const;
+};
+
+// Largest log-density before exp (keeps sigma finite).
+inline constexpr float kMaxLogDensity = 15.f;
+
+// Per-batch buffers; reused across batches (grows, never shrinks).
+struct StaticFieldContext {
+  int64_t n = 0;
+  bool has_position_jacobian = false;
+  nn::AlignedVector<float> unit_positions;  // [n, 3] in [0,1]^3
+  nn::AlignedVector<float> density_input;   // [n, L*F + condition_dims]
+  nn::AlignedVector<float> grid_jacobian;   // [n, L*F, 3] when positions need gradients
+  nn::AlignedVector<float> density_output;  // [n, geo]
+  nn::AlignedVector<float> color_input;     // [n, geo + sh]
+  nn::AlignedVector<float> grid_features;   // [n, L*F] (only when condition_dims > 0)
+  nn::AlignedVector<float> d_color_input;   // [n, geo + sh]
+  nn::AlignedVector<float> d_density_output;// [n, geo]
+  nn::AlignedVector<float> d_density_input; // [n, L*F + condition_dims]
+  nn::AlignedVector<float> d_unit_positions;// [n, 3]
+  nn::MlpContext density_mlp;
+  nn::MlpContext color_mlp;
+};
+
+class StaticField {
+ public:
+  // Registers "<name>/grid", "<name>/density", "<name>/color" in *store (grid in `grid_group`,
+  // MLPs in `mlp_group`); the store must outlive the field.
+  StaticField(const StaticFieldOptions& options, const Aabb& aabb, nn::ParameterStore* store,
+              const std::string& name, int grid_group, int mlp_group);
+  void Initialize(uint64_t seed);
+
+  // positions [n, 3] canonical world frame; directions [n, 3] unit, world frame; condition
+  // [n, condition_dims] or null when condition_dims = 0 -> sigma [n], rgb [n, 3].
+  // keep_for_backward keeps what Backward needs; need_position_grad also keeps the grid's
+  // Jacobian so Backward can return d/d positions.
+  void Forward(const Executor& executor, int64_t n, const float* positions, const float* directions,
+               const float* condition, float* sigma, float* rgb, StaticFieldContext* ctx,
+               bool keep_for_backward, bool need_position_grad) const;
+  // After Forward(keep_for_backward), with its outputs sigma [n] and rgb [n, 3]: accumulates
+  // parameter gradients into the store from d_sigma [n] and d_rgb [n, 3]; writes d_positions
+  // [n, 3] (world frame) unless null.
+  void Backward(const Executor& executor, int64_t n, const float* sigma, const float* rgb, const float* d_sigma,
+                const float* d_rgb, StaticFieldContext* ctx, float* d_positions);
+  // Density only (occupancy-grid updates): positions [n, 3] -> sigma [n].
+  void Density(const Executor& executor, int64_t n, const float* positions, const float* condition, float* sigma,
+               StaticFieldContext* ctx) const;
+
+  const StaticFieldOptions& options() const { return options_; }
+  const Aabb& aabb() const { return aabb_; }
+  std::string ToString() const;
+
+ private:
+  void DensityForward(const Executor& executor, int64_t n, const float* positions, const float* condition,
+                      StaticFieldContext* ctx, bool keep_for_backward, bool need_position_grad) const;
+
+  StaticFieldOptions options_;
+  Aabb aabb_;
+  nn::HashGridEncoding grid_;
+  nn::Mlp density_mlp_;
+  nn::Mlp color_mlp_;
+};
+
+}  // namespace icef

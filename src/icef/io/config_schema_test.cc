@@ -1,0 +1,78 @@
+#include "icef/io/config_schema.h"
+
+#include <gtest/gtest.h>
+
+namespace icef {
+namespace {
+
+struct Example {
+  int steps = 10;
+  double lr = 0.5;
+  float scale = 2.f;
+  bool flag = false;
+  std::string name = "a";
+  std::vector<int> widths = {1, 2};
+  int64_t big = 7;
+  void Bind(ConfigSchema& s) {
+    s.Int("steps", &steps, "steps");
+    s.Number("lr", &lr, "learning rate");
+    s.Float("scale", &scale, "scale");
+    s.Bool("flag", &flag, "flag");
+    s.String("name", &name, "name");
+    s.IntArray("widths", &widths, "widths");
+    s.Int64("big", &big, "big");
+  }
+};
+
+Result<Example> Parse(const std::string& text) {
+  ICEF_ASSIGN_OR_RETURN(Json j, ParseJson(text, "cfg.json"));
+  ICEF_ASSIGN_OR_RETURN(JsonObjectView v, JsonObjectView::Make(j, "cfg.json", ""));
+  Example e;
+  ICEF_RETURN_IF_ERROR(ReadConfig(v, &e));
+  return e;
+}
+
+TEST(ConfigSchemaTest, ReadsKnownKeysAndKeepsDefaults) {
+  auto e = Parse(R"({"steps": 5, "widths": [3, 4, 5], "flag": true})");
+  ASSERT_TRUE(e.ok()) << e.status().message();
+  EXPECT_EQ(e->steps, 5);
+  EXPECT_EQ(e->widths, (std::vector<int>{3, 4, 5}));
+  EXPECT_TRUE(e->flag);
+  EXPECT_EQ(e->lr, 0.5);
+  EXPECT_EQ(e->name, "a");
+}
+
+TEST(ConfigSchemaTest, UnknownKeyIsAnErrorListingValidKeys) {
+  auto e = Parse(R"({"stpes": 5})");
+  ASSERT_FALSE(e.ok());
+  EXPECT_NE(e.status().message().find("cfg.json"), std::string::npos);
+  EXPECT_NE(e.status().message().find("stpes"), std::string::npos);
+  EXPECT_NE(e.status().message().find("valid keys: steps, lr"), std::string::npos);
+}
+
+TEST(ConfigSchemaTest, WrongTypesAndValuesNameTheKey) {
+  for (const char* bad : {R"({"steps": "x"})", R"({"steps": 1.5})", R"({"widths": [1, 2.5]})", R"({"flag": 1})",
+                          R"({"lr": NaN})", R"({"scale": 1e300})"}) {
+    auto e = Parse(bad);
+    ASSERT_FALSE(e.ok()) << bad;
+  }
+}
+
+TEST(ConfigSchemaTest, WriteRoundTripsAndDocuments) {
+  Example e;
+  e.steps = 42;
+  e.scale = 0.1f;
+  const Json j = WriteConfig(e);
+  EXPECT_EQ(j["steps"], 42);
+  auto back = Parse(j.dump());
+  ASSERT_TRUE(back.ok());
+  EXPECT_EQ(back->steps, 42);
+  EXPECT_EQ(back->scale, 0.1f);
+  ConfigSchema s;
+  Example d;
+  d.Bind(s);
+  EXPECT_NE(s.MarkdownRows().find("| `lr` | `0.5` | learning rate |"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace icef
