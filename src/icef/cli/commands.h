@@ -13,6 +13,7 @@ namespace icef::cli {
 using CommandFn = std::function<Status()>;
 
 CommandFn RegisterInfo(CLI::App& app);
+CommandFn RegisterImport(CLI::App& app);
 CommandFn RegisterMask(CLI::App& app);
 CommandFn RegisterFaceId(CLI::App& app);
 CommandFn RegisterDemo(CLI::App& app);

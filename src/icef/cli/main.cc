@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   const std::pair<const char*, std::pair<const char*, Register>> commands[] = {
       {"demo", {"Run the built-in demo end to end", icef::cli::RegisterDemo}},
       {"info", {"Summarise and validate a dataset", icef::cli::RegisterInfo}},
+      {"import", {"Convert a NerFace / instant-ngp dataset into our format", icef::cli::RegisterImport}},
       {"mask", {"Show the expression-region mask (overlay + volume slices)", icef::cli::RegisterMask}},
       {"faceid", {"Face-identity descriptors of photos and their pairwise distances", icef::cli::RegisterFaceId}},
   };

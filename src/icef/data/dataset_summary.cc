@@ -144,27 +144,28 @@ std::string DatasetSummary::ToString() const {
   }
   os << "\n";
   os << "  background:    " << Vec3Text(background);
-  if (background_file_path) os << " (mean of image " << *background_file_path << ")";
+  if (background_file_path) os << " (image " << *background_file_path << ")";
   os << "\n";
-  os << "  landmarks:    ";
+  os << "  landmarks:     ";
+  std::string separator;
   for (const SplitSummary& s : splits) {
     if (s.num_frames == 0) continue;
-    os << " " << s.name << " 2D " << s.with_landmarks_2d << "/" << s.num_frames << ", 3D " << s.with_landmarks_3d
-       << "/" << s.num_frames << ";";
+    os << separator << s.name << " 2D " << s.with_landmarks_2d << "/" << s.num_frames << ", 3D "
+       << s.with_landmarks_3d << "/" << s.num_frames;
+    separator = "; ";
   }
   os << "\n";
-  os << "  tiers:        ";
-  bool any_tier = false;
+  os << "  tiers:         ";
+  separator.clear();
   for (const SplitSummary& s : splits) {
     if (s.num_frames == s.without_tier) continue;
-    any_tier = true;
-    os << " " << s.name << ":";
+    os << separator << s.name << ":";
     for (Tier t : {Tier::kObserved, Tier::kNear, Tier::kModerate, Tier::kFar})
       os << " " << TierName(t) << " " << s.tier_counts[static_cast<int>(t)];
-    if (s.without_tier) os << " none " << s.without_tier;
-    os << ";";
+    if (s.without_tier) os << ", untiered " << s.without_tier;
+    separator = "; ";
   }
-  if (!any_tier) os << " none";
+  if (separator.empty()) os << "none";
   if (tier_thresholds) os << " (thresholds " << Num((*tier_thresholds)[0]) << ", " << Num((*tier_thresholds)[1]) << ")";
   os << "\n";
   os << "  train expression distance (pairwise): ";
