@@ -14,13 +14,16 @@ Status OccupancyGridOptions::Validate() const {
   if (!(threshold >= 0.f) || !std::isfinite(threshold)) return Status::Error("occupancy.threshold must be >= 0");
   if (dilation < 0 || dilation > 16) return Status::Error("occupancy.dilation must be in [0, 16]");
   if (query_batch < 1) return Status::Error("occupancy.query_batch must be >= 1");
+  if (!(update_fraction > 0.f && update_fraction <= 1.f))
+    return Status::Error("occupancy.update_fraction must be in (0, 1]");
   return Status::Ok();
 }
 
 std::string OccupancyGridOptions::ToString() const {
   std::ostringstream os;
   os << "OccupancyGridOptions(resolution=" << resolution << ", decay=" << decay << ", threshold=" << threshold
-     << ", dilation=" << dilation << ", query_batch=" << query_batch << ")";
+     << ", dilation=" << dilation << ", query_batch=" << query_batch
+     << ", update_fraction=" << update_fraction << ")";
   return os.str();
 }
 
@@ -66,25 +69,31 @@ void OccupancyGrid::Update(const DensityQuery& query, uint64_t seed, int64_t ste
   const int r = options_.resolution;
   const int64_t cells = num_cells();
   const Vec3f cell_size = aabb_.Extent() / float(r);
-  const int64_t batch = std::min(options_.query_batch, cells);
+  for (float& d : density_) d *= options_.decay;
+  // The cells to re-query this step, in index order.
+  std::vector<int64_t> selected;
+  selected.reserve(options_.update_fraction >= 1.f ? cells : int64_t(cells * options_.update_fraction * 1.1f) + 16);
+  for (int64_t c = 0; c < cells; ++c) {
+    if (options_.update_fraction >= 1.f ||
+        Rng(seed, StreamId("occupancy_subset"), uint64_t(step), uint64_t(c)).Uniform() < options_.update_fraction)
+      selected.push_back(c);
+  }
+  const int64_t batch = std::max<int64_t>(1, std::min<int64_t>(options_.query_batch, int64_t(selected.size())));
   std::vector<float> positions(batch * 3);
   std::vector<float> sigma(batch);
-  for (int64_t begin = 0; begin < cells; begin += batch) {
-    const int64_t n = std::min(batch, cells - begin);
+  for (int64_t begin = 0; begin < int64_t(selected.size()); begin += batch) {
+    const int64_t n = std::min<int64_t>(batch, int64_t(selected.size()) - begin);
     for (int64_t i = 0; i < n; ++i) {
-      const int64_t c = begin + i;
-      const int x = int(c % r), y = int((c / r) % r), z = int(c / (int64_t(r) * r));
+      const int64_t c = selected[begin + i];
+      const int idx[3] = {int(c % r), int((c / r) % r), int(c / (int64_t(r) * r))};
       Rng rng(seed, StreamId("occupancy"), uint64_t(step), uint64_t(c));
-      for (int a = 0; a < 3; ++a) {
-        const int idx = a == 0 ? x : (a == 1 ? y : z);
-        positions[3 * i + a] = aabb_.min[a] + (float(idx) + rng.Uniform()) * cell_size[a];
-      }
+      for (int a = 0; a < 3; ++a) positions[3 * i + a] = aabb_.min[a] + (float(idx[a]) + rng.Uniform()) * cell_size[a];
     }
     query(positions.data(), n, sigma.data());
     for (int64_t i = 0; i < n; ++i) {
       const float s = std::isfinite(sigma[i]) ? std::max(sigma[i], 0.f) : 0.f;
-      float& d = density_[begin + i];
-      d = std::max(d * options_.decay, s);
+      float& d = density_[selected[begin + i]];
+      d = std::max(d, s);
     }
   }
   RecomputeBits();

@@ -21,6 +21,7 @@ struct OccupancyGridOptions {
   float threshold = 0.01f;   // a cell is occupied when its stored density (sigma, 1/world units) exceeds this
   int dilation = 1;          // occupied cells are dilated by this many cells (Chebyshev distance)
   int64_t query_batch = 65536;  // positions per density-query call
+  float update_fraction = 1.f;  // fraction of cells re-queried per Update (a random subset; all cells decay)
 
   Status Validate() const;
   std::string ToString() const;
@@ -35,9 +36,10 @@ class OccupancyGrid {
   // Checks options.Validate() and aabb validity (programming errors).
   OccupancyGrid(const Aabb& aabb, const OccupancyGridOptions& options);
 
-  // Queries one jittered point per cell (Rng keyed on (seed, "occupancy", step, cell)), folds it
-  // into the stored density with the EMA-of-max rule, then recomputes the occupied bits
-  // (threshold + dilation). Deterministic for (seed, step) and the query.
+  // Decays every stored density by `decay`, queries one jittered point per selected cell (Rng keyed
+  // on (seed, "occupancy", step, cell); with update_fraction < 1 a cell is selected with that
+  // probability) and keeps max(decayed, queried); then recomputes the occupied bits (threshold +
+  // dilation). Deterministic for (seed, step) and the query.
   void Update(const DensityQuery& query, uint64_t seed, int64_t step);
 
   // True when the cell containing p (world frame) is occupied; false outside the aabb.

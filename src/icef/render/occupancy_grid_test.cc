@@ -78,6 +78,23 @@ TEST(OccupancyGridTest, DeterministicAndRestorable) {
   EXPECT_FALSE(c.SetDensities(std::vector<float>(3)).ok());
 }
 
+TEST(OccupancyGridTest, PartialUpdatesQueryAboutThatFractionOfCells) {
+  OccupancyGridOptions o;
+  o.resolution = 16;
+  o.update_fraction = 0.25f;
+  OccupancyGrid grid(Aabb(), o);
+  int64_t queried = 0;
+  grid.Update([&](const float*, int64_t n, float* sigma) {
+    queried += n;
+    for (int64_t i = 0; i < n; ++i) sigma[i] = 1.f;
+  }, 3, 0);
+  EXPECT_GT(queried, 900);   // 0.25 * 4096 = 1024
+  EXPECT_LT(queried, 1150);
+  int64_t high = 0;
+  for (float d : grid.densities()) high += d == 1.f ? 1 : 0;
+  EXPECT_EQ(high, queried);  // exactly the queried cells took the new density
+}
+
 TEST(OccupancyGridTest, ValidateRejectsBadOptions) {
   OccupancyGridOptions o;
   EXPECT_TRUE(o.Validate().ok());
@@ -85,6 +102,9 @@ TEST(OccupancyGridTest, ValidateRejectsBadOptions) {
   EXPECT_FALSE(o.Validate().ok());
   o = OccupancyGridOptions();
   o.resolution = 0;
+  EXPECT_FALSE(o.Validate().ok());
+  o = OccupancyGridOptions();
+  o.update_fraction = 0.f;
   EXPECT_FALSE(o.Validate().ok());
 }
 
