@@ -65,6 +65,50 @@ void TNPanel(int64_t n, int k, int m, const float* a, const float* b, float* c) 
   }
 }
 
+// Column tail of fewer than 16 columns (masked loads/stores), R rows at a time.
+template <int R>
+inline void NNBlockMasked(int k, int m, const float* a, const float* b, float* c, __mmask16 mask) {
+  __m512 acc[R];
+  for (int r = 0; r < R; ++r) acc[r] = _mm512_setzero_ps();
+  for (int p = 0; p < k; ++p) {
+    const __m512 bv = _mm512_maskz_loadu_ps(mask, b + static_cast<int64_t>(p) * m);
+    for (int r = 0; r < R; ++r) {
+      acc[r] = _mm512_fmadd_ps(_mm512_set1_ps(a[static_cast<int64_t>(r) * k + p]), bv, acc[r]);
+    }
+  }
+  for (int r = 0; r < R; ++r) _mm512_mask_storeu_ps(c + static_cast<int64_t>(r) * m, mask, acc[r]);
+}
+
+void NNTail(int64_t n, int k, int m, int j0, const float* a, const float* b, float* c) {
+  const __mmask16 mask = static_cast<__mmask16>((1u << (m - j0)) - 1u);
+  int64_t s = 0;
+  for (; s + 12 <= n; s += 12) NNBlockMasked<12>(k, m, a + s * k, b + j0, c + s * m + j0, mask);
+  for (; s < n; ++s) NNBlockMasked<1>(k, m, a + s * k, b + j0, c + s * m + j0, mask);
+}
+
+// C[k, m] += A[n, k]^T B[n, m] for small m (< 16) and k a multiple of 16: vectorised along k,
+// C^T [m, k] accumulated in registers (m * k/16 accumulators), added transposed at the end.
+template <int M, int KV>
+void TNSmallM(int64_t n, const float* a, const float* b, float* c) {
+  constexpr int k = 16 * KV;
+  __m512 acc[M][KV];
+  for (int j = 0; j < M; ++j)
+    for (int v = 0; v < KV; ++v) acc[j][v] = _mm512_setzero_ps();
+  for (int64_t s = 0; s < n; ++s) {
+    __m512 av[KV];
+    for (int v = 0; v < KV; ++v) av[v] = _mm512_loadu_ps(a + s * k + 16 * v);
+    for (int j = 0; j < M; ++j) {
+      const __m512 bj = _mm512_set1_ps(b[s * M + j]);
+      for (int v = 0; v < KV; ++v) acc[j][v] = _mm512_fmadd_ps(bj, av[v], acc[j][v]);
+    }
+  }
+  alignas(64) float tmp[M][k];
+  for (int j = 0; j < M; ++j)
+    for (int v = 0; v < KV; ++v) _mm512_store_ps(&tmp[j][16 * v], acc[j][v]);
+  for (int p = 0; p < k; ++p)
+    for (int j = 0; j < M; ++j) c[p * M + j] += tmp[j][p];
+}
+
 }  // namespace
 
 template <>
@@ -72,7 +116,16 @@ void GemmNN<float>(int64_t n, int k, int m, const float* a, const float* b, floa
   if (m % 64 == 0) return NNPanel<6, 4>(n, k, m, a, b, c);
   if (m % 32 == 0) return NNPanel<12, 2>(n, k, m, a, b, c);
   if (m % 16 == 0) return NNPanel<16, 1>(n, k, m, a, b, c);
-  GemmNNGeneric(n, k, m, a, b, c);
+  const int full = m / 16 * 16;
+  if (full > 0) {
+    // Full 16-column panels straight into C (row stride m), then the masked tail.
+    for (int j0 = 0; j0 < full; j0 += 16) {
+      int64_t s = 0;
+      for (; s + 16 <= n; s += 16) NNBlock<16, 1>(k, m, a + s * k, b + j0, c + s * m + j0);
+      for (; s < n; ++s) NNBlock<1, 1>(k, m, a + s * k, b + j0, c + s * m + j0);
+    }
+  }
+  NNTail(n, k, m, full, a, b, c);
 }
 
 template <>
@@ -80,6 +133,9 @@ void GemmTNAcc<float>(int64_t n, int k, int m, const float* a, const float* b, f
   if (m % 64 == 0) return TNPanel<6, 4>(n, k, m, a, b, c);
   if (m % 32 == 0) return TNPanel<12, 2>(n, k, m, a, b, c);
   if (m % 16 == 0) return TNPanel<16, 1>(n, k, m, a, b, c);
+  if (k == 64 && m == 3) return TNSmallM<3, 4>(n, a, b, c);
+  if (k == 64 && m == 1) return TNSmallM<1, 4>(n, a, b, c);
+  if (k == 32 && m == 3) return TNSmallM<3, 2>(n, a, b, c);
   GemmTNAccGeneric(n, k, m, a, b, c);
 }
 

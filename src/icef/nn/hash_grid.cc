@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "icef/core/rng.h"
+#include "icef/nn/hash_grid_fast.h"
 
 namespace icef::nn {
 
@@ -71,14 +72,41 @@ void HashGridEncoding::Initialize(uint64_t seed) {
 
 void HashGridEncoding::ForwardTile(int64_t n, const float* positions, float* features,
                                    float* d_features_d_positions) const {
-  HashGridForward<float>(layout_, table(), n, positions, features, d_features_d_positions);
+  if (layout_.features == 2) {
+    HashGridForwardF2(layout_, table(), n, positions, features, d_features_d_positions);
+  } else {
+    HashGridForward<float>(layout_, table(), n, positions, features, d_features_d_positions);
+  }
+}
+
+void HashGridEncoding::BackwardParamsLevel(int level, int64_t n, const float* positions,
+                                           const float* d_level, int64_t d_stride) {
+  ICEF_CHECK(level >= 0 && level < layout_.num_levels, "hash grid level out of range");
+  if (layout_.features == 2) {
+    HashGridScatterLevelF2(layout_, level, n, positions, d_level, d_stride, table_grads());
+    return;
+  }
+  const HashGridLevel& lv = layout_.levels[level];
+  const int F = layout_.features;
+  float* tl = table_grads() + lv.offset * F;
+  for (int64_t s = 0; s < n; ++s) {
+    uint32_t idx[8];
+    float frac[3], w[8];
+    bool inside[3];
+    HashGridCell<float>(lv, layout_.table_size, positions + 3 * s, idx, frac, inside);
+    TrilinearWeights<float>(frac, w);
+    const float* d = d_level + s * d_stride;
+    for (int c = 0; c < 8; ++c)
+      for (int k = 0; k < F; ++k) tl[int64_t{idx[c]} * F + k] += w[c] * d[k];
+  }
 }
 
 void HashGridEncoding::BackwardParamsLevels(int64_t n, const float* positions,
                                             const float* d_features, int level_begin,
                                             int level_end) {
-  HashGridBackwardParams<float>(layout_, n, positions, d_features, table_grads(), level_begin,
-                                level_end);
+  for (int l = level_begin; l < level_end; ++l) {
+    BackwardParamsLevel(l, n, positions, d_features + l * layout_.features, output_dims());
+  }
 }
 
 void HashGridEncoding::Forward(const Executor& executor, int64_t n, const float* positions,

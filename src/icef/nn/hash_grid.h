@@ -76,6 +76,11 @@ class HashGridEncoding {
                    float* d_features_d_positions) const;
   void BackwardParamsLevels(int64_t n, const float* positions, const float* d_features,
                             int level_begin, int level_end);
+  // One level's table gradient from that level's feature gradients d_level (row s at
+  // d_level + s * d_stride, F values): d_stride = L*F with d_level = d_features + l*F reads a
+  // sample-major matrix; d_stride = F reads a level-major buffer [n, F] (cheaper to stream).
+  void BackwardParamsLevel(int level, int64_t n, const float* positions, const float* d_level,
+                           int64_t d_stride);
 
   std::string ToString() const;
 

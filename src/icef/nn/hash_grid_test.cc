@@ -109,10 +109,16 @@ TEST(HashGridTest, ThreadedBackwardIsIdenticalForAnyThreadCount) {
     enc.BackwardParams(ex, n, pos.data(), dfeat.data());
     enc.BackwardInput(ex, n, jac.data(), dfeat.data(), dpos.data());
     grads.emplace_back(store.grads(), store.grads() + store.size());
-    // Float class agrees with the double kernel.
-    std::vector<double> table(enc.table(), enc.table() + enc.num_params()), fd(n * 16);
-    HashGridForward<double>(enc.layout(), table.data(), n, pd.data(), fd.data(), nullptr);
+    // The float fast path agrees with the double kernels (features, Jacobian, table gradient).
+    std::vector<double> table(enc.table(), enc.table() + enc.num_params()), fd(n * 16), jd(n * 48);
+    std::vector<double> dd_table(table.size(), 0.0), dpd(n * 3);
+    HashGridForward<double>(enc.layout(), table.data(), n, pd.data(), fd.data(), jd.data());
+    HashGridBackwardParams<double>(enc.layout(), n, pd.data(), dd.data(), dd_table.data(), 0, 8);
+    HashGridBackwardInput<double>(enc.layout(), n, jd.data(), dd.data(), dpd.data());
     for (int64_t i = 0; i < n * 16; ++i) ASSERT_NEAR(f[i], fd[i], 1e-7);
+    for (int64_t i = 0; i < n * 48; ++i) ASSERT_NEAR(jac[i], jd[i], 1e-5 * (1 + std::abs(jd[i])));
+    for (int64_t i = 0; i < n * 3; ++i) ASSERT_NEAR(dpos[i], dpd[i], 1e-4 * (1 + std::abs(dpd[i])));
+    for (size_t i = 0; i < table.size(); ++i) ASSERT_NEAR(store.grads()[i], dd_table[i], 1e-4 * (1 + std::abs(dd_table[i])));  // float sums of ~1e3 terms
   }
   EXPECT_EQ(0, std::memcmp(grads[0].data(), grads[1].data(), grads[0].size() * sizeof(float)));
   EXPECT_EQ(0, std::memcmp(grads[0].data(), grads[2].data(), grads[0].size() * sizeof(float)));

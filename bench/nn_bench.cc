@@ -1,0 +1,178 @@
+// Benchmarks of the nn building blocks on DESIGN.md §7's reference configuration (4096 rays x 32
+// samples, 2 threads): hash encoding, each MLP, and the Eigen float32 GEMM rate that the MLP
+// figures are compared with (counter fraction_of_gemm = MLP FLOP rate / GEMM FLOP rate).
+#include <benchmark/benchmark.h>
+
+// GCC 12 reports false -Wmaybe-uninitialized positives inside Eigen's AVX-512 GEMM kernels.
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#include <Eigen/Core>
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+#include <vector>
+
+#include "icef/core/parallel.h"
+#include "icef/nn/gemm.h"
+#include "icef/nn/hash_grid.h"
+#include "icef/nn/mlp.h"
+#include "icef/nn/reference_model.h"
+
+namespace icef::nn {
+
+// Threads of every benchmark: 2 (DESIGN.md §7), or ICEF_BENCH_THREADS (e.g. 1 to read per-core
+// CPU time on a busy machine).
+int BenchThreads() {
+  static const int threads = [] {
+    const char* env = std::getenv("ICEF_BENCH_THREADS");
+    return env ? std::max(1, std::atoi(env)) : 2;
+  }();
+  return threads;
+}
+constexpr int64_t kRays = 4096;
+constexpr int kSamplesPerRay = 32;
+
+// Measures the Eigen float32 2048x2048 matrix-multiply rate once (FLOP/s, 2 threads); shared with
+// reference_bench.cc so every MLP figure can be expressed as a fraction of it.
+double MeasuredGemmFlops() {
+  static const double rate = [] {
+    const int n = 2048;
+    Eigen::setNbThreads(BenchThreads());
+    Eigen::MatrixXf a = Eigen::MatrixXf::Random(n, n), b = Eigen::MatrixXf::Random(n, n), c(n, n);
+    c.noalias() = a * b;  // warm-up
+    double best = 0;
+    for (int rep = 0; rep < 5; ++rep) {
+      const auto t0 = std::chrono::steady_clock::now();
+      c.noalias() = a * b;
+      const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      best = std::max(best, 2.0 * n * n * n / s);
+    }
+    benchmark::DoNotOptimize(c.data());
+    return best;
+  }();
+  return rate;
+}
+
+const ReferenceBatch& BenchBatch() {
+  static const ReferenceBatch batch = MakeReferenceBatch(kRays, kSamplesPerRay, 1);
+  return batch;
+}
+
+static void BM_GemmFp32(benchmark::State& state) {
+  const int n = 2048;
+  Eigen::setNbThreads(BenchThreads());
+  Eigen::MatrixXf a = Eigen::MatrixXf::Random(n, n), b = Eigen::MatrixXf::Random(n, n), c(n, n);
+  for (auto _ : state) {
+    c.noalias() = a * b;
+    benchmark::DoNotOptimize(c.data());
+    benchmark::ClobberMemory();
+  }
+  state.counters["flops_per_second"] =
+      benchmark::Counter(2.0 * n * n * n * state.iterations(), benchmark::Counter::kIsRate);
+  state.SetLabel(std::string("Eigen ") + std::to_string(EIGEN_WORLD_VERSION) + "." +
+                 std::to_string(EIGEN_MAJOR_VERSION) + "." + std::to_string(EIGEN_MINOR_VERSION) +
+                 ", SIMD " + Eigen::SimdInstructionSetsInUse() + "; nn kernel " + GemmKernelName());
+}
+BENCHMARK(BM_GemmFp32)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+
+// ---- Hash encoding -------------------------------------------------------------------------
+
+struct GridFixture {
+  ParameterStore store;
+  HashGridEncoding grid{HashGridOptions{}, &store, "grid"};
+  std::vector<float> pos, feat, jac, dfeat, dpos;
+  GridFixture() {
+    grid.Initialize(1);
+    const ReferenceBatch& b = BenchBatch();
+    const int64_t n = b.num_samples();
+    pos.resize(n * 3);
+    for (int64_t i = 0; i < n * 3; ++i) pos[i] = 0.5f * (b.positions[i] + 1.0f);
+    feat.resize(n * 32);
+    jac.resize(n * 96);
+    dfeat.assign(n * 32, 1e-3f);
+    dpos.resize(n * 3);
+  }
+};
+GridFixture& Grid() {
+  static GridFixture f;
+  return f;
+}
+
+static void BM_HashGridForward(benchmark::State& state) {
+  GridFixture& f = Grid();
+  const Executor ex(BenchThreads());
+  const int64_t n = BenchBatch().num_samples();
+  for (auto _ : state) f.grid.Forward(ex, n, f.pos.data(), f.feat.data(), nullptr);
+  state.counters["samples_per_second"] = benchmark::Counter(double(n) * state.iterations(), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_HashGridForward)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+
+static void BM_HashGridForwardBackward(benchmark::State& state) {
+  GridFixture& f = Grid();
+  const Executor ex(BenchThreads());
+  const int64_t n = BenchBatch().num_samples();
+  for (auto _ : state) {
+    f.grid.Forward(ex, n, f.pos.data(), f.feat.data(), f.jac.data());
+    f.grid.BackwardInput(ex, n, f.jac.data(), f.dfeat.data(), f.dpos.data());
+    f.grid.BackwardParams(ex, n, f.pos.data(), f.dfeat.data());
+  }
+  state.counters["samples_per_second"] = benchmark::Counter(double(n) * state.iterations(), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_HashGridForwardBackward)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+
+// ---- MLPs ----------------------------------------------------------------------------------
+
+MlpOptions BenchMlpOptions(int which) {
+  MlpOptions o;
+  if (which == 0) {
+    o.widths = {55, 64, 64, 64, 3};  // deformation
+  } else if (which == 1) {
+    o.widths = {32, 64, 16};  // density
+  } else {
+    o.widths = {32, 64, 64, 3};  // colour
+    o.output_activation = Activation::kSigmoid;
+  }
+  return o;
+}
+const char* kMlpNames[] = {"deform_55-64-64-64-3", "density_32-64-16", "colour_32-64-64-3"};
+
+static void BM_MlpForward(benchmark::State& state) {
+  const int which = static_cast<int>(state.range(0));
+  ParameterStore store;
+  Mlp mlp(BenchMlpOptions(which), &store, "mlp");
+  mlp.Initialize(1);
+  const int64_t n = BenchBatch().num_samples();
+  std::vector<float> x(n * mlp.input_dims(), 0.3f), y(n * mlp.output_dims());
+  for (size_t i = 0; i < x.size(); ++i) x[i] = float(int(i % 17) - 8) / 8.0f;
+  const Executor ex(BenchThreads());
+  MlpContext ctx;
+  for (auto _ : state) mlp.Forward(ex, n, x.data(), y.data(), &ctx, /*keep_for_backward=*/false);
+  const double flops = 2.0 * mlp.num_params() * n * state.iterations();
+  state.counters["samples_per_second"] = benchmark::Counter(double(n) * state.iterations(), benchmark::Counter::kIsRate);
+  state.counters["flops_per_second"] = benchmark::Counter(flops, benchmark::Counter::kIsRate);
+  state.SetLabel(kMlpNames[which]);
+}
+BENCHMARK(BM_MlpForward)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(0.5);
+
+static void BM_MlpForwardBackward(benchmark::State& state) {
+  const int which = static_cast<int>(state.range(0));
+  ParameterStore store;
+  Mlp mlp(BenchMlpOptions(which), &store, "mlp");
+  mlp.Initialize(1);
+  const int64_t n = BenchBatch().num_samples();
+  std::vector<float> x(n * mlp.input_dims()), y(n * mlp.output_dims()), dy(n * mlp.output_dims(), 1e-3f),
+      dx(n * mlp.input_dims());
+  for (size_t i = 0; i < x.size(); ++i) x[i] = float(int(i % 17) - 8) / 8.0f;
+  const Executor ex(BenchThreads());
+  MlpContext ctx;
+  for (auto _ : state) {
+    mlp.Forward(ex, n, x.data(), y.data(), &ctx);
+    mlp.Backward(ex, n, x.data(), y.data(), dy.data(), &ctx, dx.data());
+  }
+  const double flops = 6.0 * mlp.num_params() * n * state.iterations();
+  state.counters["samples_per_second"] = benchmark::Counter(double(n) * state.iterations(), benchmark::Counter::kIsRate);
+  state.counters["flops_per_second"] = benchmark::Counter(flops, benchmark::Counter::kIsRate);
+  state.SetLabel(kMlpNames[which]);
+}
+BENCHMARK(BM_MlpForwardBackward)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(0.5);
+
+}  // namespace icef::nn

@@ -1,0 +1,93 @@
+// The headline benchmarks on DESIGN.md §7's reference configuration (see nn/reference_model.h):
+// BM_ReferenceTrainStep (forward + backward + Adam over 4096 rays x 32 samples, 2 threads) and
+// BM_ReferenceInference, each with a samples_per_second counter; plus peak RSS and the fraction
+// of the measured Eigen float32 GEMM rate (BM_GemmFp32) that the MLP work of the step reaches.
+#include <benchmark/benchmark.h>
+#include <sys/resource.h>
+
+#include <cstdio>
+#include <vector>
+
+#include "icef/core/parallel.h"
+#include "icef/nn/reference_model.h"
+
+namespace icef::nn {
+
+double MeasuredGemmFlops();  // nn_bench.cc
+const ReferenceBatch& BenchBatch();
+int BenchThreads();
+
+namespace {
+
+double PeakRssMb() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return u.ru_maxrss / 1024.0;  // Linux: kilobytes
+}
+
+ReferenceModel& Model() {
+  static ReferenceModel model(1);
+  return model;
+}
+
+// MLP FLOPs per sample of one training step: forward (2 per MAC), weight gradients (2 per MAC),
+// input gradients (2 per MAC) except the deformation net's first layer, whose input needs none.
+double TrainMlpFlopsPerSample(const ReferenceModel& m) {
+  const MlpShape& d = m.deform().mlp().shape();
+  return 6.0 * m.MlpMacsPerSample() - 2.0 * d.widths()[0] * d.widths()[1];
+}
+
+}  // namespace
+
+static void BM_ReferenceTrainStep(benchmark::State& state) {
+  ReferenceModel& m = Model();
+  const ReferenceBatch& batch = BenchBatch();
+  const Executor ex(BenchThreads());
+  m.TrainStep(ex, batch);  // warm-up: buffers, page faults
+  const ReferenceTimings before = m.timings();
+  double loss = 0;
+  for (auto _ : state) loss = m.TrainStep(ex, batch);
+  const double samples = double(batch.num_samples()) * state.iterations();
+  state.counters["samples_per_second"] = benchmark::Counter(samples, benchmark::Counter::kIsRate);
+  const double mlp_flops = TrainMlpFlopsPerSample(m) * samples;
+  state.counters["mlp_flops_per_second"] = benchmark::Counter(mlp_flops, benchmark::Counter::kIsRate);
+  const double gemm = MeasuredGemmFlops();
+  // fraction_of_gemm is filled in as a plain value: MLP FLOP rate over the whole step / GEMM rate.
+  ReferenceTimings t = m.timings();
+  const double steps = double(t.steps - before.steps);
+  const double step_s = (t.fused_tiles - before.fused_tiles + t.grid_scatter - before.grid_scatter +
+                         t.reduce - before.reduce + t.adam - before.adam) / steps;
+  const double rate = TrainMlpFlopsPerSample(m) * batch.num_samples() / step_s;
+  state.counters["fraction_of_gemm"] = rate / gemm;
+  state.counters["gemm_flops_per_second"] = gemm;
+  state.counters["peak_rss_mb"] = PeakRssMb();
+  state.counters["loss"] = loss;
+  state.counters["ms_fused_tiles"] = 1e3 * (t.fused_tiles - before.fused_tiles) / steps;
+  state.counters["ms_grid_scatter"] = 1e3 * (t.grid_scatter - before.grid_scatter) / steps;
+  state.counters["ms_reduce"] = 1e3 * (t.reduce - before.reduce) / steps;
+  state.counters["ms_adam"] = 1e3 * (t.adam - before.adam) / steps;
+  std::printf("BM_ReferenceTrainStep: %.3f M samples/s; MLPs at %.1f GFLOP/s = %.1f%% of the %.1f GFLOP/s "
+              "Eigen GEMM; peak RSS %.0f MB\n",
+              batch.num_samples() / step_s / 1e6, rate / 1e9, 100.0 * rate / gemm, gemm / 1e9, PeakRssMb());
+}
+BENCHMARK(BM_ReferenceTrainStep)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
+
+static void BM_ReferenceInference(benchmark::State& state) {
+  ReferenceModel& m = Model();
+  const ReferenceBatch& batch = BenchBatch();
+  const Executor ex(BenchThreads());
+  std::vector<float> out(batch.num_samples() * 4);
+  m.Infer(ex, batch, out.data());
+  for (auto _ : state) {
+    m.Infer(ex, batch, out.data());
+    benchmark::DoNotOptimize(out.data());
+  }
+  const double samples = double(batch.num_samples()) * state.iterations();
+  state.counters["samples_per_second"] = benchmark::Counter(samples, benchmark::Counter::kIsRate);
+  const double macs = m.MlpMacsPerSample();
+  state.counters["mlp_flops_per_second"] = benchmark::Counter(2.0 * macs * samples, benchmark::Counter::kIsRate);
+  state.counters["peak_rss_mb"] = PeakRssMb();
+}
+BENCHMARK(BM_ReferenceInference)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
+
+}  // namespace icef::nn
