@@ -4,6 +4,8 @@
 // avx512fintrin.h after inlining); the code is correct, so the warning is silenced for this file.
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 
+#include <omp.h>
+
 #include <Eigen/Core>
 #include <algorithm>
 #include <sstream>
@@ -16,6 +18,21 @@ namespace {
 using RowMatrix = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
 int PooledSize(int in, int window, int stride) { return in < window ? 0 : (in - window) / stride + 1; }
+
+// Runs Eigen's GEMM on the calling thread only. Eigen would otherwise split each product over
+// omp_get_max_threads() OpenMP threads, which on a shared, oversubscribed machine is ~100x slower
+// (spinning barriers) for these small products; callers parallelise over images instead.
+// omp_set_num_threads only changes the calling thread's setting, restored on exit.
+class ScopedSingleThreadGemm {
+ public:
+  ScopedSingleThreadGemm() : saved_(omp_get_max_threads()) { omp_set_num_threads(1); }
+  ~ScopedSingleThreadGemm() { omp_set_num_threads(saved_); }
+  ScopedSingleThreadGemm(const ScopedSingleThreadGemm&) = delete;
+  ScopedSingleThreadGemm& operator=(const ScopedSingleThreadGemm&) = delete;
+
+ private:
+  int saved_;
+};
 
 }  // namespace
 
@@ -67,7 +84,10 @@ Tensor3 Conv2d(const Tensor3& input, const ConvWeights& weights, int stride, con
   }
   Eigen::Map<const RowMatrix> filters(weights.filters.data(), patch, weights.cout);
   Eigen::Map<RowMatrix> result(out.data.data(), int64_t(out_h) * out_w, weights.cout);
-  result.noalias() = cols * filters;
+  {
+    ScopedSingleThreadGemm single_thread;
+    result.noalias() = cols * filters;
+  }
   if (!weights.bias.empty()) {
     Eigen::Map<const Eigen::RowVectorXf> bias(weights.bias.data(), weights.cout);
     result.rowwise() += bias;

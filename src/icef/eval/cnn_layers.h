@@ -1,7 +1,8 @@
 // Forward-only convolutional layers for the pretrained evaluation networks (the face-identity
 // ResNet and LPIPS). Tensors are single images in HWC layout; filters are HWIO (TF.js / dlib
 // order), so a convolution is one GEMM of the im2col matrix [out_h * out_w, kh * kw * cin] with
-// the filter matrix [kh * kw * cin, cout]. No gradients: these networks are only evaluated.
+// the filter matrix [kh * kw * cin, cout], run on the calling thread (parallelise over images).
+// No gradients: these networks are only evaluated.
 #pragma once
 
 #include <string>
