@@ -17,5 +17,7 @@ CommandFn RegisterImport(CLI::App& app);
 CommandFn RegisterMask(CLI::App& app);
 CommandFn RegisterFaceId(CLI::App& app);
 CommandFn RegisterDemo(CLI::App& app);
+CommandFn RegisterSynth(CLI::App& app);
+CommandFn RegisterSheet(CLI::App& app);
 
 }  // namespace icef::cli

@@ -20,6 +20,8 @@ int main(int argc, char** argv) {
   const std::pair<const char*, std::pair<const char*, Register>> commands[] = {
       {"demo", {"Run the built-in demo end to end", icef::cli::RegisterDemo}},
       {"info", {"Summarise and validate a dataset", icef::cli::RegisterInfo}},
+      {"synth", {"Render a synthetic ground-truth dataset of a procedural head", icef::cli::RegisterSynth}},
+      {"sheet", {"Tile a dataset into a labelled contact sheet PNG", icef::cli::RegisterSheet}},
       {"import", {"Convert a NerFace / instant-ngp dataset into our format", icef::cli::RegisterImport}},
       {"mask", {"Show the expression-region mask (overlay + volume slices)", icef::cli::RegisterMask}},
       {"faceid", {"Face-identity descriptors of photos and their pairwise distances", icef::cli::RegisterFaceId}},

@@ -1,0 +1,65 @@
+#include "icef/synth/identity.h"
+
+#include <sstream>
+
+#include "icef/core/rng.h"
+
+namespace icef::synth {
+
+namespace {
+Vec3f Mix(const Vec3f& a, const Vec3f& b, float t) { return a + t * (b - a); }
+}  // namespace
+
+IdentityParams IdentityParams::FromSeed(uint64_t seed) {
+  Rng rng(seed, StreamId("synth.identity"));
+  auto u = [&](double lo, double hi) { return static_cast<float>(rng.Uniform(lo, hi)); };
+  IdentityParams p;
+  p.head_width = u(0.90, 1.10);
+  p.head_height = u(0.92, 1.08);
+  p.head_depth = u(0.92, 1.08);
+  p.jaw_width = u(0.84, 1.16);
+  p.chin_length = u(0.80, 1.25);
+  p.nose_length = u(0.82, 1.22);
+  p.nose_width = u(0.80, 1.30);
+  p.nose_bridge = u(0.70, 1.35);
+  p.eye_spacing = u(0.91, 1.09);
+  p.lip_thickness = u(0.70, 1.35);
+  p.brow_height = u(0.75, 1.30);
+  p.cheek_fullness = u(0.75, 1.30);
+  p.mouth_width = u(0.85, 1.18);
+
+  // Skin tones along a light-to-dark palette, with a warm/cool tint.
+  const Vec3f light(0.93f, 0.76f, 0.66f), mid(0.76f, 0.55f, 0.42f), dark(0.42f, 0.28f, 0.20f);
+  const float tone = u(0.0, 1.0);
+  Vec3f skin = tone < 0.6f ? Mix(light, mid, tone / 0.6f) : Mix(mid, dark, (tone - 0.6f) / 0.4f);
+  const float tint = u(-0.03, 0.03);
+  p.skin_tone = (skin + Vec3f(tint, 0.f, -tint)).cwiseMax(0.f).cwiseMin(1.f);
+  p.lip_color = (p.skin_tone.cwiseProduct(Vec3f(0.85f, 0.55f, 0.58f)) + Vec3f(u(0.0, 0.08), 0.f, 0.02f))
+                    .cwiseMin(1.f);
+  const Vec3f irises[] = {{0.25f, 0.42f, 0.60f}, {0.30f, 0.48f, 0.32f}, {0.38f, 0.24f, 0.12f},
+                          {0.22f, 0.14f, 0.08f}, {0.45f, 0.45f, 0.42f}};
+  p.iris_color = irises[rng.Below(5)];
+  const Vec3f hairs[] = {{0.08f, 0.06f, 0.05f}, {0.22f, 0.14f, 0.08f}, {0.45f, 0.30f, 0.16f},
+                         {0.70f, 0.55f, 0.32f}, {0.50f, 0.20f, 0.08f}};
+  p.hair_color = hairs[rng.Below(5)];
+  p.brow_color = 0.8f * p.hair_color;
+  p.blotch_strength = u(0.2, 1.0);
+  p.pore_strength = u(0.3, 1.0);
+  p.freckle_density = rng.UniformDouble() < 0.5 ? u(0.02, 0.12) : u(0.25, 0.6);
+  p.num_moles = 2 + static_cast<int>(rng.Below(5));
+  p.hairline = u(-0.03, 0.05);
+  p.detail_seed = static_cast<uint32_t>(Mix64(seed ^ 0x5eedULL));
+  return p;
+}
+
+std::string IdentityParams::ToString() const {
+  std::ostringstream os;
+  os << "IdentityParams(head=" << head_width << "x" << head_height << "x" << head_depth << ", jaw=" << jaw_width
+     << ", chin=" << chin_length << ", nose=" << nose_length << "/" << nose_width << "/" << nose_bridge
+     << ", eyes=" << eye_spacing << ", lips=" << lip_thickness << ", brows=" << brow_height
+     << ", cheeks=" << cheek_fullness << ", mouth=" << mouth_width << ", skin=[" << skin_tone.transpose()
+     << "], freckles=" << freckle_density << ", moles=" << num_moles << ")";
+  return os.str();
+}
+
+}  // namespace icef::synth

@@ -1,0 +1,1 @@
+icef_module(synth DEPS icef_data)

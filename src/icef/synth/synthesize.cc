@@ -1,0 +1,246 @@
+#include "icef/synth/synthesize.h"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <sstream>
+
+#include "icef/core/rng.h"
+#include "icef/synth/expression.h"
+#include "icef/synth/head_model.h"
+
+namespace icef::synth {
+
+namespace fs = std::filesystem;
+
+Status SynthOptions::Validate() const {
+  if (out_dir.empty()) return Status::Error("out_dir: required");
+  if (num_train < 1 || num_train > 1000) return Status::Error("k: expected 1..1000 training frames, got " + std::to_string(num_train));
+  if (resolution < 8 || resolution > 4096) return Status::Error("res: expected 8..4096 pixels, got " + std::to_string(resolution));
+  if (test_views < 1 || test_views > 1000) return Status::Error("test_views: expected 1..1000, got " + std::to_string(test_views));
+  if (novel_per_tier < 0 || novel_per_tier > 1000) return Status::Error("novel_per_tier: expected 0..1000, got " + std::to_string(novel_per_tier));
+  if (!(near_threshold > 0.0) || !(far_threshold > near_threshold))
+    return Status::Error("tier thresholds: expected 0 < near (" + std::to_string(near_threshold) + ") < far (" +
+                         std::to_string(far_threshold) + ")");
+  if (far_threshold > 2.5) return Status::Error("far threshold: expected <= 2.5 (far expressions are drawn up to ~1.5 per parameter), got " + std::to_string(far_threshold));
+  if (!(camera_distance > 1.5)) return Status::Error("camera_distance: expected > 1.5 (outside the head's box), got " + std::to_string(camera_distance));
+  if (!(focal_scale > 0.1)) return Status::Error("focal_scale: expected > 0.1, got " + std::to_string(focal_scale));
+  if (!(max_yaw_deg >= 0.0 && max_yaw_deg <= 80.0)) return Status::Error("max_yaw_deg: expected 0..80");
+  if (!(max_pitch_deg >= 0.0 && max_pitch_deg <= 60.0)) return Status::Error("max_pitch_deg: expected 0..60");
+  return render.Validate().WithContext("render");
+}
+
+std::string SynthOptions::ToString() const {
+  std::ostringstream os;
+  os << "SynthOptions(out=" << out_dir.string() << ", identity_seed=" << identity_seed << ", k=" << num_train
+     << ", res=" << resolution << ", test_views=" << test_views << ", novel_per_tier=" << novel_per_tier
+     << ", thresholds=[" << near_threshold << ", " << far_threshold << "], distance=" << camera_distance
+     << ", focal_scale=" << focal_scale << ", yaw<=" << max_yaw_deg << ", pitch<=" << max_pitch_deg << ", "
+     << render.ToString() << ")";
+  return os.str();
+}
+
+double ExpressionDelta(const std::vector<float>& beta, const std::vector<std::vector<float>>& train) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const auto& t : train) {
+    double sum = 0.0;
+    for (size_t i = 0; i < beta.size(); ++i) sum += (double(beta[i]) - t[i]) * (double(beta[i]) - t[i]);
+    best = std::min(best, std::sqrt(sum));
+  }
+  return best;
+}
+
+Tier TierForDelta(double delta, double near_threshold, double far_threshold) {
+  if (delta == 0.0) return Tier::kObserved;
+  if (delta <= near_threshold) return Tier::kNear;
+  if (delta <= far_threshold) return Tier::kModerate;
+  return Tier::kFar;
+}
+
+Camera OrbitCamera(const Intrinsics& intrinsics, double distance, double yaw_deg, double pitch_deg) {
+  const double yaw = yaw_deg * M_PI / 180.0, pitch = pitch_deg * M_PI / 180.0;
+  const Vec3d eye(distance * std::sin(yaw) * std::cos(pitch), distance * std::sin(pitch),
+                  distance * std::cos(yaw) * std::cos(pitch));
+  return Camera::LookAt(intrinsics, eye, Vec3d::Zero());
+}
+
+namespace {
+
+double AngleBetweenDeg(const Camera& a, const Camera& b) {
+  const Vec3d u = a.Center().normalized(), v = b.Center().normalized();
+  return std::acos(std::clamp(u.dot(v), -1.0, 1.0)) * 180.0 / M_PI;
+}
+
+// Moderate training expression: 2-4 active parameters in [0.15, 0.65].
+std::vector<float> TrainExpression(uint64_t seed, int k) {
+  Rng rng(seed, StreamId("synth.train_expression"), 0, k);
+  std::vector<float> beta(kNumExpressions, 0.f);
+  const int active = 2 + static_cast<int>(rng.Below(3));
+  for (int a = 0; a < active; ++a) beta[rng.Below(kNumExpressions)] = static_cast<float>(rng.Uniform(0.15, 0.65));
+  return beta;
+}
+
+// A candidate novel expression for a tier (the tier of the result is decided from its delta).
+std::vector<float> NovelCandidate(Tier tier, const std::vector<std::vector<float>>& train, const SynthOptions& o,
+                                  Rng& rng) {
+  std::vector<float> beta(kNumExpressions, 0.f);
+  if (tier == Tier::kFar) {
+    // Several parameters pushed to 0.9-1.5 on top of a softened training expression.
+    const auto& base = train[rng.Below(train.size())];
+    for (int i = 0; i < kNumExpressions; ++i) beta[i] = 0.5f * base[i];
+    const int active = 3 + static_cast<int>(rng.Below(2));
+    for (int a = 0; a < active; ++a) beta[rng.Below(kNumExpressions)] = static_cast<float>(rng.Uniform(0.9, 1.5));
+    return beta;
+  }
+  // A training expression moved by a step of the tier's length along 2-4 random parameters.
+  beta = train[rng.Below(train.size())];
+  const double lo = tier == Tier::kNear ? 0.1 * o.near_threshold : o.near_threshold;
+  const double hi = tier == Tier::kNear ? o.near_threshold : o.far_threshold;
+  std::vector<double> dir(kNumExpressions, 0.0);
+  const int active = 2 + static_cast<int>(rng.Below(3));
+  for (int a = 0; a < active; ++a) dir[rng.Below(kNumExpressions)] = rng.Normal();
+  double norm = 0.0;
+  for (double d : dir) norm += d * d;
+  norm = std::sqrt(std::max(norm, 1e-12));
+  const double step = rng.Uniform(lo, hi);
+  for (int i = 0; i < kNumExpressions; ++i)
+    beta[i] = static_cast<float>(std::max(0.0, beta[i] + step * dir[i] / norm));
+  return beta;
+}
+
+}  // namespace
+
+Result<SynthPlan> PlanSynthesis(const SynthOptions& o) {
+  ICEF_RETURN_IF_ERROR(o.Validate());
+  SynthPlan plan;
+  Intrinsics& in = plan.intrinsics;
+  in.width = in.height = o.resolution;
+  in.fl_x = in.fl_y = o.focal_scale * o.resolution;
+  in.cx = in.cy = 0.5 * o.resolution;
+  const uint64_t seed = o.identity_seed;
+  // Training views: yaw stratified over [-max_yaw, max_yaw] with jitter, random pitch.
+  for (int k = 0; k < o.num_train; ++k) {
+    Rng rng(seed, StreamId("synth.train_view"), 0, k);
+    const double u = (k + 0.5 + 0.6 * (rng.UniformDouble() - 0.5)) / o.num_train;
+    const double yaw = -o.max_yaw_deg + 2.0 * o.max_yaw_deg * u;
+    const double pitch = rng.Uniform(-o.max_pitch_deg, o.max_pitch_deg);
+    plan.train_cameras.push_back(OrbitCamera(in, o.camera_distance, yaw, pitch));
+    plan.train_expressions.push_back(TrainExpression(seed, k));
+  }
+  // Held-out views: random within 0.9 of the training range, at least 3 degrees from every
+  // training view and every other test view where possible.
+  for (int v = 0; v < o.test_views; ++v) {
+    Camera best;
+    double best_gap = -1.0;
+    for (int attempt = 0; attempt < 64; ++attempt) {
+      Rng rng(seed, StreamId("synth.test_view"), attempt, v);
+      const Camera cam = OrbitCamera(in, o.camera_distance, rng.Uniform(-0.9, 0.9) * o.max_yaw_deg,
+                                     rng.Uniform(-0.9, 0.9) * o.max_pitch_deg);
+      double gap = 1e9;
+      for (const Camera& c : plan.train_cameras) gap = std::min(gap, AngleBetweenDeg(cam, c));
+      for (const Camera& c : plan.test_cameras) gap = std::min(gap, AngleBetweenDeg(cam, c));
+      if (gap > best_gap) best = cam, best_gap = gap;
+      if (gap >= 3.0) break;
+    }
+    plan.test_cameras.push_back(best);
+  }
+  // Test expressions: every training expression (observed), then novel ones per tier.
+  for (const auto& beta : plan.train_expressions) plan.test_expressions.push_back({beta, 0.0, Tier::kObserved});
+  for (Tier tier : {Tier::kNear, Tier::kModerate, Tier::kFar}) {
+    for (int n = 0; n < o.novel_per_tier; ++n) {
+      bool found = false;
+      for (int attempt = 0; attempt < 500 && !found; ++attempt) {
+        Rng rng(seed, StreamId("synth.novel_expression"), static_cast<uint64_t>(tier) * 100000 + attempt, n);
+        TestExpression t;
+        t.beta = NovelCandidate(tier, plan.train_expressions, o, rng);
+        t.delta = ExpressionDelta(t.beta, plan.train_expressions);
+        t.tier = TierForDelta(t.delta, o.near_threshold, o.far_threshold);
+        if (t.tier != tier || t.delta < 1e-3) continue;
+        plan.test_expressions.push_back(t);
+        found = true;
+      }
+      if (!found)
+        return Status::Error(std::string("tier thresholds: could not draw a ") + TierName(tier) +
+                             " expression with near=" + std::to_string(o.near_threshold) +
+                             " far=" + std::to_string(o.far_threshold));
+    }
+  }
+  return plan;
+}
+
+namespace {
+
+Frame MakeFrame(const HeadModel& head, const Camera& camera, const std::vector<float>& beta, std::string file_path) {
+  Frame f;
+  f.file_path = std::move(file_path);
+  f.camera = camera;
+  f.expression = beta;
+  const LandmarkView lv = ProjectLandmarks(head, camera, beta);
+  f.landmarks_2d = lv.landmarks_2d;
+  f.landmarks_2d_visible = lv.visible;
+  f.landmarks_3d = lv.landmarks_3d;
+  return f;
+}
+
+std::string Numbered(const char* prefix, int i) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "images/%s_%03d.png", prefix, i);
+  return buf;
+}
+
+}  // namespace
+
+int64_t SynthImageCount(const SynthOptions& o) {
+  return o.num_train + o.test_views + int64_t(o.num_train + 3 * o.novel_per_tier) * o.test_views;
+}
+
+Status SynthesizeDataset(const SynthOptions& options, const Executor& executor, ProgressBar* progress,
+                         Dataset* written) {
+  ICEF_ASSIGN_OR_RETURN(const SynthPlan plan, PlanSynthesis(options));
+  std::error_code ec;
+  fs::create_directories(options.out_dir / "images", ec);
+  if (ec) return Status::Error((options.out_dir / "images").string() + ": cannot create directory: " + ec.message());
+  const HeadModel head(IdentityParams::FromSeed(options.identity_seed));
+
+  Dataset ds;
+  ds.root = options.out_dir;
+  ds.aabb = Aabb();  // [-1, 1]^3
+  ds.expression_dim = kNumExpressions;
+  ds.expression_names = ExpressionNames();
+  ds.background = options.render.background;
+  ds.tier_thresholds = std::array<double, 2>{options.near_threshold, options.far_threshold};
+
+  const int num_views = static_cast<int>(plan.test_cameras.size());
+  int64_t done = 0;
+  auto render = [&](Frame frame) -> Result<Frame> {
+    const Image image = RenderGroundTruth(head, frame.camera, frame.expression, executor, options.render);
+    ICEF_RETURN_IF_ERROR(WritePng(ds.root / frame.file_path, image));
+    if (progress) progress->Update(++done, frame.file_path);
+    return frame;
+  };
+  for (int k = 0; k < options.num_train; ++k) {
+    ICEF_ASSIGN_OR_RETURN(Frame f, render(MakeFrame(head, plan.train_cameras[k], plan.train_expressions[k],
+                                                    Numbered("train", k))));
+    ds.train.push_back(std::move(f));
+  }
+  const std::vector<float> neutral(kNumExpressions, 0.f);
+  for (int v = 0; v < num_views; ++v)
+    ICEF_RETURN_IF_ERROR(render(MakeFrame(head, plan.test_cameras[v], neutral, Numbered("test_neutral", v))).status());
+  int index = 0;
+  for (const TestExpression& t : plan.test_expressions) {
+    for (int v = 0; v < num_views; ++v) {
+      Frame frame = MakeFrame(head, plan.test_cameras[v], t.beta, Numbered("test", index++));
+      frame.delta = t.delta;
+      frame.tier = t.tier;
+      frame.neutral_file_path = Numbered("test_neutral", v);
+      ICEF_ASSIGN_OR_RETURN(Frame f, render(std::move(frame)));
+      ds.test.push_back(std::move(f));
+    }
+  }
+  ICEF_RETURN_IF_ERROR(SaveDataset(ds));
+  if (progress) progress->Finish(std::to_string(ds.train.size()) + " train, " + std::to_string(ds.test.size()) + " test frames");
+  if (written) *written = std::move(ds);
+  return Status::Ok();
+}
+
+}  // namespace icef::synth

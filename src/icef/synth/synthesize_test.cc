@@ -1,0 +1,138 @@
+#include "icef/synth/synthesize.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include <unistd.h>
+
+#include "icef/io/atomic_file.h"
+#include "icef/synth/contact_sheet.h"
+#include "icef/synth/expression.h"
+
+namespace icef::synth {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path TempDir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("icef_synth_test_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  return dir;
+}
+
+SynthOptions Tiny(const fs::path& out, uint64_t seed) {
+  SynthOptions o;
+  o.out_dir = out;
+  o.identity_seed = seed;
+  o.num_train = 3;
+  o.resolution = 24;
+  o.test_views = 2;
+  o.novel_per_tier = 1;
+  return o;
+}
+
+TEST(SynthesizeTest, PlanHasDistinctViewsInRangeAndHonestTiers) {
+  SynthOptions o;
+  o.out_dir = "unused";
+  o.num_train = 10;
+  o.test_views = 4;
+  o.novel_per_tier = 3;
+  const Result<SynthPlan> plan = PlanSynthesis(o);
+  ASSERT_TRUE(plan.ok()) << plan.status().message();
+  ASSERT_EQ(plan->train_cameras.size(), 10u);
+  std::vector<Vec3d> centres;
+  for (const Camera& c : plan->train_cameras) {
+    const Vec3d d = c.Center().normalized();
+    EXPECT_LE(std::abs(std::atan2(d.x(), d.z())) * 180 / M_PI, 35.0 + 1e-9);
+    EXPECT_LE(std::abs(std::asin(d.y())) * 180 / M_PI, 15.0 + 1e-9);
+    EXPECT_NEAR(c.Center().norm(), 3.5, 1e-9);
+    for (const Vec3d& other : centres) EXPECT_GT((other - d).norm(), 1e-3);
+    centres.push_back(d);
+  }
+  std::vector<int> per_tier(4, 0);
+  for (const TestExpression& t : plan->test_expressions) {
+    EXPECT_DOUBLE_EQ(t.delta, ExpressionDelta(t.beta, plan->train_expressions));
+    EXPECT_EQ(t.tier, TierForDelta(t.delta, o.near_threshold, o.far_threshold));
+    ++per_tier[static_cast<int>(t.tier)];
+    float max_value = 0.f;
+    for (float b : t.beta) {
+      max_value = std::max(max_value, b);
+      EXPECT_GE(b, 0.f);
+    }
+    if (t.tier == Tier::kFar) {
+      EXPECT_GE(max_value, 0.9f);
+    }
+  }
+  EXPECT_EQ(per_tier, (std::vector<int>{10, 3, 3, 3}));
+  for (const auto& beta : plan->train_expressions)
+    for (float b : beta) EXPECT_LE(b, 0.65f);  // training expressions are moderate
+}
+
+TEST(SynthesizeTest, TierForDelta) {
+  EXPECT_EQ(TierForDelta(0.0, 0.3, 0.8), Tier::kObserved);
+  EXPECT_EQ(TierForDelta(0.3, 0.3, 0.8), Tier::kNear);
+  EXPECT_EQ(TierForDelta(0.31, 0.3, 0.8), Tier::kModerate);
+  EXPECT_EQ(TierForDelta(0.81, 0.3, 0.8), Tier::kFar);
+  EXPECT_DOUBLE_EQ(ExpressionDelta({3.f, 4.f}, {{0.f, 0.f}, {3.f, 5.f}}), 1.0);
+}
+
+TEST(SynthesizeTest, BadOptionsAreErrorsNamingTheField) {
+  SynthOptions o = Tiny("x", 1);
+  o.near_threshold = 0.9;
+  EXPECT_NE(o.Validate().message().find("tier thresholds"), std::string::npos);
+  o = Tiny("x", 1);
+  o.num_train = 0;
+  EXPECT_NE(o.Validate().message().find("k:"), std::string::npos);
+  o = Tiny("", 1);
+  EXPECT_FALSE(o.Validate().ok());
+}
+
+TEST(SynthesizeTest, WritesALoadableDeterministicDataset) {
+  const fs::path a = TempDir("a"), b = TempDir("b"), c = TempDir("c");
+  Dataset written;
+  ASSERT_TRUE(SynthesizeDataset(Tiny(a, 5), Executor(2), nullptr, &written).ok());
+  ASSERT_TRUE(SynthesizeDataset(Tiny(b, 5), Executor(1), nullptr).ok());
+  ASSERT_TRUE(SynthesizeDataset(Tiny(c, 6), Executor(2), nullptr).ok());
+  // Same seed, same bytes (JSON and every image); another identity differs.
+  int files = 0, differing = 0;
+  for (const auto& entry : fs::recursive_directory_iterator(a)) {
+    if (!entry.is_regular_file()) continue;
+    const fs::path rel = fs::relative(entry.path(), a);
+    ++files;
+    EXPECT_EQ(*ReadFile(entry.path()), *ReadFile(b / rel)) << rel;
+    if (rel.extension() == ".png") differing += *ReadFile(entry.path()) != *ReadFile(c / rel);
+  }
+  const int images = static_cast<int>(SynthImageCount(Tiny(a, 5)));
+  EXPECT_EQ(files, images + 2);  // + transforms_train.json, transforms_test.json
+  EXPECT_EQ(differing, images);
+
+  const Result<Dataset> loaded = LoadDataset(a);
+  ASSERT_TRUE(loaded.ok()) << loaded.status().message();
+  const Dataset& ds = *loaded;
+  EXPECT_EQ(ds.train.size(), 3u);
+  EXPECT_EQ(ds.test.size(), static_cast<size_t>((3 + 3) * 2));
+  EXPECT_EQ(ds.expression_dim, kNumExpressions);
+  EXPECT_EQ(ds.expression_names, ExpressionNames());
+  ASSERT_TRUE(ds.tier_thresholds.has_value());
+  std::vector<std::vector<float>> train;
+  for (const Frame& f : ds.train) {
+    train.push_back(f.expression);
+    EXPECT_TRUE(f.landmarks_2d && f.landmarks_3d && f.landmarks_2d_visible);
+  }
+  for (const Frame& f : ds.test) {
+    ASSERT_TRUE(f.delta && f.tier && f.neutral_file_path);
+    const double delta = ExpressionDelta(f.expression, train);
+    EXPECT_NEAR(*f.delta, delta, 1e-6);  // the JSON's delta agrees with the expressions
+    EXPECT_EQ(*f.tier, TierForDelta(delta < 1e-9 ? 0.0 : delta, (*ds.tier_thresholds)[0], (*ds.tier_thresholds)[1]));
+    EXPECT_TRUE(f.landmarks_2d && f.landmarks_3d && f.landmarks_2d_visible);
+  }
+  const Result<Image> sheet = MakeContactSheet(ds, ContactSheetOptions());
+  ASSERT_TRUE(sheet.ok()) << sheet.status().message();
+  EXPECT_GT(sheet->width, 3 * 96);
+  fs::remove_all(a), fs::remove_all(b), fs::remove_all(c);
+}
+
+}  // namespace
+}  // namespace icef::synth
