@@ -95,7 +95,7 @@ Vec3f HeadModel::SkinAlbedo(const Vec3f& p) const {
     const Vec3f across(-dir.y(), dir.x(), 0.f);
     const Vec3f local(across.dot(p) * 520.f, dir.dot(p) * 55.f, s * 4.f);
     const float stroke = SmoothStep(-0.1f, 0.45f, ValueNoise(local, seed + 6u));
-    c = Mix(c, id.brow_color, band * (0.3f + 0.65f * stroke));
+    c = Mix(c, id.brow_color, band * (0.5f + 0.5f * stroke));
   }
   return c.cwiseMax(0.f).cwiseMin(1.f);
 }

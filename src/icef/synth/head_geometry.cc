@@ -25,7 +25,7 @@ HeadGeometry HeadGeometry::FromIdentity(const IdentityParams& p) {
     const float s = side == 0 ? -1.f : 1.f;
     g.cheek_c[side] = Vec3f(s * 0.118f * std::sqrt(p.jaw_width), -0.055f, 0.175f);
     g.ear_c[side] = Vec3f(s * 0.262f * p.head_width, eye_y - 0.045f, -0.035f);
-    g.eye_c[side] = Vec3f(s * eye_x, eye_y, 0.236f);
+    g.eye_c[side] = Vec3f(s * eye_x, eye_y, 0.241f);
     g.brow_ridge_c[side] = Vec3f(s * eye_x, eye_y + 0.05f * p.brow_height, 0.245f);
   }
   g.nose_top = Vec3f(0.f, eye_y + 0.005f, 0.262f + 0.012f * (p.nose_bridge - 1.f));
@@ -38,7 +38,7 @@ HeadGeometry HeadGeometry::FromIdentity(const IdentityParams& p) {
     g.nostril_c[side] = g.nose_tip + Vec3f(s * 0.027f * p.nose_width, -0.012f, -0.03f);
   }
   g.mouth_y = g.nose_tip.y() - 0.065f;
-  g.mouth_half_width = 0.05f * p.mouth_width;
+  g.mouth_half_width = 0.056f * p.mouth_width;
   g.lip_z = 0.285f;
   g.upper_lip_c = Vec3f(0.f, g.mouth_y + 0.011f * p.lip_thickness, 0.258f);
   g.upper_lip_r = Vec3f(g.mouth_half_width * 1.05f, 0.012f * p.lip_thickness, 0.028f + 0.008f * (p.lip_thickness - 1.f));

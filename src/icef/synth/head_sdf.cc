@@ -46,7 +46,7 @@ float HeadModel::CanonicalDistance(const Vec3f& p, const ExpressionState& s, Mat
   d = SmoothMin(d, lips, 0.012f);
   // Eye socket of the nearer eye (the two sockets are far apart), then the eyeball and the lids.
   const Vec3f q = p - g.eye_c[near_side];
-  d = SmoothMax(d, -SdSphere(q - Vec3f(0.f, 0.f, 0.008f), g.eye_r + 0.014f), 0.015f);
+  d = SmoothMax(d, -SdSphere(q - Vec3f(0.f, 0.f, 0.006f), g.eye_r + 0.009f), 0.012f);
   const float eyeball = SdSphere(q, g.eye_r);
   const float shell = q.norm() - (g.eye_r + g.lid_thickness);
   const float a_up = s.lid_upper[near_side], a_low = g.lid_lower;

@@ -42,7 +42,7 @@ IdentityParams IdentityParams::FromSeed(uint64_t seed) {
   const Vec3f hairs[] = {{0.08f, 0.06f, 0.05f}, {0.22f, 0.14f, 0.08f}, {0.45f, 0.30f, 0.16f},
                          {0.70f, 0.55f, 0.32f}, {0.50f, 0.20f, 0.08f}};
   p.hair_color = hairs[rng.Below(5)];
-  p.brow_color = 0.8f * p.hair_color;
+  p.brow_color = 0.5f * p.hair_color + Vec3f(0.03f, 0.02f, 0.015f);
   p.blotch_strength = u(0.2, 1.0);
   p.pore_strength = u(0.3, 1.0);
   p.freckle_density = rng.UniformDouble() < 0.5 ? u(0.02, 0.12) : u(0.25, 0.6);

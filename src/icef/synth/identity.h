@@ -31,7 +31,7 @@ struct IdentityParams {
   Vec3f lip_color = Vec3f(0.70f, 0.36f, 0.36f);
   Vec3f iris_color = Vec3f(0.30f, 0.45f, 0.55f);
   Vec3f hair_color = Vec3f(0.20f, 0.13f, 0.08f);
-  Vec3f brow_color = Vec3f(0.17f, 0.11f, 0.07f);
+  Vec3f brow_color = Vec3f(0.13f, 0.09f, 0.055f);
   float blotch_strength = 0.5f;  // low-frequency skin variation, 0..1
   float pore_strength = 0.5f;    // high-frequency pore texture, 0..1
   float freckle_density = 0.3f;  // probability of a freckle per lattice cell (cheeks and nose)
