@@ -47,7 +47,9 @@ HashGridLayout MakeHashGridLayout(const HashGridOptions& o) {
     lv.dense = dense_entries <= static_cast<double>(g.table_size);
     lv.entries = lv.dense ? static_cast<int64_t>(dense_entries) : int64_t{g.table_size};
     lv.offset = offset;
-    offset += lv.entries;
+    // Levels start on 8-entry boundaries so that an x-neighbour pair (indices 2j, 2j+1) never
+    // straddles a cache line when F = 2 (the padding entries are never addressed).
+    offset += (lv.entries + 7) / 8 * 8;
     g.levels.push_back(lv);
   }
   g.total_entries = offset;

@@ -6,7 +6,8 @@
 // trilinear interpolation of the 8 cell corners' table entries. Corner v = c + (i, j, k) is
 // indexed densely, v.x + v.y (R+1) + v.z (R+1)^2, when (R_l + 1)^3 <= T (the level then has
 // (R_l + 1)^3 entries), else by the spatial hash (v.x * 1 ^ v.y * 2654435761 ^ v.z * 805459861)
-// mod T (T entries). Table: level after level, each [entries, F] row-major.
+// mod T (T entries). Table: level after level, each [entries, F] row-major, each level starting
+// on a multiple of 8 entries (padding entries stay at their initial values and get no gradient).
 // Features: [n, L * F], level-major (level l at columns l*F .. l*F+F-1).
 #pragma once
 
@@ -29,7 +30,7 @@ struct HashGridLayout {
   int features = 0;         // F
   uint32_t table_size = 0;  // T (power of two)
   std::vector<HashGridLevel> levels;
-  int64_t total_entries = 0;
+  int64_t total_entries = 0;  // padding included
   int64_t num_params() const { return total_entries * features; }
   int output_dims() const { return num_levels * features; }
 };

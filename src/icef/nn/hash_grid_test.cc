@@ -21,7 +21,8 @@ TEST(HashGridLayoutTest, ReferenceConfigurationIsDenseAtLevelsZeroToFive) {
   for (int l = 0; l < 16; ++l) EXPECT_EQ(g.levels[l].dense, l <= 5) << "level " << l;
   EXPECT_EQ(g.levels[5].entries, 65 * 65 * 65);
   EXPECT_EQ(g.levels[6].entries, 1 << 19);
-  EXPECT_EQ(g.levels[6].offset, g.levels[5].offset + g.levels[5].entries);
+  EXPECT_EQ(g.levels[6].offset, (g.levels[5].offset + g.levels[5].entries + 7) / 8 * 8);
+  for (const HashGridLevel& lv : g.levels) EXPECT_EQ(lv.offset % 8, 0);
   // About 11.4 M parameters (DESIGN.md §7).
   EXPECT_GT(g.num_params(), 11'300'000);
   EXPECT_LT(g.num_params(), 11'600'000);
