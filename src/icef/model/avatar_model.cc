@@ -1,0 +1,405 @@
+#include "icef/model/avatar_model.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "icef/core/rng.h"
+#include "icef/model/identity_losses.h"
+#include "icef/render/distortion_loss.h"
+
+namespace icef {
+
+struct ModelWorkspace {
+  RaySamples samples;
+  std::vector<float> dirs, betas, offsets, canonical, sigma, rgb, d_sigma, d_rgb, d_canonical, mask_values;
+  std::vector<float> lin_offsets, anchors, tangents;
+  CompositeOutputs<float> composite;
+  std::vector<float> d_color, d_opacity, d_weights;
+  StaticFieldContext static_ctx;
+  DeformationContext deform_ctx;
+  // L_smooth: 2m points (x_i, then x_i + delta_i).
+  std::vector<float> smooth_positions, smooth_betas, smooth_offsets, smooth_d_offsets, smooth_weight;
+  std::vector<int64_t> smooth_index;
+  DeformationContext smooth_ctx;
+};
+
+namespace {
+template <typename V>
+void Fit(V& v, size_t size) {
+  v.resize(size);
+}
+}  // namespace
+
+double LossTerms::psnr() const { return photo > 0 ? -10.0 * std::log10(photo) : 99.0; }
+
+bool LossTerms::AllFinite() const {
+  return std::isfinite(photo) && std::isfinite(mask) && std::isfinite(id) && std::isfinite(smooth) &&
+         std::isfinite(distortion) && std::isfinite(total);
+}
+
+std::string LossTerms::ToString() const {
+  std::ostringstream os;
+  os.precision(4);
+  os << "loss " << total << " (photo " << photo << ", mask " << mask << ", id " << id << ", smooth " << smooth
+     << ", dist " << distortion << ") psnr " << psnr();
+  return os.str();
+}
+
+AvatarModel::AvatarModel(const ModelConfig& config, const ModelSetup& setup, RegionMask mask,
+                     ExpressionConfidence confidence)
+    : config_(config),
+      setup_(setup),
+      method_(config.ParsedMethod()),
+      traits_(TraitsOf(method_)),
+      mask_(std::move(mask)),
+      confidence_(std::move(confidence)),
+      occupancy_(setup.aabb, config.OccupancyOptions()),
+      train_ws_(std::make_unique<ModelWorkspace>()),
+      render_ws_(std::make_unique<ModelWorkspace>()) {}
+
+AvatarModel::~AvatarModel() = default;
+
+Result<std::unique_ptr<AvatarModel>> AvatarModel::Create(const ModelConfig& config, const ModelSetup& setup,
+                                                     const Executor& executor) {
+  ICEF_RETURN_IF_ERROR(config.Validate().WithContext("model config"));
+  if (!setup.aabb.IsValid()) return Status::Error("model setup: invalid aabb " + setup.aabb.ToString());
+  if (setup.expression_dim < 1) return Status::Error("model setup: expression_dim must be >= 1");
+  ICEF_ASSIGN_OR_RETURN(RegionMask mask, RegionMask::FromLandmarks(setup.mask_landmarks, config.MaskOptions(), executor));
+  ICEF_ASSIGN_OR_RETURN(ExpressionConfidence confidence,
+                        ExpressionConfidence::Create(setup.training_expressions, config.ConfidenceOpts()));
+  if (confidence.expression_dim() != setup.expression_dim)
+    return Status::Error("model setup: training expressions do not have expression_dim values");
+  std::unique_ptr<AvatarModel> model(new AvatarModel(config, setup, std::move(mask), std::move(confidence)));
+  model->static_field_ = std::make_unique<StaticField>(config.StaticOptions(setup.expression_dim), setup.aabb,
+                                                       &model->store_, "static", kGridGroup, kMlpGroup);
+  if (model->traits_.deformation) {
+    model->deformation_ = std::make_unique<DeformationField>(config.DeformationOptions(), setup.expression_dim,
+                                                             setup.aabb, &model->store_, "deformation", kDeformGroup);
+  }
+  return model;
+}
+
+void AvatarModel::Initialize(uint64_t seed) {
+  static_field_->Initialize(Mix64(seed ^ StreamId("static_field")));
+  if (deformation_) deformation_->Initialize(Mix64(seed ^ StreamId("deformation_field")));
+  occupancy_.Fill(true);
+}
+
+NearestExpression AvatarModel::Nearest(std::span<const float> beta) const { return confidence_.Nearest(beta); }
+
+void AvatarModel::QueryStatic(const Executor& executor, int64_t n, const float* canonical, const float* directions,
+                            const float* condition, float* sigma, float* rgb) const {
+  StaticFieldContext ctx;
+  static_field_->Forward(executor, n, canonical, directions, condition, sigma, rgb, &ctx, false, false);
+}
+
+void AvatarModel::OffsetsPhi(const Executor& executor, int64_t n, const float* positions,
+                           std::span<const float> beta, float* offsets) const {
+  if (!deformation_) {
+    std::fill(offsets, offsets + 3 * n, 0.f);
+    return;
+  }
+  std::vector<float> betas(n * setup_.expression_dim);
+  for (int64_t i = 0; i < n; ++i) std::copy(beta.begin(), beta.end(), betas.begin() + i * setup_.expression_dim);
+  DeformationContext ctx;
+  deformation_->Forward(executor, n, positions, betas.data(), offsets, &ctx, false);
+}
+
+void AvatarModel::OffsetsLinearized(const Executor& executor, int64_t n, const float* positions,
+                                  std::span<const float> beta, float* offsets) const {
+  if (!deformation_) {
+    std::fill(offsets, offsets + 3 * n, 0.f);
+    return;
+  }
+  const int b = setup_.expression_dim;
+  const NearestExpression near = Nearest(beta);
+  const std::vector<float>& anchor = setup_.training_expressions[near.index];
+  std::vector<float> anchors(n * b), directions(n * b);
+  for (int64_t i = 0; i < n; ++i)
+    for (int k = 0; k < b; ++k) {
+      anchors[i * b + k] = anchor[k];
+      directions[i * b + k] = beta[k] - anchor[k];
+    }
+  DeformationContext ctx;
+  deformation_->LinearizedForward(executor, n, positions, anchors.data(), directions.data(), offsets, &ctx);
+}
+
+void AvatarModel::Offsets(const Executor& executor, int64_t n, const float* positions, std::span<const float> beta,
+                        float* offsets) const {
+  OffsetsPhi(executor, n, positions, beta, offsets);
+  if (!deformation_ || !traits_.confidence) return;
+  const NearestExpression near = Nearest(beta);
+  if (near.kappa >= 1.0) return;  // delta = 0: D_final = D_phi exactly
+  std::vector<float> lin(3 * n);
+  OffsetsLinearized(executor, n, positions, beta, lin.data());
+  const float kappa = static_cast<float>(near.kappa);
+  for (int64_t i = 0; i < 3 * n; ++i) offsets[i] = kappa * offsets[i] + (1.f - kappa) * lin[i];
+}
+
+LossTerms AvatarModel::TrainForwardBackward(const TrainRays& batch, const LossWeights& weights, uint64_t seed,
+                                          int64_t step, const Executor& executor) {
+  ModelWorkspace& ws = *train_ws_;
+  const int64_t num_rays = static_cast<int64_t>(batch.rays.size());
+  const int b = setup_.expression_dim;
+  const bool has_alpha = !batch.target_alpha.empty();
+  SampleRays(batch.rays, setup_.aabb, config_.SamplerOptions(true), &occupancy_, seed, step, executor, &ws.samples);
+  const int64_t n = ws.samples.size();
+  const float* positions = ws.samples.positions.data();
+
+  // Per-sample view directions and expressions.
+  Fit(ws.dirs, 3 * n);
+  const bool need_betas = deformation_ || traits_.entangled_beta;
+  if (need_betas) Fit(ws.betas, n * b);
+  ParallelFor(executor, num_rays, [&](int64_t r0, int64_t r1, int) {
+    for (int64_t r = r0; r < r1; ++r) {
+      const int64_t off = ws.samples.ray_offset[r], cnt = ws.samples.ray_count[r];
+      const Vec3f& d = batch.rays[r].direction;
+      const std::vector<float>& beta = setup_.training_expressions[batch.frame[r]];
+      for (int64_t i = off; i < off + cnt; ++i) {
+        for (int a = 0; a < 3; ++a) ws.dirs[3 * i + a] = d[a];
+        if (need_betas) std::copy(beta.begin(), beta.end(), ws.betas.begin() + i * b);
+      }
+    }
+  });
+
+  // Observation -> canonical.
+  const float* canonical = positions;
+  if (deformation_) {
+    Fit(ws.offsets, 3 * n);
+    Fit(ws.canonical, 3 * n);
+    deformation_->Forward(executor, n, positions, ws.betas.data(), ws.offsets.data(), &ws.deform_ctx, true);
+    for (int64_t i = 0; i < 3 * n; ++i) ws.canonical[i] = positions[i] + ws.offsets[i];
+    canonical = ws.canonical.data();
+  }
+  Fit(ws.sigma, n);
+  Fit(ws.rgb, 3 * n);
+  static_field_->Forward(executor, n, canonical, ws.dirs.data(), traits_.entangled_beta ? ws.betas.data() : nullptr,
+                         ws.sigma.data(), ws.rgb.data(), &ws.static_ctx, true, deformation_ != nullptr);
+
+  // Compositing over the known background.
+  const float bg[3] = {setup_.background.x(), setup_.background.y(), setup_.background.z()};
+  CompositeInputs<float> in{ws.sigma, ws.rgb, ws.samples.t, ws.samples.dt, ws.samples.ray_offset,
+                            ws.samples.ray_count, std::span<const float>(bg, 3)};
+  CompositeForward(in, config_.CompositeOpts(), executor, &ws.composite);
+
+  // Ray losses and their gradients.
+  LossTerms terms;
+  terms.samples = n;
+  Fit(ws.d_color, 3 * num_rays);
+  Fit(ws.d_opacity, num_rays);
+  double photo = 0, mask_loss = 0;
+  const double inv_c = 1.0 / (3.0 * std::max<int64_t>(num_rays, 1)), inv_r = 1.0 / std::max<int64_t>(num_rays, 1);
+  for (int64_t r = 0; r < num_rays; ++r) {
+    for (int a = 0; a < 3; ++a) {
+      const double e = ws.composite.color[3 * r + a] - batch.target_rgb[3 * r + a];
+      photo += e * e;
+      ws.d_color[3 * r + a] = static_cast<float>(2.0 * e * inv_c);
+    }
+    if (has_alpha && weights.lambda_mask > 0) {
+      const double e = ws.composite.opacity[r] - batch.target_alpha[r];
+      mask_loss += e * e;
+      ws.d_opacity[r] = static_cast<float>(weights.lambda_mask * 2.0 * e * inv_r);
+    } else {
+      ws.d_opacity[r] = 0.f;
+    }
+  }
+  terms.photo = photo * inv_c;
+  terms.mask = mask_loss * inv_r;
+  std::span<const float> d_weights;
+  if (weights.lambda_distortion > 0) {
+    Fit(ws.d_weights, n);
+    double dist = 0;
+    for (int64_t r = 0; r < num_rays; ++r) {
+      const int64_t off = ws.samples.ray_offset[r], cnt = ws.samples.ray_count[r];
+      if (cnt == 0) continue;
+      dist += DistortionLossRay<float>(cnt, &ws.composite.weights[off], &ws.samples.t[off], &ws.samples.dt[off]);
+      DistortionLossRayBackward<float>(cnt, &ws.composite.weights[off], &ws.samples.t[off], &ws.samples.dt[off],
+                                       static_cast<float>(weights.lambda_distortion * inv_r), &ws.d_weights[off]);
+    }
+    terms.distortion = dist * inv_r;
+    d_weights = ws.d_weights;
+  }
+  CompositeOutputGradients<float> grads{ws.d_color, ws.d_opacity, {}, d_weights};
+  CompositeBackward(in, ws.composite, grads, executor, &ws.d_sigma, &ws.d_rgb);
+
+  if (deformation_) Fit(ws.d_canonical, 3 * n);
+  static_field_->Backward(executor, n, ws.sigma.data(), ws.rgb.data(), ws.d_sigma.data(), ws.d_rgb.data(),
+                          &ws.static_ctx, deformation_ ? ws.d_canonical.data() : nullptr);
+
+  if (deformation_) {
+    const bool id_terms = traits_.identity_losses && (weights.lambda_id > 0 || weights.lambda_smooth > 0);
+    const Vec3f half = 0.5f * setup_.aabb.Extent();
+    const Vec3f inv_half2 = half.cwiseProduct(half).cwiseInverse();
+    if (id_terms) {
+      Fit(ws.mask_values, n);
+      mask_.EvaluateBatch(positions, n, ws.mask_values.data());
+    }
+    if (id_terms && weights.lambda_id > 0) {
+      const float inv_half2_arr[3] = {inv_half2.x(), inv_half2.y(), inv_half2.z()};
+      terms.id = IdentityLoss<float>(n, ws.offsets.data(), ws.mask_values.data(), inv_half2_arr,
+                                     static_cast<float>(weights.lambda_id), ws.d_canonical.data());
+    }
+    deformation_->Backward(executor, n, ws.d_canonical.data(), &ws.deform_ctx);
+
+    if (id_terms && weights.lambda_smooth > 0) {
+      // L_smooth (identity_losses.h) on up to smooth_max_samples boundary samples (w_b > 0).
+      ws.smooth_index.clear();
+      for (int64_t i = 0; i < n; ++i) {
+        if (BoundaryWeight(ws.mask_values[i]) > 1e-3f) ws.smooth_index.push_back(i);
+      }
+      const int64_t avail = static_cast<int64_t>(ws.smooth_index.size());
+      const int64_t m = std::min<int64_t>(avail, weights.smooth_max_samples);
+      if (m > 0) {
+        Fit(ws.smooth_positions, 6 * m);
+        Fit(ws.smooth_betas, 2 * m * b);
+        Fit(ws.smooth_offsets, 6 * m);
+        Fit(ws.smooth_d_offsets, 6 * m);
+        Fit(ws.smooth_weight, m);
+        const float eps = static_cast<float>(weights.smooth_epsilon);
+        for (int64_t j = 0; j < m; ++j) {
+          const int64_t i = ws.smooth_index[j * avail / m];  // even stride over the boundary samples
+          Rng rng(seed, StreamId("smooth_direction"), uint64_t(step), uint64_t(j));
+          Vec3f u(static_cast<float>(rng.Normal()), static_cast<float>(rng.Normal()), static_cast<float>(rng.Normal()));
+          u /= std::max(u.norm(), 1e-6f);
+          for (int a = 0; a < 3; ++a) {
+            ws.smooth_positions[3 * j + a] = positions[3 * i + a];
+            ws.smooth_positions[3 * (m + j) + a] = positions[3 * i + a] + eps * u[a] * half[a];
+          }
+          std::copy(ws.betas.begin() + i * b, ws.betas.begin() + (i + 1) * b, ws.smooth_betas.begin() + j * b);
+          std::copy(ws.betas.begin() + i * b, ws.betas.begin() + (i + 1) * b, ws.smooth_betas.begin() + (m + j) * b);
+          const float mk = ws.mask_values[i];
+          ws.smooth_weight[j] = BoundaryWeight(mk);
+        }
+        deformation_->Forward(executor, 2 * m, ws.smooth_positions.data(), ws.smooth_betas.data(),
+                              ws.smooth_offsets.data(), &ws.smooth_ctx, true);
+        const float half_arr[3] = {half.x(), half.y(), half.z()};
+        terms.smooth = SmoothnessLoss<float>(m, ws.smooth_offsets.data(), ws.smooth_weight.data(), half_arr, eps,
+                                             static_cast<float>(weights.lambda_smooth), ws.smooth_d_offsets.data());
+        deformation_->Backward(executor, 2 * m, ws.smooth_d_offsets.data(), &ws.smooth_ctx);
+      }
+    }
+  }
+  const double lid = traits_.identity_losses ? weights.lambda_id : 0.0;
+  const double lsm = traits_.identity_losses ? weights.lambda_smooth : 0.0;
+  terms.total = terms.photo + weights.lambda_mask * terms.mask + lid * terms.id + lsm * terms.smooth +
+                weights.lambda_distortion * terms.distortion;
+  return terms;
+}
+
+void AvatarModel::Render(std::span<const Ray> rays, std::span<const float> beta, const Vec3f& background,
+                       const Executor& executor, RenderOutput* out) const {
+  ICEF_CHECK(static_cast<int>(beta.size()) == setup_.expression_dim, "beta has the wrong length");
+  ModelWorkspace& ws = *render_ws_;
+  const int64_t total_rays = static_cast<int64_t>(rays.size());
+  out->color.assign(3 * total_rays, 0.f);
+  out->depth.assign(total_rays, 0.f);
+  out->opacity.assign(total_rays, 0.f);
+  out->mask.assign(total_rays, 0.f);
+  out->deformation.assign(total_rays, 0.f);
+  const int b = setup_.expression_dim;
+  const NearestExpression near = Nearest(beta);
+  const bool blend = deformation_ && traits_.confidence && near.kappa < 1.0;
+  const float kappa = static_cast<float>(near.kappa);
+  const float bg[3] = {background.x(), background.y(), background.z()};
+  constexpr int64_t kChunk = 4096;
+  for (int64_t r0 = 0; r0 < total_rays; r0 += kChunk) {
+    const int64_t nr = std::min(kChunk, total_rays - r0);
+    SampleRays(rays.subspan(r0, nr), setup_.aabb, config_.SamplerOptions(false), &occupancy_, 0, 0, executor,
+               &ws.samples);
+    const int64_t n = ws.samples.size();
+    const float* positions = ws.samples.positions.data();
+    Fit(ws.dirs, 3 * n);
+    for (int64_t r = 0; r < nr; ++r)
+      for (int64_t i = ws.samples.ray_offset[r]; i < ws.samples.ray_offset[r] + ws.samples.ray_count[r]; ++i)
+        for (int a = 0; a < 3; ++a) ws.dirs[3 * i + a] = rays[r0 + r].direction[a];
+    if (deformation_ || traits_.entangled_beta) {
+      Fit(ws.betas, n * b);
+      for (int64_t i = 0; i < n; ++i) std::copy(beta.begin(), beta.end(), ws.betas.begin() + i * b);
+    }
+    Fit(ws.offsets, 3 * n);
+    std::fill(ws.offsets.begin(), ws.offsets.end(), 0.f);
+    const float* canonical = positions;
+    if (deformation_) {
+      deformation_->Forward(executor, n, positions, ws.betas.data(), ws.offsets.data(), &ws.deform_ctx, false);
+      if (blend) {
+        const std::vector<float>& anchor = setup_.training_expressions[near.index];
+        Fit(ws.anchors, n * b);
+        Fit(ws.tangents, n * b);
+        for (int64_t i = 0; i < n; ++i)
+          for (int k = 0; k < b; ++k) {
+            ws.anchors[i * b + k] = anchor[k];
+            ws.tangents[i * b + k] = beta[k] - anchor[k];
+          }
+        Fit(ws.lin_offsets, 3 * n);
+        deformation_->LinearizedForward(executor, n, positions, ws.anchors.data(), ws.tangents.data(),
+                                        ws.lin_offsets.data(), &ws.deform_ctx);
+        for (int64_t i = 0; i < 3 * n; ++i)
+          ws.offsets[i] = kappa * ws.offsets[i] + (1.f - kappa) * ws.lin_offsets[i];
+      }
+      Fit(ws.canonical, 3 * n);
+      for (int64_t i = 0; i < 3 * n; ++i) ws.canonical[i] = positions[i] + ws.offsets[i];
+      canonical = ws.canonical.data();
+    }
+    Fit(ws.sigma, n);
+    Fit(ws.rgb, 3 * n);
+    static_field_->Forward(executor, n, canonical, ws.dirs.data(), traits_.entangled_beta ? ws.betas.data() : nullptr,
+                           ws.sigma.data(), ws.rgb.data(), &ws.static_ctx, false, false);
+    CompositeInputs<float> in{ws.sigma, ws.rgb, ws.samples.t, ws.samples.dt, ws.samples.ray_offset,
+                              ws.samples.ray_count, std::span<const float>(bg, 3)};
+    CompositeForward(in, config_.CompositeOpts(), executor, &ws.composite);
+    Fit(ws.mask_values, n);
+    mask_.EvaluateBatch(positions, n, ws.mask_values.data());
+    for (int64_t r = 0; r < nr; ++r) {
+      const int64_t o = r0 + r;
+      for (int a = 0; a < 3; ++a) out->color[3 * o + a] = ws.composite.color[3 * r + a];
+      out->depth[o] = ws.composite.depth[r];
+      out->opacity[o] = ws.composite.opacity[r];
+      float m = 0, d = 0;
+      for (int64_t i = ws.samples.ray_offset[r]; i < ws.samples.ray_offset[r] + ws.samples.ray_count[r]; ++i) {
+        const float w = ws.composite.weights[i];
+        m += w * ws.mask_values[i];
+        d += w * Vec3f(ws.offsets[3 * i], ws.offsets[3 * i + 1], ws.offsets[3 * i + 2]).norm();
+      }
+      out->mask[o] = m;
+      out->deformation[o] = d;
+    }
+  }
+}
+
+void AvatarModel::UpdateOccupancy(uint64_t seed, int64_t step, const Executor& executor) {
+  const int b = setup_.expression_dim;
+  StaticFieldContext sctx;
+  DeformationContext dctx;
+  std::vector<float> betas, offsets, canonical, sigma;
+  auto query = [&](const float* positions, int64_t n, float* out) {
+    std::fill(out, out + n, 0.f);
+    sigma.resize(n);
+    betas.resize(n * b);
+    if (deformation_) offsets.resize(3 * n), canonical.resize(3 * n);
+    for (const std::vector<float>& beta : setup_.training_expressions) {
+      for (int64_t i = 0; i < n; ++i) std::copy(beta.begin(), beta.end(), betas.begin() + i * b);
+      const float* c = positions;
+      if (deformation_) {
+        deformation_->Forward(executor, n, positions, betas.data(), offsets.data(), &dctx, false);
+        for (int64_t i = 0; i < 3 * n; ++i) canonical[i] = positions[i] + offsets[i];
+        c = canonical.data();
+      }
+      static_field_->Density(executor, n, c, traits_.entangled_beta ? betas.data() : nullptr, sigma.data(), &sctx);
+      for (int64_t i = 0; i < n; ++i) out[i] = std::max(out[i], sigma[i]);
+      if (!deformation_ && !traits_.entangled_beta) break;  // density does not depend on beta
+    }
+  };
+  occupancy_.Update(query, seed, step);
+}
+
+std::string AvatarModel::ToString() const {
+  std::ostringstream os;
+  os << "AvatarModel(method=" << MethodName(method_) << ", params=" << store_.size() << ", "
+     << static_field_->ToString();
+  if (deformation_) os << ", " << deformation_->ToString();
+  os << ", mask from " << setup_.mask_source << ")";
+  return os.str();
+}
+
+}  // namespace icef

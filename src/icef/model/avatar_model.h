@@ -1,0 +1,145 @@
+// One method of DESIGN.md §2 = fields + renderer + losses. AvatarModel owns the parameter slab, the
+// static canonical field, the deformation field (absent for `nerface`), the region mask M, the
+// expression confidence and the occupancy grid, and provides the two things everything else needs:
+//   - TrainForwardBackward: loss terms of a batch of training rays, gradients accumulated into the
+//     slab (the trainer runs the optimiser);
+//   - Render: colour, depth, opacity, expected mask and deformation magnitude of any rays at any
+//     expression, with confidence-weighted warping D_final = kappa D_phi + (1 - kappa) D_lin.
+#pragma once
+
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "icef/core/parallel.h"
+#include "icef/field/confidence.h"
+#include "icef/field/deformation_field.h"
+#include "icef/field/region_mask.h"
+#include "icef/field/static_field.h"
+#include "icef/model/model_config.h"
+#include "icef/model/model_setup.h"
+#include "icef/nn/parameter_store.h"
+#include "icef/render/compositing.h"
+#include "icef/render/occupancy_grid.h"
+#include "icef/render/ray_sampler.h"
+
+namespace icef {
+
+// Optimiser parameter groups of the slab.
+inline constexpr int kGridGroup = 0;
+inline constexpr int kMlpGroup = 1;
+inline constexpr int kDeformGroup = 2;
+
+// Loss weights of L = L_photo + lambda_mask L_mask + lambda_id L_id + lambda_smooth L_smooth
+// + lambda_distortion L_dist (the trainer fills them from TrainConfig; the method's traits zero
+// L_id and L_smooth where the method has none).
+struct LossWeights {
+  double lambda_id = 0.0;
+  double lambda_smooth = 0.0;
+  double lambda_mask = 0.0;
+  double lambda_distortion = 0.0;
+  double smooth_epsilon = 0.01;  // finite-difference offset of L_smooth, in half-extent units of the aabb
+  int smooth_max_samples = 8192;  // cap on boundary samples used by L_smooth per batch
+};
+
+// A batch of training rays, each from a training frame with a known expression.
+struct TrainRays {
+  std::vector<Ray> rays;              // [R] world frame
+  std::vector<int32_t> frame;         // [R] training frame index (its expression is setup.training_expressions[k])
+  std::vector<float> target_rgb;      // [R, 3] composited over the background
+  std::vector<float> target_alpha;    // [R] foreground mask, or empty when the images have no alpha
+};
+
+struct LossTerms {
+  double photo = 0;       // mean squared error over rays and channels
+  double mask = 0;        // mean squared error of opacity against alpha
+  double id = 0;          // L_id (mean over samples, half-extent units squared)
+  double smooth = 0;      // L_smooth estimate
+  double distortion = 0;  // mean distortion loss per ray
+  double total = 0;       // weighted sum
+  int64_t samples = 0;    // samples evaluated
+  double psnr() const;    // from `photo`
+  bool AllFinite() const;
+  std::string ToString() const;
+};
+
+struct RenderOutput {
+  std::vector<float> color;        // [R, 3]
+  std::vector<float> depth;        // [R] expected depth (0 where the ray hits nothing)
+  std::vector<float> opacity;      // [R]
+  std::vector<float> mask;         // [R] sum_i w_i M(x_i)
+  std::vector<float> deformation;  // [R] sum_i w_i ||D_final(x_i) - x_i|| (world units)
+};
+
+// Reusable buffers of TrainForwardBackward / Render (no allocation once grown).
+struct ModelWorkspace;
+
+class AvatarModel {
+ public:
+  // Builds the fields and registers their parameters. Errors: invalid config or setup.
+  static Result<std::unique_ptr<AvatarModel>> Create(const ModelConfig& config, const ModelSetup& setup,
+                                                   const Executor& executor);
+  ~AvatarModel();
+
+  // Draws initial parameters (deterministic for the seed).
+  void Initialize(uint64_t seed);
+
+  // Forward + backward of one batch: accumulates d total / d parameters into store().grads().
+  LossTerms TrainForwardBackward(const TrainRays& batch, const LossWeights& weights, uint64_t seed, int64_t step,
+                                 const Executor& executor);
+
+  // Renders rays at expression beta [expression_dim] over `background`.
+  void Render(std::span<const Ray> rays, std::span<const float> beta, const Vec3f& background,
+              const Executor& executor, RenderOutput* out) const;
+
+  // Folds the current density (max over the training expressions) into the occupancy grid.
+  void UpdateOccupancy(uint64_t seed, int64_t step, const Executor& executor);
+
+  // beta_n, delta, kappa for an expression.
+  NearestExpression Nearest(std::span<const float> beta) const;
+
+  // Canonical-space query of the static field (tests and tools): sigma [n], rgb [n, 3].
+  void QueryStatic(const Executor& executor, int64_t n, const float* canonical, const float* directions,
+                   const float* condition, float* sigma, float* rgb) const;
+  // The warp D_final(x, beta) - x, confidence-weighted as in Render: offsets [n, 3] world frame.
+  void Offsets(const Executor& executor, int64_t n, const float* positions, std::span<const float> beta,
+               float* offsets) const;
+  // D_phi (kappa forced to 1) and D_lin around beta_n separately (tests).
+  void OffsetsPhi(const Executor& executor, int64_t n, const float* positions, std::span<const float> beta,
+                  float* offsets) const;
+  void OffsetsLinearized(const Executor& executor, int64_t n, const float* positions, std::span<const float> beta,
+                         float* offsets) const;
+
+  nn::ParameterStore& store() { return store_; }
+  const nn::ParameterStore& store() const { return store_; }
+  const ModelConfig& config() const { return config_; }
+  const ModelSetup& setup() const { return setup_; }
+  Method method() const { return method_; }
+  const MethodTraits& traits() const { return traits_; }
+  OccupancyGrid& occupancy() { return occupancy_; }
+  const OccupancyGrid& occupancy() const { return occupancy_; }
+  const RegionMask& mask() const { return mask_; }
+  const ExpressionConfidence& confidence() const { return confidence_; }
+  DeformationField* deformation() { return deformation_.get(); }
+  const DeformationField* deformation() const { return deformation_.get(); }
+  std::string ToString() const;
+
+ private:
+  AvatarModel(const ModelConfig& config, const ModelSetup& setup, RegionMask mask, ExpressionConfidence confidence);
+
+  ModelConfig config_;
+  ModelSetup setup_;
+  Method method_;
+  MethodTraits traits_;
+  nn::ParameterStore store_;
+  std::unique_ptr<StaticField> static_field_;
+  std::unique_ptr<DeformationField> deformation_;
+  RegionMask mask_;
+  ExpressionConfidence confidence_;
+  OccupancyGrid occupancy_;
+  std::unique_ptr<ModelWorkspace> train_ws_;
+  mutable std::unique_ptr<ModelWorkspace> render_ws_;
+};
+
+}  // namespace icef

@@ -1,0 +1,227 @@
+#include "icef/model/avatar_model.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "icef/core/rng.h"
+#include "icef/model/identity_losses.h"
+#include "icef/model/model_test_util.h"
+
+namespace icef {
+namespace {
+
+using testing_model::TinyModelConfig;
+using testing_model::TinySetup;
+
+std::unique_ptr<AvatarModel> MakeModel(const std::string& method, float deform_scale = 0.5f) {
+  ModelConfig config = TinyModelConfig(method);
+  config.deform_init_scale = deform_scale;  // a clearly non-zero warp from the start
+  auto model = AvatarModel::Create(config, TinySetup(), Executor(2));
+  ICEF_CHECK(model.ok(), model.status().message());
+  (*model)->Initialize(7);
+  return std::move(model).value();
+}
+
+std::vector<float> RandomPoints(int n, uint64_t seed) {
+  Rng rng(seed, StreamId("points"));
+  std::vector<float> p(3 * n);
+  for (float& v : p) v = static_cast<float>(rng.Uniform(-0.4, 0.4));
+  return p;
+}
+
+TEST(MethodTest, ParseAndTraits) {
+  for (Method m : AllMethods()) EXPECT_EQ(*ParseMethod(MethodName(m)), m);
+  EXPECT_FALSE(ParseMethod("icef2").ok());
+  EXPECT_NE(ParseMethod("x").status().message().find("icef-no-conf"), std::string::npos);
+  EXPECT_TRUE(TraitsOf(Method::kIcef).confidence);
+  EXPECT_FALSE(TraitsOf(Method::kIcefNoConf).confidence);
+  EXPECT_FALSE(TraitsOf(Method::kIcefNoId).identity_losses);
+  EXPECT_FALSE(TraitsOf(Method::kWarp).identity_losses);
+  EXPECT_FALSE(TraitsOf(Method::kNerface).deformation);
+  EXPECT_TRUE(TraitsOf(Method::kNerface).entangled_beta);
+}
+
+TEST(AvatarModelTest, StaticFieldNeverSeesBeta) {
+  // ICEF: the canonical field has no expression input, so rendering two expressions that warp
+  // every point to the same canonical point gives the same colour. We check it directly: the
+  // static field at fixed canonical points is identical whatever expression the model was last
+  // rendered at, while the entangled nerface baseline does change with beta.
+  auto icef = MakeModel("icef");
+  EXPECT_EQ(icef->config().StaticOptions(3).condition_dims, 0);
+  const int n = 64;
+  const std::vector<float> x = RandomPoints(n, 1);
+  std::vector<float> dirs(3 * n, 0.f);
+  for (int i = 0; i < n; ++i) dirs[3 * i + 2] = 1.f;
+  std::vector<float> s0(n), c0(3 * n), s1(n), c1(3 * n);
+  icef->QueryStatic(Executor(2), n, x.data(), dirs.data(), nullptr, s0.data(), c0.data());
+  RenderOutput out;
+  std::vector<Ray> rays = {Ray{Vec3f(0, 0, 2), Vec3f(0, 0, -1)}};
+  icef->Render(rays, std::vector<float>{1.f, 1.f, 1.f}, Vec3f::Ones(), Executor(2), &out);
+  icef->QueryStatic(Executor(2), n, x.data(), dirs.data(), nullptr, s1.data(), c1.data());
+  EXPECT_EQ(s0, s1);
+  EXPECT_EQ(c0, c1);
+
+  auto nerface = MakeModel("nerface");
+  EXPECT_EQ(nerface->config().StaticOptions(3).condition_dims, 3);
+  std::vector<float> beta0(3 * n, 0.f), beta1(3 * n, 1.f);
+  nerface->QueryStatic(Executor(2), n, x.data(), dirs.data(), beta0.data(), s0.data(), c0.data());
+  nerface->QueryStatic(Executor(2), n, x.data(), dirs.data(), beta1.data(), s1.data(), c1.data());
+  EXPECT_NE(s0, s1);
+}
+
+TEST(AvatarModelTest, ConfidenceBlendAtObservedAndFarExpressions) {
+  auto model = MakeModel("icef");
+  const int n = 32;
+  const std::vector<float> x = RandomPoints(n, 2);
+  const Executor ex(2);
+  std::vector<float> phi(3 * n), lin(3 * n), fin(3 * n);
+  // At a training expression delta = 0, kappa = 1: D_final == D_phi exactly.
+  const std::vector<float>& observed = model->setup().training_expressions[1];
+  EXPECT_EQ(model->Nearest(observed).delta, 0.0);
+  EXPECT_EQ(model->Nearest(observed).kappa, 1.0);
+  model->Offsets(ex, n, x.data(), observed, fin.data());
+  model->OffsetsPhi(ex, n, x.data(), observed, phi.data());
+  EXPECT_EQ(fin, phi);
+  // As delta grows, D_final -> D_lin: the gap shrinks like kappa.
+  double prev_gap = 1e30;
+  for (float scale : {0.5f, 2.f, 8.f}) {
+    std::vector<float> beta = {0.5f + scale, 0.2f * scale, -0.3f * scale};
+    const NearestExpression near = model->Nearest(beta);
+    model->Offsets(ex, n, x.data(), beta, fin.data());
+    model->OffsetsPhi(ex, n, x.data(), beta, phi.data());
+    model->OffsetsLinearized(ex, n, x.data(), beta, lin.data());
+    double gap = 0, expected = 0;
+    for (int i = 0; i < 3 * n; ++i) {
+      gap = std::max(gap, double(std::abs(fin[i] - lin[i])));
+      expected = std::max(expected, near.kappa * std::abs(phi[i] - lin[i]));
+      ASSERT_NEAR(fin[i], near.kappa * phi[i] + (1 - near.kappa) * lin[i], 1e-5);
+    }
+    EXPECT_LE(gap, expected + 1e-6);
+    EXPECT_LT(gap, prev_gap);
+    prev_gap = gap;
+  }
+  EXPECT_LT(prev_gap, 1e-3);
+  // icef-no-conf never blends.
+  auto no_conf = MakeModel("icef-no-conf");
+  std::vector<float> beta = {3.f, 1.f, 0.f};
+  no_conf->Offsets(ex, n, x.data(), beta, fin.data());
+  no_conf->OffsetsPhi(ex, n, x.data(), beta, phi.data());
+  EXPECT_EQ(fin, phi);
+}
+
+TEST(AvatarModelTest, LinearizedWarpMatchesFiniteDifferences) {
+  auto model = MakeModel("icef");
+  const int n = 32;
+  const std::vector<float> x = RandomPoints(n, 3);
+  const Executor ex(1);
+  const std::vector<float> beta = {0.9f, 0.4f, -0.2f};
+  const int k = model->Nearest(beta).index;
+  const std::vector<float>& anchor = model->setup().training_expressions[k];
+  std::vector<float> lin(3 * n), base(3 * n), plus(3 * n), minus(3 * n);
+  model->OffsetsLinearized(ex, n, x.data(), beta, lin.data());
+  model->OffsetsPhi(ex, n, x.data(), anchor, base.data());
+  // The warp is piecewise smooth (ReLU MLP): a small step keeps most points off the kinks.
+  const float h = 1e-3f;
+  std::vector<float> bp(3), bm(3);
+  for (int i = 0; i < 3; ++i) {
+    bp[i] = anchor[i] + h * (beta[i] - anchor[i]);
+    bm[i] = anchor[i] - h * (beta[i] - anchor[i]);
+  }
+  model->OffsetsPhi(ex, n, x.data(), bp, plus.data());
+  model->OffsetsPhi(ex, n, x.data(), bm, minus.data());
+  double max_err = 0, max_tangent = 0;
+  for (int i = 0; i < 3 * n; ++i) {
+    const double fd = base[i] + (double(plus[i]) - minus[i]) / (2 * h);
+    max_err = std::max(max_err, std::abs(fd - lin[i]));
+    max_tangent = std::max(max_tangent, std::abs(double(lin[i]) - base[i]));
+  }
+  EXPECT_GT(max_tangent, 1e-3);  // the linear term is not trivially zero
+  EXPECT_LT(max_err, 1e-2 * max_tangent + 1e-5);
+}
+
+TEST(IdentityLossTest, ZeroInsideRegionsPositiveOutside) {
+  const double inv_half2[3] = {4, 4, 4};
+  const double offsets[6] = {0.1, -0.2, 0.05, 0.3, 0.0, -0.1};
+  const float inside[2] = {1.f, 1.f}, outside[2] = {0.f, 0.f};
+  EXPECT_EQ(IdentityLoss<double>(2, offsets, inside, inv_half2, 1.0, nullptr), 0.0);
+  EXPECT_GT(IdentityLoss<double>(2, offsets, outside, inv_half2, 1.0, nullptr), 0.0);
+  const double zero[6] = {0, 0, 0, 0, 0, 0};
+  EXPECT_EQ(IdentityLoss<double>(2, zero, outside, inv_half2, 1.0, nullptr), 0.0);
+}
+
+TEST(IdentityLossTest, GradientsMatchFiniteDifferences) {
+  Rng rng(11, StreamId("id_grad"));
+  const int n = 7;
+  std::vector<double> off(6 * n);
+  std::vector<float> mask(2 * n), weights(n);
+  for (double& v : off) v = rng.Uniform(-0.3, 0.3);
+  for (float& m : mask) m = static_cast<float>(rng.Uniform());
+  for (float& w : weights) w = static_cast<float>(rng.Uniform());
+  const double inv_half2[3] = {1.5, 2.0, 0.7}, half[3] = {0.8, 0.7, 1.2}, eps = 0.05;
+  std::vector<double> g_id(6 * n, 0.0), g_sm(6 * n, 0.0);
+  IdentityLoss<double>(2 * n, off.data(), mask.data(), inv_half2, 0.3, g_id.data());
+  SmoothnessLoss<double>(n, off.data(), weights.data(), half, eps, 0.7, g_sm.data());
+  const double h = 1e-6;
+  for (int i = 0; i < 6 * n; ++i) {
+    std::vector<double> p = off, m = off;
+    p[i] += h;
+    m[i] -= h;
+    const double fd_id = 0.3 * (IdentityLoss<double>(2 * n, p.data(), mask.data(), inv_half2, 1.0, nullptr) -
+                                IdentityLoss<double>(2 * n, m.data(), mask.data(), inv_half2, 1.0, nullptr)) / (2 * h);
+    const double fd_sm = 0.7 * (SmoothnessLoss<double>(n, p.data(), weights.data(), half, eps, 1.0, nullptr) -
+                                SmoothnessLoss<double>(n, m.data(), weights.data(), half, eps, 1.0, nullptr)) / (2 * h);
+    EXPECT_NEAR(g_id[i], fd_id, 1e-7 * (1 + std::abs(fd_id))) << i;
+    EXPECT_NEAR(g_sm[i], fd_sm, 1e-7 * (1 + std::abs(fd_sm))) << i;
+  }
+}
+
+// End-to-end check of the hand-written chain (compositing, static field, warp, losses): the
+// total training loss against central differences in a few parameters with large gradients.
+// The engine is float32, so the tolerance is looser than the double-precision checks of each
+// component (nn/, render/, identity_losses).
+TEST(AvatarModelTest, TrainLossGradientMatchesFiniteDifferences) {
+  for (const char* method : {"icef", "nerface"}) {
+    auto model = MakeModel(method, 0.05f);
+    TrainRays batch;
+    Rng rng(5, StreamId("batch"));
+    for (int r = 0; r < 24; ++r) {
+      const Vec3f o(static_cast<float>(rng.Uniform(-0.2, 0.2)), static_cast<float>(rng.Uniform(-0.2, 0.2)), 2.f);
+      batch.rays.push_back(Ray{o, Vec3f(0, 0, -1)});
+      batch.frame.push_back(r % 3);
+      for (int a = 0; a < 3; ++a) batch.target_rgb.push_back(static_cast<float>(rng.Uniform()));
+      batch.target_alpha.push_back(static_cast<float>(rng.Uniform()));
+    }
+    LossWeights w;
+    w.lambda_id = 0.5;
+    w.lambda_mask = 0.2;
+    w.lambda_distortion = 0.01;
+    const Executor ex(1);
+    // Raise densities so the compositing weights are non-trivial.
+    nn::ParameterStore& store = model->store();
+    store.ZeroGrads();
+    model->TrainForwardBackward(batch, w, 3, 0, ex);
+    std::vector<float> grads(store.grads(), store.grads() + store.size());
+    std::vector<int64_t> order(grads.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = int64_t(i);
+    std::partial_sort(order.begin(), order.begin() + 12, order.end(),
+                      [&](int64_t a, int64_t b) { return std::abs(grads[a]) > std::abs(grads[b]); });
+    ASSERT_GT(std::abs(grads[order[0]]), 1e-6) << method;
+    for (int k = 0; k < 12; ++k) {
+      const int64_t i = order[k];
+      const float saved = store.params()[i];
+      const float h = std::max(1e-3f, 1e-3f * std::abs(saved));
+      store.params()[i] = saved + h;
+      const double lp = model->TrainForwardBackward(batch, w, 3, 0, ex).total;
+      store.params()[i] = saved - h;
+      const double lm = model->TrainForwardBackward(batch, w, 3, 0, ex).total;
+      store.params()[i] = saved;
+      const double fd = (lp - lm) / (2.0 * (double(saved + h) - double(saved)));
+      EXPECT_NEAR(grads[i], fd, 2e-2 * std::abs(fd) + 1e-6) << method << " parameter " << i;
+    }
+    store.ZeroGrads();
+  }
+}
+
+}  // namespace
+}  // namespace icef

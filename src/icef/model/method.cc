@@ -1,0 +1,45 @@
+#include "icef/model/method.h"
+
+namespace icef {
+
+MethodTraits TraitsOf(Method method) {
+  MethodTraits t;
+  switch (method) {
+    case Method::kIcef: break;
+    case Method::kIcefNoId: t.identity_losses = false; break;
+    case Method::kIcefNoConf: t.confidence = false; break;
+    case Method::kWarp: t.identity_losses = false, t.confidence = false; break;
+    case Method::kNerface:
+      t.deformation = false, t.identity_losses = false, t.confidence = false, t.entangled_beta = true;
+      break;
+  }
+  return t;
+}
+
+const char* MethodName(Method method) {
+  switch (method) {
+    case Method::kIcef: return "icef";
+    case Method::kIcefNoId: return "icef-no-id";
+    case Method::kIcefNoConf: return "icef-no-conf";
+    case Method::kWarp: return "warp";
+    case Method::kNerface: return "nerface";
+  }
+  return "?";
+}
+
+const std::vector<Method>& AllMethods() {
+  static const std::vector<Method> kAll = {Method::kIcef, Method::kIcefNoId, Method::kIcefNoConf, Method::kWarp,
+                                           Method::kNerface};
+  return kAll;
+}
+
+Result<Method> ParseMethod(const std::string& name) {
+  std::string valid;
+  for (Method m : AllMethods()) {
+    if (name == MethodName(m)) return m;
+    valid += (valid.empty() ? "" : ", ") + std::string(MethodName(m));
+  }
+  return Status::Error("unknown method '" + name + "' (valid: " + valid + ")");
+}
+
+}  // namespace icef

@@ -1,0 +1,62 @@
+#include "icef/model/model_setup.h"
+
+#include "icef/field/region_mask.h"
+
+namespace icef {
+
+Result<ModelSetup> ModelSetup::FromDataset(const Dataset& dataset, const Executor& executor) {
+  if (dataset.train.empty()) return Status::Error(dataset.root.string() + ": the dataset has no training frames");
+  ModelSetup s;
+  s.aabb = dataset.aabb;
+  s.expression_dim = dataset.expression_dim;
+  s.expression_names = dataset.expression_names;
+  for (const Frame& f : dataset.train) s.training_expressions.push_back(f.expression);
+  s.background = dataset.background;
+  ICEF_ASSIGN_OR_RETURN(const RegionMask mask, RegionMask::FromDataset(dataset, RegionMaskOptions{}, executor));
+  s.mask_landmarks = mask.landmarks();
+  s.mask_source = mask.source();
+  return s;
+}
+
+Json ModelSetup::ToJson() const {
+  Json j;
+  j["aabb"] = {{aabb.min.x(), aabb.min.y(), aabb.min.z()}, {aabb.max.x(), aabb.max.y(), aabb.max.z()}};
+  j["expression_dim"] = expression_dim;
+  j["expression_names"] = expression_names;
+  j["training_expressions"] = training_expressions;
+  Json lm = Json::array();
+  for (const Vec3f& p : mask_landmarks) lm.push_back({p.x(), p.y(), p.z()});
+  j["mask_landmarks"] = lm;
+  j["mask_source"] = mask_source;
+  j["background"] = {background.x(), background.y(), background.z()};
+  return j;
+}
+
+Result<ModelSetup> ModelSetup::FromJson(const Json& json, const std::string& origin) {
+  ICEF_ASSIGN_OR_RETURN(const JsonObjectView v, JsonObjectView::Make(json, origin, "setup"));
+  ModelSetup s;
+  ICEF_ASSIGN_OR_RETURN(const auto aabb, v.NumberMatrix("aabb", 2, 3));
+  s.aabb.min = Vec3f(aabb[0][0], aabb[0][1], aabb[0][2]);
+  s.aabb.max = Vec3f(aabb[1][0], aabb[1][1], aabb[1][2]);
+  if (!s.aabb.IsValid()) return v.Error("aabb", "min must be below max");
+  ICEF_ASSIGN_OR_RETURN(s.expression_dim, v.Int("expression_dim"));
+  if (s.expression_dim < 1) return v.Error("expression_dim", "must be >= 1");
+  ICEF_ASSIGN_OR_RETURN(s.expression_names, v.StringArray("expression_names"));
+  ICEF_ASSIGN_OR_RETURN(const auto expressions, v.NumberMatrix("training_expressions", -1, s.expression_dim));
+  for (const auto& row : expressions) s.training_expressions.emplace_back(row.begin(), row.end());
+  if (s.training_expressions.empty()) return v.Error("training_expressions", "must not be empty");
+  ICEF_ASSIGN_OR_RETURN(const auto lm, v.NumberMatrix("mask_landmarks", kNumLandmarks, 3));
+  for (const auto& p : lm) s.mask_landmarks.emplace_back(p[0], p[1], p[2]);
+  ICEF_ASSIGN_OR_RETURN(s.mask_source, v.String("mask_source"));
+  ICEF_ASSIGN_OR_RETURN(const auto bg, v.NumberArray("background", 3));
+  s.background = Vec3f(bg[0], bg[1], bg[2]);
+  return s;
+}
+
+int ModelSetup::ExpressionIndex(const std::string& name) const {
+  for (size_t i = 0; i < expression_names.size(); ++i)
+    if (expression_names[i] == name) return static_cast<int>(i);
+  return -1;
+}
+
+}  // namespace icef

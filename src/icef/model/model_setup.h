@@ -1,0 +1,35 @@
+// What a model takes from its training dataset and keeps for its whole life (saved in every
+// checkpoint, so rendering and evaluation need only the model directory): the aabb, the
+// expression space, the observed training expressions (for the confidence kappa and beta_n), the
+// 68 landmarks the region mask is built from, and the background colour.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "icef/core/parallel.h"
+#include "icef/data/dataset.h"
+#include "icef/io/json_util.h"
+#include "icef/math/ray.h"
+
+namespace icef {
+
+struct ModelSetup {
+  Aabb aabb;                                          // world frame
+  int expression_dim = 0;
+  std::vector<std::string> expression_names;          // [expression_dim] or empty
+  std::vector<std::vector<float>> training_expressions;  // [K][expression_dim]
+  std::vector<Vec3f> mask_landmarks;                  // [68] world frame
+  std::string mask_source;                            // where the landmarks came from
+  Vec3f background = Vec3f::Ones();
+
+  // From a loaded dataset's training split; the landmarks come from RegionMask::FromDataset's
+  // rules (mean landmarks_3d, else triangulated landmarks_2d).
+  static Result<ModelSetup> FromDataset(const Dataset& dataset, const Executor& executor);
+  Json ToJson() const;
+  static Result<ModelSetup> FromJson(const Json& json, const std::string& origin);
+  // Index of a named expression coefficient, or -1.
+  int ExpressionIndex(const std::string& name) const;
+};
+
+}  // namespace icef

@@ -1,0 +1,1 @@
+icef_module(model DEPS icef_field icef_render)

@@ -1,0 +1,32 @@
+// Renders whole images from a AvatarModel: one ray per pixel centre of a camera, at one expression.
+#pragma once
+
+#include <span>
+
+#include "icef/io/image.h"
+#include "icef/math/camera.h"
+#include "icef/model/avatar_model.h"
+
+namespace icef {
+
+struct RenderedImage {
+  Image color;        // RGB over the background
+  Image depth;        // 1 channel, expected depth (world units; 0 where nothing is hit)
+  Image opacity;      // 1 channel
+  Image mask;         // 1 channel: expected region mask M along each ray
+  Image deformation;  // 1 channel: expected ||D_final(x) - x|| (world units)
+  NearestExpression nearest;  // beta_n, delta, kappa of the expression
+};
+
+RenderedImage RenderImage(const AvatarModel& model, const Camera& camera, std::span<const float> beta,
+                          const Vec3f& background, const Executor& executor);
+
+// Maps a 1-channel image to RGB for viewing: values over [lo, hi] through a perceptual colour map
+// (viridis-like); hi <= lo uses the image's own range.
+Image ColorizeScalar(const Image& scalar, float lo, float hi);
+
+// Mean squared error and PSNR of two RGB images of the same size.
+double MeanSquaredError(const Image& a, const Image& b);
+double PsnrFromMse(double mse);
+
+}  // namespace icef

@@ -1,0 +1,44 @@
+// Model directories and checkpoints. A model directory holds
+//   checkpoint.icef   parameters, optimiser state, occupancy grid, trainer state, resolved config and
+//                     dataset-derived setup (io/checkpoint.h container: versioned, checksummed,
+//                     written atomically)
+//   config.json       the effective run config (also inside the checkpoint)
+//   summary.json      written when training ends
+//   train_log.jsonl   one JSON line per logged step
+// Rendering and evaluation rebuild everything from checkpoint.icef alone.
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "icef/io/json_util.h"
+#include "icef/model/avatar_model.h"
+#include "icef/nn/adam.h"
+#include "icef/train/train_config.h"
+
+namespace icef {
+
+inline constexpr const char* kCheckpointFile = "checkpoint.icef";
+
+struct TrainerState {
+  int64_t step = 0;              // completed optimiser steps
+  double elapsed_seconds = 0;    // training wall time so far (over all resumed runs)
+  std::vector<std::string> log;  // train_log.jsonl lines so far
+};
+
+Status SaveCheckpoint(const std::filesystem::path& path, const RunConfig& config, const AvatarModel& model,
+                      const nn::Adam* adam, const TrainerState& state);
+
+struct LoadedModel {
+  RunConfig config;
+  std::unique_ptr<AvatarModel> model;
+  std::string adam_state;  // serialised Adam state (empty when the checkpoint has none)
+  TrainerState state;
+};
+
+// Reads a checkpoint file, or MODEL_DIR/checkpoint.icef when given a directory. Errors name the
+// file and what is wrong (corrupt, truncated, from another version, missing section).
+Result<LoadedModel> LoadModel(const std::filesystem::path& path, const Executor& executor);
+
+}  // namespace icef

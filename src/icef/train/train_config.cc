@@ -1,0 +1,144 @@
+#include "icef/train/train_config.h"
+
+#include <set>
+
+#include "icef/io/checkpoint.h"
+
+namespace icef {
+
+void TrainConfig::Bind(ConfigSchema& s) {
+  s.Int64("steps", &steps, "optimiser steps");
+  s.Number("time_budget_seconds", &time_budget_seconds, "stop after this much wall time in seconds (0 = no limit)");
+  s.Int("batch_rays", &batch_rays, "rays per step");
+  s.Number("lr_grid", &lr_grid, "Adam learning rate of the hash grid");
+  s.Number("lr_mlp", &lr_mlp, "Adam learning rate of the static field's MLPs");
+  s.Number("lr_deform", &lr_deform, "Adam learning rate of the deformation MLP");
+  s.Number("lr_final_factor", &lr_final_factor, "learning rates decay exponentially to this factor at the last step");
+  s.Number("lambda_id", &lambda_id, "weight of L_id, identity preservation outside the expression regions");
+  s.Number("lambda_smooth", &lambda_smooth, "weight of L_smooth, deformation smoothness at the region boundary");
+  s.Number("lambda_mask", &lambda_mask, "weight of the alpha-mask loss (auxiliary; datasets with alpha only)");
+  s.Number("lambda_distortion", &lambda_distortion, "weight of the mip-NeRF 360 distortion loss (auxiliary; 0 = off)");
+  s.Number("smooth_epsilon", &smooth_epsilon, "finite-difference offset of L_smooth (half-extent units of the aabb)");
+  s.Int("smooth_max_samples", &smooth_max_samples, "boundary samples per step used by L_smooth");
+  s.Int("anneal_steps", &anneal_steps, "coarse-to-fine: deformation frequencies switch on over these steps (0 = off)");
+  s.Int("occupancy_warmup", &occupancy_warmup, "steps before the occupancy grid starts skipping empty space");
+  s.Int("occupancy_every", &occupancy_every, "steps between occupancy grid updates");
+  s.Int("checkpoint_every", &checkpoint_every, "steps between checkpoints (0 = only at the end)");
+  s.Int("log_every", &log_every, "steps between lines of MODEL/train_log.jsonl");
+  s.Int("eval_every", &eval_every, "steps between held-out PSNR evaluations on observed-tier test frames (0 = off)");
+  s.Int64("seed", &seed, "root seed of every random draw");
+  s.Int("threads", &threads, "worker threads (0 = all cores)");
+}
+
+Status TrainConfig::Validate() const {
+  auto positive = [](double v) { return std::isfinite(v) && v > 0; };
+  auto non_negative = [](double v) { return std::isfinite(v) && v >= 0; };
+  if (steps < 1) return Status::Error("train.steps must be >= 1");
+  if (!non_negative(time_budget_seconds)) return Status::Error("train.time_budget_seconds must be >= 0");
+  if (batch_rays < 1) return Status::Error("train.batch_rays must be >= 1");
+  if (!positive(lr_grid) || !positive(lr_mlp) || !positive(lr_deform))
+    return Status::Error("train.lr_grid, lr_mlp and lr_deform must be positive");
+  if (!positive(lr_final_factor) || lr_final_factor > 1) return Status::Error("train.lr_final_factor must be in (0, 1]");
+  if (!non_negative(lambda_id)) return Status::Error("train.lambda_id must be a finite number >= 0");
+  if (!non_negative(lambda_smooth)) return Status::Error("train.lambda_smooth must be a finite number >= 0");
+  if (!non_negative(lambda_mask)) return Status::Error("train.lambda_mask must be a finite number >= 0");
+  if (!non_negative(lambda_distortion)) return Status::Error("train.lambda_distortion must be a finite number >= 0");
+  if (!positive(smooth_epsilon)) return Status::Error("train.smooth_epsilon must be positive");
+  if (smooth_max_samples < 1) return Status::Error("train.smooth_max_samples must be >= 1");
+  if (anneal_steps < 0 || occupancy_warmup < 0 || occupancy_every < 1 || checkpoint_every < 0 || log_every < 1 ||
+      eval_every < 0)
+    return Status::Error("train: anneal_steps, occupancy_warmup, checkpoint_every, eval_every must be >= 0 and "
+                         "occupancy_every, log_every >= 1");
+  if (threads < 0) return Status::Error("train.threads must be >= 0");
+  return Status::Ok();
+}
+
+Status RunConfig::Validate() const {
+  ICEF_RETURN_IF_ERROR(model.Validate().WithContext("model"));
+  return train.Validate();
+}
+
+Json RunConfig::ToJson() const {
+  Json j;
+  j["model"] = WriteConfig(model);
+  j["train"] = WriteConfig(train);
+  return j;
+}
+
+namespace {
+Status ApplyJson(const Json& json, const std::string& origin, const std::filesystem::path& base_dir,
+                 std::set<std::string>* visited, RunConfig* config) {
+  ICEF_ASSIGN_OR_RETURN(const JsonObjectView root, JsonObjectView::Make(json, origin, ""));
+  const std::vector<std::string> unknown = root.UnknownKeys({"parent", "model", "train"});
+  if (!unknown.empty()) return root.Error(unknown.front(), "unknown key (valid keys: parent, model, train)");
+  if (root.Has("parent")) {
+    ICEF_ASSIGN_OR_RETURN(const std::string parent, root.String("parent"));
+    const std::filesystem::path path = base_dir / parent;
+    if (!visited->insert(std::filesystem::weakly_canonical(path).string()).second)
+      return root.Error("parent", "cycle of parent configs through " + path.string());
+    ICEF_ASSIGN_OR_RETURN(const Json parent_json, ReadJsonFile(path));
+    ICEF_RETURN_IF_ERROR(ApplyJson(parent_json, path.string(), path.parent_path(), visited, config));
+  }
+  if (root.Has("model")) {
+    ICEF_ASSIGN_OR_RETURN(const JsonObjectView m, root.Object("model"));
+    ICEF_RETURN_IF_ERROR(ReadConfig(m, &config->model));
+  }
+  if (root.Has("train")) {
+    ICEF_ASSIGN_OR_RETURN(const JsonObjectView t, root.Object("train"));
+    ICEF_RETURN_IF_ERROR(ReadConfig(t, &config->train));
+  }
+  return Status::Ok();
+}
+}  // namespace
+
+Result<RunConfig> RunConfig::FromJson(const Json& json, const std::string& origin) {
+  RunConfig config;
+  std::set<std::string> visited;
+  ICEF_RETURN_IF_ERROR(ApplyJson(json, origin, std::filesystem::path("."), &visited, &config));
+  ICEF_RETURN_IF_ERROR(config.Validate().WithContext(origin));
+  return config;
+}
+
+Result<RunConfig> RunConfig::FromFile(const std::filesystem::path& path) {
+  ICEF_ASSIGN_OR_RETURN(const Json json, ReadJsonFile(path));
+  RunConfig config;
+  std::set<std::string> visited = {std::filesystem::weakly_canonical(path).string()};
+  ICEF_RETURN_IF_ERROR(ApplyJson(json, path.string(), path.parent_path(), &visited, &config));
+  ICEF_RETURN_IF_ERROR(config.Validate().WithContext(path.string()));
+  return config;
+}
+
+Status RunConfig::ApplyOverride(const std::string& assignment) {
+  const size_t eq = assignment.find('=');
+  const size_t dot = assignment.find('.');
+  if (eq == std::string::npos || dot == std::string::npos || dot > eq)
+    return Status::Error("--set '" + assignment + "': expected SECTION.KEY=VALUE, e.g. train.steps=500");
+  const std::string section = assignment.substr(0, dot), key = assignment.substr(dot + 1, eq - dot - 1);
+  const std::string text = assignment.substr(eq + 1);
+  Json value = Json::parse(text, nullptr, /*allow_exceptions=*/false);
+  if (value.is_discarded()) value = text;
+  Json patch;
+  patch[section][key] = value;
+  std::set<std::string> visited;
+  RunConfig updated = *this;
+  ICEF_RETURN_IF_ERROR(ApplyJson(patch, "--set " + assignment, ".", &visited, &updated));
+  ICEF_RETURN_IF_ERROR(updated.Validate().WithContext("--set " + assignment));
+  *this = updated;
+  return Status::Ok();
+}
+
+uint64_t RunConfig::Hash() const { return Fnv1a64(ToJson().dump()); }
+
+std::string ConfigDocumentation() {
+  std::string out;
+  ConfigSchema model_schema, train_schema;
+  ModelConfig model;
+  TrainConfig train;
+  model.Bind(model_schema);
+  train.Bind(train_schema);
+  out += "## `model`\n\n| key | default | meaning |\n|---|---|---|\n" + model_schema.MarkdownRows();
+  out += "\n## `train`\n\n| key | default | meaning |\n|---|---|---|\n" + train_schema.MarkdownRows();
+  return out;
+}
+
+}  // namespace icef

@@ -1,0 +1,62 @@
+// Run configs: {"parent": "other.json", "model": {...ModelConfig keys}, "train": {...TrainConfig
+// keys}}. A parent is read first (paths relative to the child file) and the child overrides the
+// keys it names, as instant-ngp's configs do. Unknown keys are errors that list the valid keys.
+// docs/config.md lists every key, its default and meaning.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "icef/io/config_schema.h"
+#include "icef/model/model_config.h"
+
+namespace icef {
+
+struct TrainConfig {
+  int64_t steps = 2000;              // optimiser steps
+  double time_budget_seconds = 0;    // stop after this much wall time (0 = no limit); the step count still bounds it
+  int batch_rays = 4096;             // rays per step
+  double lr_grid = 1e-2;             // Adam learning rate of the hash grid
+  double lr_mlp = 1e-3;              // Adam learning rate of the static field's MLPs
+  double lr_deform = 1e-3;           // Adam learning rate of the deformation MLP
+  double lr_final_factor = 0.1;      // learning rates decay exponentially to this factor at the last step
+  double lambda_id = 0.1;            // weight of L_id (identity preservation outside the expression regions)
+  double lambda_smooth = 1e-4;       // weight of L_smooth (deformation smoothness at the region boundary)
+  double lambda_mask = 0.1;          // weight of the alpha-mask loss (images with alpha only)
+  double lambda_distortion = 1e-3;   // weight of the mip-NeRF 360 distortion loss (0 = off)
+  double smooth_epsilon = 0.01;      // finite-difference offset of L_smooth (half-extent units)
+  int smooth_max_samples = 4096;     // boundary samples per step used by L_smooth
+  int anneal_steps = 500;            // coarse-to-fine: deformation frequencies are switched on over these steps (0 = off)
+  int occupancy_warmup = 256;        // steps before the occupancy grid starts skipping empty space
+  int occupancy_every = 16;          // steps between occupancy grid updates
+  int checkpoint_every = 500;        // steps between checkpoints (0 = only at the end)
+  int log_every = 50;                // steps between lines of train_log.jsonl
+  int eval_every = 0;                // steps between held-out PSNR evaluations on observed-tier test frames (0 = off)
+  int64_t seed = 0;                  // root seed of every random draw
+  int threads = 0;                   // worker threads (0 = all cores)
+
+  void Bind(ConfigSchema& s);
+  Status Validate() const;
+};
+
+struct RunConfig {
+  ModelConfig model;
+  TrainConfig train;
+
+  Status Validate() const;
+  Json ToJson() const;
+  // Reads a config file (following "parent" links); keys absent everywhere keep their defaults.
+  static Result<RunConfig> FromFile(const std::filesystem::path& path);
+  static Result<RunConfig> FromJson(const Json& json, const std::string& origin);
+  // Applies one "section.key=value" override, e.g. "train.steps=500" or "model.method=warp"
+  // (value parsed as JSON, or taken as a string when it is not valid JSON).
+  Status ApplyOverride(const std::string& assignment);
+  // Stable hash of the resolved config (for checkpoint headers).
+  uint64_t Hash() const;
+};
+
+// Markdown for docs/config.md: one table per section.
+std::string ConfigDocumentation();
+
+}  // namespace icef

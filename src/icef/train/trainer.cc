@@ -1,0 +1,240 @@
+#include "icef/train/trainer.h"
+
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "icef/io/atomic_file.h"
+#include "icef/model/render_image.h"
+
+namespace icef {
+
+namespace fs = std::filesystem;
+
+Json TrainSummary::ToJson() const {
+  Json j;
+  j["method"] = method;
+  j["steps"] = steps;
+  j["wall_seconds"] = wall_seconds;
+  j["final_loss"] = final_loss;
+  j["final_batch_psnr"] = final_batch_psnr;
+  j["psnr_observed"] = psnr_observed ? Json(*psnr_observed) : Json(nullptr);
+  j["observed_frames"] = observed_frames;
+  j["samples_per_second"] = samples_per_second;
+  j["interrupted"] = interrupted;
+  j["stop_reason"] = stop_reason;
+  return j;
+}
+
+std::string TrainSummary::BriefReport() const {
+  std::ostringstream os;
+  os.precision(4);
+  os << method << ": " << steps << " steps in " << wall_seconds << " s (" << stop_reason << "), final loss "
+     << final_loss << ", batch PSNR " << final_batch_psnr << " dB";
+  if (psnr_observed) os << ", held-out PSNR (observed tier, " << observed_frames << " frames) " << *psnr_observed << " dB";
+  return os.str();
+}
+
+Trainer::Trainer(const Dataset& dataset, fs::path model_dir, RunConfig config, TrainingData data,
+                 std::unique_ptr<AvatarModel> model, const Executor& executor)
+    : dataset_(dataset),
+      model_dir_(std::move(model_dir)),
+      config_(std::move(config)),
+      data_(std::move(data)),
+      model_(std::move(model)),
+      executor_(executor) {
+  adam_ = std::make_unique<nn::Adam>(MakeAdamOptions(), &model_->store());
+}
+
+nn::AdamOptions Trainer::MakeAdamOptions() const {
+  const TrainConfig& t = config_.train;
+  nn::AdamOptions o;
+  nn::AdamGroup grid, mlp, deform;
+  grid.learning_rate = t.lr_grid;
+  grid.sparse = true;
+  mlp.learning_rate = t.lr_mlp;
+  deform.learning_rate = t.lr_deform;
+  o.groups = {grid, mlp, deform};  // indices kGridGroup, kMlpGroup, kDeformGroup
+  o.schedule = nn::LrSchedule::kExponential;
+  o.decay_rate = t.lr_final_factor;
+  o.decay_steps = std::max<int64_t>(1, t.steps);
+  return o;
+}
+
+static Status CheckDatasetMatches(const Dataset& dataset, const ModelSetup& setup, const std::string& where) {
+  if (dataset.expression_dim != setup.expression_dim)
+    return Status::Error(where + ": expression_dim " + std::to_string(dataset.expression_dim) +
+                         " differs from the model's " + std::to_string(setup.expression_dim));
+  if (dataset.train.size() != setup.training_expressions.size())
+    return Status::Error(where + ": the dataset's training split differs from the one the model was trained on");
+  return Status::Ok();
+}
+
+Result<std::unique_ptr<Trainer>> Trainer::Create(const Dataset& dataset, const fs::path& model_dir,
+                                                 const RunConfig& config, const Executor& executor) {
+  ICEF_RETURN_IF_ERROR(config.Validate());
+  std::error_code ec;
+  fs::create_directories(model_dir, ec);
+  if (!fs::is_directory(model_dir)) return Status::Error(model_dir.string() + ": cannot create the model directory");
+  ICEF_ASSIGN_OR_RETURN(TrainingData data, TrainingData::Load(dataset));
+  ICEF_ASSIGN_OR_RETURN(const ModelSetup setup, ModelSetup::FromDataset(dataset, executor));
+  ICEF_ASSIGN_OR_RETURN(std::unique_ptr<AvatarModel> model, AvatarModel::Create(config.model, setup, executor));
+  model->Initialize(static_cast<uint64_t>(config.train.seed));
+  ICEF_RETURN_IF_ERROR(WriteFileAtomic(model_dir / "config.json", FormatJson(config.ToJson())));
+  return std::unique_ptr<Trainer>(new Trainer(dataset, model_dir, config, std::move(data), std::move(model), executor));
+}
+
+Result<std::unique_ptr<Trainer>> Trainer::Resume(const Dataset& dataset, const fs::path& model_dir,
+                                                 std::optional<int64_t> steps_override,
+                                                 std::optional<double> time_budget_override,
+                                                 const Executor& executor) {
+  ICEF_ASSIGN_OR_RETURN(LoadedModel loaded, LoadModel(model_dir, executor));
+  ICEF_RETURN_IF_ERROR(CheckDatasetMatches(dataset, loaded.model->setup(), dataset.root.string()));
+  RunConfig config = loaded.config;
+  if (steps_override) config.train.steps = *steps_override;
+  if (time_budget_override) config.train.time_budget_seconds = *time_budget_override;
+  ICEF_RETURN_IF_ERROR(config.Validate());
+  ICEF_ASSIGN_OR_RETURN(TrainingData data, TrainingData::Load(dataset));
+  std::unique_ptr<Trainer> trainer(
+      new Trainer(dataset, model_dir, loaded.config, std::move(data), std::move(loaded.model), executor));
+  if (!loaded.adam_state.empty()) {
+    std::istringstream in(loaded.adam_state);
+    ICEF_RETURN_IF_ERROR(trainer->adam_->Read(in).WithContext((model_dir / kCheckpointFile).string() + " [adam]"));
+  }
+  trainer->config_ = config;  // the extended step count (the schedule keeps the original horizon)
+  trainer->state_ = loaded.state;
+  return trainer;
+}
+
+void Trainer::ApplySchedules() {
+  if (DeformationField* d = model_->deformation()) {
+    const int anneal = config_.train.anneal_steps;
+    const double n = config_.model.deform_frequencies;
+    d->SetAnnealing(anneal > 0 ? std::min(n, n * double(state_.step) / anneal) : n);
+  }
+}
+
+Result<LossTerms> Trainer::Step() {
+  const TrainConfig& t = config_.train;
+  const uint64_t seed = static_cast<uint64_t>(t.seed);
+  ApplySchedules();
+  if (state_.step >= t.occupancy_warmup && state_.step % t.occupancy_every == 0)
+    model_->UpdateOccupancy(seed, state_.step, executor_);
+  data_.SampleBatch(t.batch_rays, seed, state_.step, &batch_);
+  LossWeights w;
+  w.lambda_id = t.lambda_id;
+  w.lambda_smooth = t.lambda_smooth;
+  w.lambda_mask = data_.has_alpha() ? t.lambda_mask : 0.0;
+  w.lambda_distortion = t.lambda_distortion;
+  w.smooth_epsilon = t.smooth_epsilon;
+  w.smooth_max_samples = t.smooth_max_samples;
+  const LossTerms terms = model_->TrainForwardBackward(batch_, w, seed, state_.step, executor_);
+  auto bad = [&](const char* name, double v) -> Status {
+    if (std::isfinite(v)) return Status::Ok();
+    return Status::Error("step " + std::to_string(state_.step) + ": loss term '" + name +
+                         "' is not finite; training stopped, the last checkpoint is kept");
+  };
+  ICEF_RETURN_IF_ERROR(bad("photo", terms.photo));
+  ICEF_RETURN_IF_ERROR(bad("mask", terms.mask));
+  ICEF_RETURN_IF_ERROR(bad("id", terms.id));
+  ICEF_RETURN_IF_ERROR(bad("smooth", terms.smooth));
+  ICEF_RETURN_IF_ERROR(bad("distortion", terms.distortion));
+  const float* g = model_->store().grads();
+  float sum = 0;
+  for (int64_t i = 0, n = model_->store().size(); i < n; ++i) sum += g[i] * 0.f;  // NaN/Inf propagate through * 0
+  if (!std::isfinite(sum))
+    return Status::Error("step " + std::to_string(state_.step) +
+                         ": a parameter gradient is not finite; training stopped, the last checkpoint is kept");
+  adam_->Step(executor_);
+  ++state_.step;
+  last_terms_ = terms;
+  return terms;
+}
+
+Status Trainer::SaveCheckpoint() const {
+  ICEF_RETURN_IF_ERROR(icef::SaveCheckpoint(model_dir_ / kCheckpointFile, config_, *model_, adam_.get(), state_));
+  std::string log;
+  for (const auto& line : state_.log) log += line + "\n";
+  return WriteFileAtomic(model_dir_ / "train_log.jsonl", log);
+}
+
+std::optional<double> Trainer::MeanTierPsnr(const AvatarModel& model, const Dataset& dataset, Tier tier,
+                                            const Executor& executor, int* count) {
+  double sum = 0;
+  int n = 0;
+  for (const Frame& f : dataset.test) {
+    if (f.tier != tier) continue;
+    auto img = LoadFrameImage(dataset, f);
+    if (!img.ok()) continue;
+    const Image gt = CompositeOver(*img, dataset.background);
+    const RenderedImage r = RenderImage(model, f.camera, f.expression, dataset.background, executor);
+    sum += PsnrFromMse(MeanSquaredError(r.color, gt));
+    ++n;
+  }
+  if (count) *count = n;
+  if (n == 0) return std::nullopt;
+  return sum / n;
+}
+
+Result<TrainSummary> Trainer::Run(const ProgressFn& progress, const std::atomic<bool>* stop) {
+  using Clock = std::chrono::steady_clock;
+  const TrainConfig& t = config_.train;
+  const auto start = Clock::now();
+  const double elapsed_before = state_.elapsed_seconds;
+  const int64_t start_step = state_.step;
+  int64_t samples = 0;
+  TrainSummary summary;
+  summary.method = config_.model.method;
+  summary.stop_reason = "steps";
+  auto elapsed = [&] { return elapsed_before + std::chrono::duration<double>(Clock::now() - start).count(); };
+  while (state_.step < t.steps) {
+    if (stop && stop->load()) {
+      summary.interrupted = true;
+      summary.stop_reason = "interrupted";
+      break;
+    }
+    if (t.time_budget_seconds > 0 && elapsed() >= t.time_budget_seconds) {
+      summary.stop_reason = "time budget";
+      break;
+    }
+    ICEF_ASSIGN_OR_RETURN(const LossTerms terms, Step());
+    samples += terms.samples;
+    state_.elapsed_seconds = elapsed();
+    if (state_.step % t.log_every == 0 || state_.step == t.steps) {
+      Json line;
+      line["step"] = state_.step;
+      line["seconds"] = state_.elapsed_seconds;
+      line["loss"] = terms.total;
+      line["photo"] = terms.photo;
+      line["mask"] = terms.mask;
+      line["id"] = terms.id;
+      line["smooth"] = terms.smooth;
+      line["distortion"] = terms.distortion;
+      line["batch_psnr"] = terms.psnr();
+      line["occupied"] = model_->occupancy().OccupiedFraction();
+      if (t.eval_every > 0 && state_.step % t.eval_every == 0) {
+        int count = 0;
+        const auto psnr = MeanTierPsnr(*model_, dataset_, Tier::kObserved, executor_, &count);
+        line["psnr_observed"] = psnr ? Json(*psnr) : Json(nullptr);
+      }
+      state_.log.push_back(line.dump());
+    }
+    if (progress) progress({state_.step, t.steps, state_.elapsed_seconds, terms});
+    if (t.checkpoint_every > 0 && state_.step % t.checkpoint_every == 0) ICEF_RETURN_IF_ERROR(SaveCheckpoint());
+  }
+  state_.elapsed_seconds = elapsed();
+  const double run_seconds = state_.elapsed_seconds - elapsed_before;
+  ICEF_RETURN_IF_ERROR(SaveCheckpoint());
+  summary.steps = state_.step;
+  summary.wall_seconds = state_.elapsed_seconds;
+  summary.final_loss = last_terms_.total;
+  summary.final_batch_psnr = last_terms_.psnr();
+  summary.samples_per_second = run_seconds > 0 ? samples / run_seconds : 0;
+  (void)start_step;
+  if (!summary.interrupted)
+    summary.psnr_observed = MeanTierPsnr(*model_, dataset_, Tier::kObserved, executor_, &summary.observed_frames);
+  ICEF_RETURN_IF_ERROR(WriteFileAtomic(model_dir_ / "summary.json", FormatJson(summary.ToJson())));
+  return summary;
+}
+
+}  // namespace icef

@@ -1,0 +1,94 @@
+// Trains one AvatarModel on one dataset: ray batches from the training frames, the model's
+// forward/backward, Adam over the whole slab, the learning-rate schedule, coarse-to-fine
+// annealing of the deformation encoding, occupancy-grid updates, periodic atomic checkpoints,
+// resume, a NaN/Inf guard, and MODEL/summary.json at the end. It never parses options, writes
+// images or draws progress bars: callers observe it through the progress callback.
+#pragma once
+
+#include <atomic>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <optional>
+
+#include "icef/data/dataset.h"
+#include "icef/nn/adam.h"
+#include "icef/train/model_io.h"
+#include "icef/train/train_config.h"
+#include "icef/train/training_data.h"
+
+namespace icef {
+
+struct TrainSummary {
+  std::string method;
+  int64_t steps = 0;                  // completed steps
+  double wall_seconds = 0;            // training time (all resumed runs together)
+  double final_loss = 0;              // total loss of the last step
+  double final_batch_psnr = 0;        // PSNR of the last training batch
+  std::optional<double> psnr_observed;  // mean PSNR over test frames of tier `observed`
+  int observed_frames = 0;
+  double samples_per_second = 0;      // field samples per second of training time (this run)
+  bool interrupted = false;           // stopped by a signal before the end
+  std::string stop_reason;            // "steps", "time budget" or "interrupted"
+
+  Json ToJson() const;
+  std::string BriefReport() const;
+};
+
+struct TrainProgress {
+  int64_t step = 0;
+  int64_t total_steps = 0;
+  double elapsed_seconds = 0;
+  LossTerms terms;
+};
+
+class Trainer {
+ public:
+  using ProgressFn = std::function<void(const TrainProgress&)>;
+
+  // Fresh run: creates model_dir, writes config.json. With resume, continues from
+  // model_dir/checkpoint.icef (its config wins; `steps_override`/`time_budget_override` may
+  // extend it).
+  static Result<std::unique_ptr<Trainer>> Create(const Dataset& dataset, const std::filesystem::path& model_dir,
+                                                 const RunConfig& config, const Executor& executor);
+  static Result<std::unique_ptr<Trainer>> Resume(const Dataset& dataset, const std::filesystem::path& model_dir,
+                                                 std::optional<int64_t> steps_override,
+                                                 std::optional<double> time_budget_override,
+                                                 const Executor& executor);
+
+  // Runs to the configured step count or time budget, or until *stop becomes true (then a
+  // checkpoint is written and summary.interrupted is set). A non-finite loss or gradient stops
+  // training with an error naming the step and the term; the last checkpoint stays intact.
+  Result<TrainSummary> Run(const ProgressFn& progress, const std::atomic<bool>* stop);
+
+  // One optimiser step (exposed for tests); returns its loss terms.
+  Result<LossTerms> Step();
+  Status SaveCheckpoint() const;
+
+  AvatarModel& model() { return *model_; }
+  const RunConfig& config() const { return config_; }
+  int64_t step() const { return state_.step; }
+
+  // Mean PSNR of the model over the dataset's test frames of one tier (nullopt when none).
+  static std::optional<double> MeanTierPsnr(const AvatarModel& model, const Dataset& dataset, Tier tier,
+                                            const Executor& executor, int* count);
+
+ private:
+  Trainer(const Dataset& dataset, std::filesystem::path model_dir, RunConfig config, TrainingData data,
+          std::unique_ptr<AvatarModel> model, const Executor& executor);
+  nn::AdamOptions MakeAdamOptions() const;
+  void ApplySchedules();
+
+  const Dataset& dataset_;
+  std::filesystem::path model_dir_;
+  RunConfig config_;
+  TrainingData data_;
+  std::unique_ptr<AvatarModel> model_;
+  std::unique_ptr<nn::Adam> adam_;
+  const Executor& executor_;
+  TrainerState state_;
+  TrainRays batch_;
+  LossTerms last_terms_;
+};
+
+}  // namespace icef

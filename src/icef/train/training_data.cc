@@ -1,0 +1,59 @@
+#include "icef/train/training_data.h"
+
+namespace icef {
+
+Result<TrainingData> TrainingData::Load(const Dataset& dataset) {
+  TrainingData data;
+  if (dataset.train.empty()) return Status::Error(dataset.root.string() + ": no training frames");
+  Image background_image;
+  if (dataset.background_file_path) {
+    ICEF_ASSIGN_OR_RETURN(background_image, ReadImage(dataset.root / *dataset.background_file_path));
+  }
+  bool any_alpha = false, all_alpha = true;
+  std::vector<Image> images;
+  for (const Frame& frame : dataset.train) {
+    ICEF_ASSIGN_OR_RETURN(Image img, LoadFrameImage(dataset, frame));
+    any_alpha |= img.HasAlpha();
+    all_alpha &= img.HasAlpha();
+    images.push_back(std::move(img));
+  }
+  data.has_alpha_ = any_alpha && all_alpha;
+  for (size_t k = 0; k < images.size(); ++k) {
+    const Image& img = images[k];
+    data.cameras_.push_back(dataset.train[k].camera);
+    const bool bg_img = !background_image.empty() && background_image.width == img.width &&
+                        background_image.height == img.height;
+    for (int y = 0; y < img.height; ++y) {
+      for (int x = 0; x < img.width; ++x) {
+        const Vec3f bg = bg_img ? background_image.Rgb(x, y) : dataset.background;
+        const float a = img.HasAlpha() ? img.At(x, y, 3) : 1.f;
+        const Vec3f c = a * img.Rgb(x, y) + (1.f - a) * bg;
+        data.frame_of_pixel_.push_back(static_cast<int32_t>(k));
+        data.pixel_x_.push_back(x);
+        data.pixel_y_.push_back(y);
+        data.rgb_.insert(data.rgb_.end(), {c.x(), c.y(), c.z()});
+        if (data.has_alpha_) data.alpha_.push_back(a);
+      }
+    }
+  }
+  return data;
+}
+
+void TrainingData::SampleBatch(int num_rays, uint64_t seed, int64_t step, TrainRays* batch) const {
+  batch->rays.resize(num_rays);
+  batch->frame.resize(num_rays);
+  batch->target_rgb.resize(3 * size_t(num_rays));
+  batch->target_alpha.resize(has_alpha_ ? num_rays : 0);
+  Rng rng(seed, StreamId("ray_batch"), uint64_t(step));
+  const uint64_t total = frame_of_pixel_.size();
+  for (int r = 0; r < num_rays; ++r) {
+    const uint64_t p = rng.Below(total);
+    const int k = frame_of_pixel_[p];
+    batch->frame[r] = k;
+    batch->rays[r] = cameras_[k].PixelRay(pixel_x_[p], pixel_y_[p]);
+    for (int a = 0; a < 3; ++a) batch->target_rgb[3 * r + a] = rgb_[3 * p + a];
+    if (has_alpha_) batch->target_alpha[r] = alpha_[p];
+  }
+}
+
+}  // namespace icef

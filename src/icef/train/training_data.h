@@ -1,0 +1,36 @@
+// The training frames of a dataset held in memory for ray sampling: cameras, target colours
+// composited over the dataset's background, and alpha where the images have it.
+#pragma once
+
+#include <vector>
+
+#include "icef/core/rng.h"
+#include "icef/data/dataset.h"
+#include "icef/model/avatar_model.h"
+
+namespace icef {
+
+class TrainingData {
+ public:
+  // Loads every training image; errors name the image file.
+  static Result<TrainingData> Load(const Dataset& dataset);
+
+  int num_frames() const { return static_cast<int>(cameras_.size()); }
+  bool has_alpha() const { return has_alpha_; }
+  int64_t num_pixels() const { return static_cast<int64_t>(frame_of_pixel_.size()); }
+  const Camera& camera(int k) const { return cameras_[k]; }
+
+  // Fills `batch` with `num_rays` rays drawn uniformly over all training pixels, from
+  // Rng(seed, "ray_batch", step): deterministic for (seed, step).
+  void SampleBatch(int num_rays, uint64_t seed, int64_t step, TrainRays* batch) const;
+
+ private:
+  std::vector<Camera> cameras_;
+  std::vector<int32_t> frame_of_pixel_;  // [P] global pixel -> frame
+  std::vector<int32_t> pixel_x_, pixel_y_;  // [P]
+  std::vector<float> rgb_;                  // [P, 3] over the background
+  std::vector<float> alpha_;                // [P] or empty
+  bool has_alpha_ = false;
+};
+
+}  // namespace icef
