@@ -5,7 +5,7 @@ set -euo pipefail
 
 PACKAGES=(
   build-essential cmake ninja-build pkg-config git
-  libeigen3-dev nlohmann-json3-dev libcli11-dev libstb-dev
+  libeigen3-dev nlohmann-json3-dev libcli11-dev libstb-dev libgif-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libdlib-dev libdlib-data opencv-doc python3-skimage python-matplotlib-data  # eval: face alignment, test photos
 )
