@@ -12,6 +12,7 @@ namespace icef::nn {
 namespace {
 constexpr char kMagic[8] = {'I', 'C', 'E', 'F', 'A', 'D', 'M', '\0'};
 constexpr uint32_t kVersion = 1;
+constexpr int64_t kAdamChunk = 1 << 16;
 
 // Branch-free so the compiler vectorises it (AVX-512 masked blends for the sparse case).
 template <bool kSparse>
@@ -115,9 +116,10 @@ void Adam::Step(const Executor& executor) {
     float* v = v_.data() + b.offset;
     const float b1 = static_cast<float>(g.beta1), b2 = static_cast<float>(g.beta2);
     const float eps = static_cast<float>(g.epsilon), wd = static_cast<float>(g.weight_decay);
+    // Elementwise, so dynamic chunks are deterministic; small blocks stay on the caller.
     const Executor serial(1);
-    const Executor& ex = b.size >= (1 << 16) ? executor : serial;
-    ParallelFor(ex, b.size, [&](int64_t begin, int64_t end, int) {
+    const Executor& ex = b.size >= 2 * kAdamChunk ? executor : serial;
+    ParallelForChunks(ex, b.size, kAdamChunk, [&](int64_t begin, int64_t end) {
       if (g.sparse) {
         UpdateRange<true>(p + begin, gr + begin, m + begin, v + begin, end - begin, lr, b1, b2, c1, c2, eps, wd);
       } else {

@@ -8,7 +8,7 @@
 // entry whose gradient is exactly zero this step is skipped entirely (moments not decayed,
 // parameter not moved), as torch.optim.SparseAdam / instant-ngp do; bias correction uses the
 // global step. Step() zeroes the gradients it consumed, so no separate ZeroGrads pass is needed.
-// Elementwise and split over threads by contiguous ranges: bit-identical for any thread count.
+// Elementwise and split over threads in dynamic chunks: bit-identical for any thread count.
 //
 // Serialisation: magic "ICEFADM\0", u32 version (=1), i64 step, i64 slab size, then m and v.
 #pragma once

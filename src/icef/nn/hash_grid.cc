@@ -114,7 +114,7 @@ void HashGridEncoding::BackwardParamsLevels(int64_t n, const float* positions,
 void HashGridEncoding::Forward(const Executor& executor, int64_t n, const float* positions,
                                float* features, float* d_features_d_positions) const {
   const int out = output_dims();
-  ParallelFor(executor, n, [&](int64_t begin, int64_t end, int) {
+  ParallelForChunks(executor, n, 4096, [&](int64_t begin, int64_t end) {
     ForwardTile(end - begin, positions + 3 * begin, features + begin * out,
                 d_features_d_positions ? d_features_d_positions + begin * out * 3 : nullptr);
   });
@@ -122,9 +122,11 @@ void HashGridEncoding::Forward(const Executor& executor, int64_t n, const float*
 
 void HashGridEncoding::BackwardParams(const Executor& executor, int64_t n, const float* positions,
                                       const float* d_features) {
-  const int threads = std::min(executor.num_threads(), layout_.num_levels);
-  ParallelFor(Executor(threads), threads, [&](int64_t, int64_t, int t) {
-    for (int l = t; l < layout_.num_levels; l += threads) {
+  // One level per work item, finest (hashed, most expensive) first, handed out dynamically.
+  const int levels = layout_.num_levels;
+  ParallelForChunks(executor, levels, 1, [&](int64_t begin, int64_t end) {
+    for (int64_t i = begin; i < end; ++i) {
+      const int l = levels - 1 - static_cast<int>(i);
       BackwardParamsLevels(n, positions, d_features, l, l + 1);
     }
   });
@@ -134,7 +136,7 @@ void HashGridEncoding::BackwardInput(const Executor& executor, int64_t n,
                                      const float* d_features_d_positions, const float* d_features,
                                      float* d_positions) const {
   const int out = output_dims();
-  ParallelFor(executor, n, [&](int64_t begin, int64_t end, int) {
+  ParallelForChunks(executor, n, 4096, [&](int64_t begin, int64_t end) {
     HashGridBackwardInput<float>(layout_, end - begin, d_features_d_positions + begin * out * 3,
                                  d_features + begin * out, d_positions + 3 * begin);
   });

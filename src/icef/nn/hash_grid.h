@@ -62,8 +62,8 @@ class HashGridEncoding {
                float* d_features_d_positions = nullptr) const;
 
   // ACCUMULATES d loss / d table into the store's gradient block from d_features [n, L*F].
-  // Levels are split over threads (level l -> thread l mod T) and each level sees the samples in
-  // index order, so the result is bit-identical for ANY thread count.
+  // Levels are handed to threads one at a time and each level sees the samples in index order,
+  // so the result is bit-identical for ANY thread count and scheduling.
   void BackwardParams(const Executor& executor, int64_t n, const float* positions,
                       const float* d_features);
 

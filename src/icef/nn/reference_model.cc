@@ -127,13 +127,9 @@ struct ReferenceModel::ThreadBuffers {
     dp.resize(T * 3);
     scratch.resize(std::max({FrequencyMlpScratch(ds, T), MlpBackwardScratch(m.density_.shape(), T),
                              MlpBackwardScratch(m.colour_.shape(), T)}));
-    dw_deform.resize(ds.num_params());
-    dw_density.resize(m.density_.num_params());
-    dw_colour.resize(m.colour_.num_params());
   }
   AlignedVector<float> beta, dfeat, def_in, def_hidden, g, p, feat, jac, dens_hidden, dens_out, col_in,
-      col_hidden, rgb, drgb, d_col_in, d_dens_out, dp, scratch, dw_deform, dw_density, dw_colour;
-  double loss = 0.0;
+      col_hidden, rgb, drgb, d_col_in, d_dens_out, dp, scratch;
 };
 
 ReferenceModel::ReferenceModel(uint64_t seed)
@@ -158,8 +154,8 @@ int64_t ReferenceModel::MlpMacsPerSample() const {
   return deform_.mlp().num_params() + density_.num_params() + colour_.num_params();
 }
 
-void ReferenceModel::EnsureBuffers(int threads, int64_t n) {
-  while (static_cast<int>(threads_.size()) < threads) threads_.push_back(std::make_unique<ThreadBuffers>(*this));
+void ReferenceModel::EnsureBuffers(int64_t n) {
+  if (!pool_) pool_ = std::make_unique<ScratchPool<ThreadBuffers>>();
   if (canonical_.size() < static_cast<size_t>(n * 3)) canonical_.resize(n * 3);
   if (d_features_.size() < static_cast<size_t>(n * 32)) d_features_.resize(n * 32);
 }
@@ -200,7 +196,11 @@ void ReferenceModel::ForwardTile(ThreadBuffers& b, const ReferenceBatch& batch, 
   }
 }
 
-double ReferenceModel::BackwardTile(ThreadBuffers& b, const ReferenceBatch& batch, int64_t s0, int64_t m) {
+double ReferenceModel::BackwardTile(ThreadBuffers& b, const ReferenceBatch& batch, int64_t s0, int64_t m,
+                                    float* dw) {
+  float* dw_deform = dw;
+  float* dw_density = dw_deform + deform_.mlp().num_params();
+  float* dw_colour = dw_density + density_.num_params();
   const float inv_n = 1.0f / static_cast<float>(batch.num_samples());
   const float* target = batch.targets.data() + 3 * s0;
   double loss = 0.0;
@@ -216,14 +216,14 @@ double ReferenceModel::BackwardTile(ThreadBuffers& b, const ReferenceBatch& batc
   }
   // Colour MLP -> d [dens_out, sh]; density MLP -> d features (kept for pass 2).
   MlpBackward<float>(colour_.shape(), wt_colour_.data(), m, b.col_in.data(), b.col_hidden.data(),
-                     b.rgb.data(), b.drgb.data(), b.dw_colour.data(), b.d_col_in.data(), b.scratch.data());
+                     b.rgb.data(), b.drgb.data(), dw_colour, b.d_col_in.data(), b.scratch.data());
   for (int64_t i = 0; i < m; ++i) {
     std::copy(b.d_col_in.data() + i * 32, b.d_col_in.data() + i * 32 + 16, b.d_dens_out.data() + i * 16);
     b.d_dens_out[16 * i] += kSigmaWeight * inv_n * std::exp(b.dens_out[16 * i]);
   }
   float* d_feat = b.dfeat.data();
   MlpBackward<float>(density_.shape(), wt_density_.data(), m, b.feat.data(), b.dens_hidden.data(),
-                     b.dens_out.data(), b.d_dens_out.data(), b.dw_density.data(), d_feat, b.scratch.data());
+                     b.dens_out.data(), b.d_dens_out.data(), dw_density, d_feat, b.scratch.data());
   // Through the grid to the canonical position, then into the deformation net (dp/dg = 1/2).
   HashGridBackwardInput<float>(grid_.layout(), m, b.jac.data(), d_feat, b.dp.data());
   // Level-major copy for the scatter pass: d_features_[l][s][2].
@@ -239,52 +239,61 @@ double ReferenceModel::BackwardTile(ThreadBuffers& b, const ReferenceBatch& batc
   FrequencyMlpBackward<float>(deform_.options().encoding, deform_.encoding().weights().data(),
                               deform_.mlp().shape(), wt_deform_.data(), m, batch.positions.data() + 3 * s0,
                               b.def_in.data(), b.def_hidden.data(), b.g.data(), b.dp.data(),
-                              b.dw_deform.data(), nullptr, nullptr, b.scratch.data());
+                              dw_deform, nullptr, nullptr, b.scratch.data());
   return loss;
 }
 
 double ReferenceModel::ForwardBackward(const Executor& executor, const ReferenceBatch& batch) {
   const int64_t n = batch.num_samples();
-  const int threads = executor.num_threads();
-  EnsureBuffers(threads, n);
+  EnsureBuffers(n);
   MlpTransposeWeights<float>(deform_.mlp().shape(), deform_.mlp().weights(), wt_deform_.data());
   MlpTransposeWeights<float>(density_.shape(), density_.weights(), wt_density_.data());
   MlpTransposeWeights<float>(colour_.shape(), colour_.weights(), wt_colour_.data());
+  const int64_t params = MlpMacsPerSample();  // = MLP parameter count (no biases)
+  const int64_t chunks = (n + kReferenceChunk - 1) / kReferenceChunk;
+  if (chunk_grads_.size() < static_cast<size_t>(chunks * params)) chunk_grads_.resize(chunks * params);
+  chunk_loss_.assign(chunks, 0.0);
   const auto t0 = Clock::now();
-  ParallelFor(executor, n, [&](int64_t begin, int64_t end, int t) {
-    ThreadBuffers& b = *threads_[t];
-    std::fill(b.dw_deform.begin(), b.dw_deform.end(), 0.0f);
-    std::fill(b.dw_density.begin(), b.dw_density.end(), 0.0f);
-    std::fill(b.dw_colour.begin(), b.dw_colour.end(), 0.0f);
-    b.loss = 0.0;
-    for (int64_t s = begin; s < end; s += kReferenceTile) {
-      const int64_t m = std::min(kReferenceTile, end - s);
-      ForwardTile(b, batch, s, m, /*train=*/true, nullptr);
-      b.loss += BackwardTile(b, batch, s, m);
+  ParallelForChunks(executor, n, kReferenceChunk, [&](int64_t begin, int64_t end) {
+    auto b = pool_->Borrow([this] { return std::make_unique<ThreadBuffers>(*this); });
+    // begin/end cover whole chunks (one, or all of them when running on one thread).
+    for (int64_t c0 = begin; c0 < end; c0 += kReferenceChunk) {
+      const int64_t c = c0 / kReferenceChunk;
+      const int64_t c1 = std::min(end, c0 + kReferenceChunk);
+      float* dw = chunk_grads_.data() + c * params;
+      std::fill(dw, dw + params, 0.0f);
+      double loss = 0.0;
+      for (int64_t s = c0; s < c1; s += kReferenceTile) {
+        const int64_t m = std::min(kReferenceTile, c1 - s);
+        ForwardTile(*b, batch, s, m, /*train=*/true, nullptr);
+        loss += BackwardTile(*b, batch, s, m, dw);
+      }
+      chunk_loss_[c] = loss;
     }
   });
   const auto t1 = Clock::now();
   {
+    // One level per work item, most expensive (hashed, finest) first.
     const int levels = grid_.layout().num_levels;
-    const int workers = std::min(threads, levels);
-    ParallelFor(Executor(workers), workers, [&](int64_t, int64_t, int t) {
-      for (int l = t; l < levels; l += workers) {
+    ParallelForChunks(executor, levels, 1, [&](int64_t begin, int64_t end) {
+      for (int64_t i = begin; i < end; ++i) {
+        const int l = levels - 1 - static_cast<int>(i);
         grid_.BackwardParamsLevel(l, n, canonical_.data(), d_features_.data() + int64_t{l} * n * 2, 2);
       }
     });
   }
   const auto t2 = Clock::now();
   double loss = 0.0;
-  const int used = static_cast<int>(std::min<int64_t>(threads, n));
-  for (int t = 0; t < used; ++t) {
-    const ThreadBuffers& b = *threads_[t];
-    loss += b.loss;
-    auto add = [](float* g, const AlignedVector<float>& dw) {
-      for (size_t i = 0; i < dw.size(); ++i) g[i] += dw[i];
-    };
-    add(deform_.mlp().weight_grads(), b.dw_deform);
-    add(density_.weight_grads(), b.dw_density);
-    add(colour_.weight_grads(), b.dw_colour);
+  float* g_deform = deform_.mlp().weight_grads();
+  float* g_density = density_.weight_grads();
+  float* g_colour = colour_.weight_grads();
+  const int64_t p0 = deform_.mlp().num_params(), p1 = density_.num_params();
+  for (int64_t c = 0; c < chunks; ++c) {
+    loss += chunk_loss_[c];
+    const float* dw = chunk_grads_.data() + c * params;
+    for (int64_t i = 0; i < p0; ++i) g_deform[i] += dw[i];
+    for (int64_t i = 0; i < p1; ++i) g_density[i] += dw[p0 + i];
+    for (int64_t i = 0; i < params - p0 - p1; ++i) g_colour[i] += dw[p0 + p1 + i];
   }
   const auto t3 = Clock::now();
   timings_.fused_tiles += Seconds(t0, t1);
@@ -302,11 +311,11 @@ void ReferenceModel::OptimizerStep(const Executor& executor) {
 
 void ReferenceModel::Infer(const Executor& executor, const ReferenceBatch& batch, float* rgb_sigma) {
   const int64_t n = batch.num_samples();
-  EnsureBuffers(executor.num_threads(), 0);
-  ParallelFor(executor, n, [&](int64_t begin, int64_t end, int t) {
-    ThreadBuffers& b = *threads_[t];
+  EnsureBuffers(0);
+  ParallelForChunks(executor, n, kReferenceChunk, [&](int64_t begin, int64_t end) {
+    auto b = pool_->Borrow([this] { return std::make_unique<ThreadBuffers>(*this); });
     for (int64_t s = begin; s < end; s += kReferenceTile) {
-      ForwardTile(b, batch, s, std::min(kReferenceTile, end - s), /*train=*/false, rgb_sigma);
+      ForwardTile(*b, batch, s, std::min(kReferenceTile, end - s), /*train=*/false, rgb_sigma);
     }
   });
 }

@@ -13,11 +13,12 @@
 // canonical position into the deformation net) + Adam (lr 1e-2 grid [sparse], 1e-3 MLPs, betas
 // 0.9/0.99, eps 1e-15).
 //
-// Execution: pass 1 splits samples over threads (contiguous ranges), each range into tiles of
-// kReferenceTile samples that go through every stage forward and backward while activations stay
-// in L1/L2; MLP weight gradients accumulate per thread and are reduced in thread order. Pass 2
-// scatters the hash-table gradients with levels split over threads (each level sees samples in
-// index order). Pass 3 is Adam. Everything is deterministic for a fixed thread count.
+// Execution: pass 1 splits samples into fixed chunks of kReferenceChunk samples, handed to threads
+// dynamically; a chunk runs tiles of kReferenceTile samples through every stage forward and
+// backward while activations stay in L1/L2, accumulating MLP weight gradients in its own buffer;
+// the buffers are reduced in chunk order. Pass 2 scatters the hash-table gradients one level per
+// work item (each level sees the samples in index order). Pass 3 is Adam (elementwise). The
+// result is bit-identical for any thread count and any scheduling.
 #pragma once
 
 #include <cstdint>
@@ -31,11 +32,15 @@
 #include "icef/nn/hash_grid.h"
 #include "icef/nn/mlp.h"
 #include "icef/nn/parameter_store.h"
+#include "icef/nn/scratch_pool.h"
 #include "icef/nn/sh_encoding.h"
 
 namespace icef::nn {
 
 inline constexpr int64_t kReferenceTile = 128;
+// Samples per work chunk: chunks are handed to threads dynamically (load balancing on a shared
+// machine); each chunk has its own MLP-gradient accumulator, reduced in chunk order.
+inline constexpr int64_t kReferenceChunk = 4096;
 inline constexpr int kReferenceExpressionDims = 16;
 
 // A synthetic batch: rays through the aabb [-1,1]^3 from a sphere of radius 3, samples evenly
@@ -91,10 +96,11 @@ class ReferenceModel {
 
  private:
   struct ThreadBuffers;
-  void EnsureBuffers(int threads, int64_t n);
+  void EnsureBuffers(int64_t n);
   void ForwardTile(ThreadBuffers& b, const ReferenceBatch& batch, int64_t s0, int64_t m, bool train,
                    float* rgb_sigma);
-  double BackwardTile(ThreadBuffers& b, const ReferenceBatch& batch, int64_t s0, int64_t m);
+  // Accumulates MLP weight gradients into dw (deformation, density, colour blocks back to back).
+  double BackwardTile(ThreadBuffers& b, const ReferenceBatch& batch, int64_t s0, int64_t m, float* dw);
 
   ParameterStore store_;
   HashGridEncoding grid_;
@@ -103,7 +109,9 @@ class ReferenceModel {
   Mlp colour_;
   ShEncoding sh_;
   std::unique_ptr<Adam> adam_;
-  std::vector<std::unique_ptr<ThreadBuffers>> threads_;
+  std::unique_ptr<ScratchPool<ThreadBuffers>> pool_;
+  AlignedVector<float> chunk_grads_;  // [num_chunks, MLP params]
+  std::vector<double> chunk_loss_;
   AlignedVector<float> canonical_;   // [N, 3] normalised canonical positions (pass 2 input)
   AlignedVector<float> d_features_;  // [16][N][2] d loss / d grid features, level-major (pass 2)
   AlignedVector<float> wt_deform_, wt_density_, wt_colour_;  // untransposed weights (backward)

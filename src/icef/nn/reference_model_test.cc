@@ -29,6 +29,19 @@ TEST(DeterminismTest, TwoThreadRunsAreBitIdentical) {
   EXPECT_TRUE(SameBits(oa.data(), ob.data(), static_cast<int64_t>(oa.size())));
 }
 
+// Work is split into fixed chunks with per-chunk accumulators, so even the thread count does not
+// change a single bit.
+TEST(DeterminismTest, ThreadCountDoesNotChangeResults) {
+  const ReferenceBatch batch = MakeReferenceBatch(300, 32, 8);  // 9600 samples: a partial chunk
+  ReferenceModel one(3), three(3);
+  one.TrainStep(Executor(1), batch);
+  three.TrainStep(Executor(3), batch);
+  const double l1 = one.ForwardBackward(Executor(1), batch), l3 = three.ForwardBackward(Executor(3), batch);
+  EXPECT_EQ(l1, l3);
+  EXPECT_TRUE(SameBits(one.store().grads(), three.store().grads(), one.store().size()));
+  EXPECT_TRUE(SameBits(one.store().params(), three.store().params(), one.store().size()));
+}
+
 TEST(ReferenceModelTest, GradientsReachEveryModuleAndTrainingReducesTheLoss) {
   const ReferenceBatch batch = MakeReferenceBatch(64, 32, 3);
   const Executor ex(2);
