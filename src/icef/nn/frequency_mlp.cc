@@ -1,5 +1,7 @@
 #include "icef/nn/frequency_mlp.h"
 
+#include "icef/nn/scratch_pool.h"
+
 namespace icef::nn {
 
 Status FrequencyMlpOptions::Validate() const {
@@ -38,7 +40,8 @@ int64_t PerThread(const MlpShape& s) {
 void FrequencyMlp::Forward(const Executor& executor, int64_t n, const float* x, const float* c,
                            float* y, FrequencyMlpContext* ctx, bool keep_for_backward) const {
   const MlpShape& s = mlp_.shape();
-  const int threads = executor.num_threads();
+  const int threads = std::min(executor.num_threads(), 64);
+  SlotAllocator slots(threads);
   const int64_t per_thread = PerThread(s);
   if (ctx->scratch.size() < static_cast<size_t>(per_thread * threads)) ctx->scratch.resize(per_thread * threads);
   const int w0 = s.input_dims(), hps = s.hidden_per_sample(), out = s.output_dims();
@@ -51,7 +54,9 @@ void FrequencyMlp::Forward(const Executor& executor, int64_t n, const float* x, 
   }
   const float* w = mlp_.weights();
   const float* fw = encoding_.weights().data();
-  ParallelFor(executor, n, [&](int64_t begin, int64_t end, int t) {
+  ParallelForChunks(executor, n, kMlpChunk, [&](int64_t begin, int64_t end) {
+    const SlotAllocator::Slot slot(&slots);
+    const int t = slot.index();
     float* scratch = ctx->scratch.data() + per_thread * t;
     float* tile_in = scratch + FrequencyMlpScratch(s, kMlpTile);
     float* tile_hidden = tile_in + kMlpTile * w0;
@@ -67,35 +72,40 @@ void FrequencyMlp::Forward(const Executor& executor, int64_t n, const float* x, 
 
 void FrequencyMlp::Backward(const Executor& executor, int64_t n, const float* x, const float* y,
                             const float* dy, FrequencyMlpContext* ctx, float* dx, float* dc_out) {
-  ICEF_CHECK(ctx->n == n && ctx->num_threads == executor.num_threads(),
-             "FrequencyMlp::Backward must follow Forward(keep_for_backward) on the same batch");
+  ICEF_CHECK(ctx->n == n, "FrequencyMlp::Backward must follow Forward(keep_for_backward) on the same batch");
   const MlpShape& s = mlp_.shape();
-  const int threads = executor.num_threads();
+  const int threads = std::min(executor.num_threads(), 64);
+  SlotAllocator slots(threads);
   const int64_t per_thread = PerThread(s);
+  if (ctx->scratch.size() < static_cast<size_t>(per_thread * threads)) ctx->scratch.resize(per_thread * threads);
   const int64_t np = s.num_params();
+  const int64_t chunks = (n + kMlpChunk - 1) / kMlpChunk;
   MlpContext& mc = ctx->mlp;
-  if (mc.weight_grads.size() < static_cast<size_t>(np * threads)) mc.weight_grads.resize(np * threads);
+  if (mc.weight_grads.size() < static_cast<size_t>(np * chunks)) mc.weight_grads.resize(np * chunks);
   if (mc.w_transposed.size() < static_cast<size_t>(np)) mc.w_transposed.resize(np);
   MlpTransposeWeights<float>(s, mlp_.weights(), mc.w_transposed.data());
-  std::fill(mc.weight_grads.begin(), mc.weight_grads.begin() + np * threads, 0.0f);
   const int w0 = s.input_dims(), hps = s.hidden_per_sample(), out = s.output_dims();
   const int d = options_.encoding.input_dims, dc = options_.condition_dims;
   const float* fw = encoding_.weights().data();
-  ParallelFor(executor, n, [&](int64_t begin, int64_t end, int t) {
-    float* scratch = ctx->scratch.data() + per_thread * t;
-    float* dw = mc.weight_grads.data() + np * t;
-    for (int64_t r = begin; r < end; r += kMlpTile) {
-      const int64_t m = std::min(kMlpTile, end - r);
-      FrequencyMlpBackward<float>(options_.encoding, fw, s, mc.w_transposed.data(), m, x + r * d,
-                                  ctx->input.data() + r * w0, mc.hidden.data() + r * hps,
-                                  y + r * out, dy + r * out, dw, dx ? dx + r * d : nullptr,
-                                  dc_out ? dc_out + r * dc : nullptr, scratch);
+  ParallelForChunks(executor, n, kMlpChunk, [&](int64_t begin, int64_t end) {
+    const SlotAllocator::Slot slot(&slots);
+    float* scratch = ctx->scratch.data() + per_thread * slot.index();
+    for (int64_t c0 = begin; c0 < end; c0 += kMlpChunk) {
+      float* dw = mc.weight_grads.data() + np * (c0 / kMlpChunk);
+      std::fill(dw, dw + np, 0.0f);
+      const int64_t c1 = std::min(end, c0 + kMlpChunk);
+      for (int64_t r = c0; r < c1; r += kMlpTile) {
+        const int64_t m = std::min(kMlpTile, c1 - r);
+        FrequencyMlpBackward<float>(options_.encoding, fw, s, mc.w_transposed.data(), m, x + r * d,
+                                    ctx->input.data() + r * w0, mc.hidden.data() + r * hps,
+                                    y + r * out, dy + r * out, dw, dx ? dx + r * d : nullptr,
+                                    dc_out ? dc_out + r * dc : nullptr, scratch);
+      }
     }
   });
   float* g = mlp_.weight_grads();
-  const int used = static_cast<int>(std::min<int64_t>(threads, std::max<int64_t>(n, 1)));
-  for (int t = 0; t < used; ++t) {
-    const float* dw = mc.weight_grads.data() + np * t;
+  for (int64_t c = 0; c < chunks; ++c) {
+    const float* dw = mc.weight_grads.data() + np * c;
     for (int64_t i = 0; i < np; ++i) g[i] += dw[i];
   }
 }
@@ -104,14 +114,17 @@ void FrequencyMlp::Jvp(const Executor& executor, int64_t n, const float* x, cons
                        const float* vx, const float* vc, float* y, float* jy,
                        FrequencyMlpContext* ctx) const {
   const MlpShape& s = mlp_.shape();
-  const int threads = executor.num_threads();
+  const int threads = std::min(executor.num_threads(), 64);
+  SlotAllocator slots(threads);
   const int64_t per_thread = PerThread(s);
   if (ctx->scratch.size() < static_cast<size_t>(per_thread * threads)) ctx->scratch.resize(per_thread * threads);
   const int out = s.output_dims();
   const int d = options_.encoding.input_dims, dc = options_.condition_dims;
   const float* w = mlp_.weights();
   const float* fw = encoding_.weights().data();
-  ParallelFor(executor, n, [&](int64_t begin, int64_t end, int t) {
+  ParallelForChunks(executor, n, kMlpChunk, [&](int64_t begin, int64_t end) {
+    const SlotAllocator::Slot slot(&slots);
+    const int t = slot.index();
     float* scratch = ctx->scratch.data() + per_thread * t;
     for (int64_t r = begin; r < end; r += kMlpTile) {
       const int64_t m = std::min(kMlpTile, end - r);

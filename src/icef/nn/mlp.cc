@@ -1,6 +1,8 @@
 #include "icef/nn/mlp.h"
 
 #include <algorithm>
+
+#include "icef/nn/scratch_pool.h"
 #include <cmath>
 #include <sstream>
 
@@ -81,7 +83,8 @@ void GrowTo(V* v, size_t n) {
 void Mlp::Forward(const Executor& executor, int64_t n, const float* x, float* y, MlpContext* ctx,
                   bool keep_for_backward) const {
   ICEF_CHECK(ctx != nullptr, "Mlp::Forward needs a context");
-  const int threads = executor.num_threads();
+  const int threads = std::min(executor.num_threads(), 64);
+  SlotAllocator slots(threads);
   const int64_t per_thread = ScratchPerThread(shape_);
   GrowTo(&ctx->scratch, static_cast<size_t>(per_thread * threads));
   if (keep_for_backward) {
@@ -92,7 +95,9 @@ void Mlp::Forward(const Executor& executor, int64_t n, const float* x, float* y,
   const float* w = weights();
   const int hps = shape_.hidden_per_sample();
   const int in_w = input_dims(), out_w = output_dims();
-  ParallelFor(executor, n, [&](int64_t begin, int64_t end, int t) {
+  ParallelForChunks(executor, n, kMlpChunk, [&](int64_t begin, int64_t end) {
+    const SlotAllocator::Slot slot(&slots);
+    const int t = slot.index();
     float* scratch = ctx->scratch.data() + per_thread * t;
     for (int64_t s = begin; s < end; s += kMlpTile) {
       const int64_t m = std::min(kMlpTile, end - s);
@@ -104,31 +109,38 @@ void Mlp::Forward(const Executor& executor, int64_t n, const float* x, float* y,
 
 void Mlp::Backward(const Executor& executor, int64_t n, const float* x, const float* y,
                    const float* dy, MlpContext* ctx, float* dx) {
-  ICEF_CHECK(ctx != nullptr && ctx->n == n && ctx->num_threads == executor.num_threads(),
-             "Mlp::Backward must follow Forward(keep_for_backward) on the same batch and executor");
-  const int threads = executor.num_threads();
+  ICEF_CHECK(ctx != nullptr && ctx->n == n,
+             "Mlp::Backward must follow Forward(keep_for_backward) on the same batch");
+  const int threads = std::min(executor.num_threads(), 64);
+  SlotAllocator slots(threads);
   const int64_t per_thread = ScratchPerThread(shape_);
+  GrowTo(&ctx->scratch, static_cast<size_t>(per_thread * threads));
   const int64_t np = num_params();
-  GrowTo(&ctx->weight_grads, static_cast<size_t>(np * threads));
+  const int64_t chunks = (n + kMlpChunk - 1) / kMlpChunk;
+  GrowTo(&ctx->weight_grads, static_cast<size_t>(np * chunks));
   GrowTo(&ctx->w_transposed, static_cast<size_t>(np));
   MlpTransposeWeights<float>(shape_, weights(), ctx->w_transposed.data());
-  std::fill(ctx->weight_grads.begin(), ctx->weight_grads.begin() + np * threads, 0.0f);
   const int hps = shape_.hidden_per_sample();
   const int in_w = input_dims(), out_w = output_dims();
-  ParallelFor(executor, n, [&](int64_t begin, int64_t end, int t) {
-    float* scratch = ctx->scratch.data() + per_thread * t;
-    float* dw = ctx->weight_grads.data() + np * t;
-    for (int64_t s = begin; s < end; s += kMlpTile) {
-      const int64_t m = std::min(kMlpTile, end - s);
-      MlpBackward<float>(shape_, ctx->w_transposed.data(), m, x + s * in_w,
-                         ctx->hidden.data() + s * hps, y + s * out_w, dy + s * out_w, dw,
-                         dx ? dx + s * in_w : nullptr, scratch);
+  ParallelForChunks(executor, n, kMlpChunk, [&](int64_t begin, int64_t end) {
+    const SlotAllocator::Slot slot(&slots);
+    float* scratch = ctx->scratch.data() + per_thread * slot.index();
+    // [begin, end) is one chunk, or all of them on a single thread.
+    for (int64_t c0 = begin; c0 < end; c0 += kMlpChunk) {
+      float* dw = ctx->weight_grads.data() + np * (c0 / kMlpChunk);
+      std::fill(dw, dw + np, 0.0f);
+      const int64_t c1 = std::min(end, c0 + kMlpChunk);
+      for (int64_t s = c0; s < c1; s += kMlpTile) {
+        const int64_t m = std::min(kMlpTile, c1 - s);
+        MlpBackward<float>(shape_, ctx->w_transposed.data(), m, x + s * in_w,
+                           ctx->hidden.data() + s * hps, y + s * out_w, dy + s * out_w, dw,
+                           dx ? dx + s * in_w : nullptr, scratch);
+      }
     }
   });
   float* g = weight_grads();
-  const int used = static_cast<int>(std::min<int64_t>(threads, std::max<int64_t>(n, 1)));
-  for (int t = 0; t < used; ++t) {
-    const float* dw = ctx->weight_grads.data() + np * t;
+  for (int64_t c = 0; c < chunks; ++c) {
+    const float* dw = ctx->weight_grads.data() + np * c;
     for (int64_t i = 0; i < np; ++i) g[i] += dw[i];
   }
 }
@@ -137,12 +149,15 @@ void Mlp::Jvp(const Executor& executor, int64_t n, const float* x, int slice_beg
               const float* v, float* y, float* jy, MlpContext* ctx) const {
   ICEF_CHECK(slice_begin >= 0 && slice_dims > 0 && slice_begin + slice_dims <= input_dims(),
              "Mlp::Jvp: slice outside the input");
-  const int threads = executor.num_threads();
+  const int threads = std::min(executor.num_threads(), 64);
+  SlotAllocator slots(threads);
   const int64_t per_thread = ScratchPerThread(shape_);
   GrowTo(&ctx->scratch, static_cast<size_t>(per_thread * threads));
   const float* w = weights();
   const int in_w = input_dims(), out_w = output_dims();
-  ParallelFor(executor, n, [&](int64_t begin, int64_t end, int t) {
+  ParallelForChunks(executor, n, kMlpChunk, [&](int64_t begin, int64_t end) {
+    const SlotAllocator::Slot slot(&slots);
+    const int t = slot.index();
     float* scratch = ctx->scratch.data() + per_thread * t;
     for (int64_t s = begin; s < end; s += kMlpTile) {
       const int64_t m = std::min(kMlpTile, end - s);

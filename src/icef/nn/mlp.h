@@ -7,10 +7,11 @@
 // output_init_scale (e.g. 1e-3 to start a residual deformation near the identity). Draws come
 // from Rng(seed, "mlp_init", block index, weight index): independent of threads.
 //
-// Threading: samples are split into num_threads contiguous ranges (ParallelFor), each range into
-// tiles of kMlpTile samples that stay in L1/L2 through all layers. Weight gradients accumulate per
-// thread and are added to the slab in thread order: results are bit-identical for a fixed thread
-// count. Nothing is allocated per batch once the MlpContext has grown to the batch size.
+// Threading: samples are split into fixed chunks of kMlpChunk samples handed to threads
+// dynamically (ParallelForChunks), each chunk into tiles of kMlpTile samples that stay in L1/L2
+// through all layers. Weight gradients accumulate per chunk and are added to the slab in chunk
+// order: results are bit-identical for any thread count and scheduling. Nothing is allocated per
+// batch once the MlpContext has grown to the batch size.
 #pragma once
 
 #include <cstdint>
@@ -28,6 +29,9 @@ namespace icef::nn {
 
 // Samples per tile in the threaded Mlp entry points.
 inline constexpr int64_t kMlpTile = 128;
+// Samples per dynamically scheduled work chunk (a multiple of kMlpTile); weight gradients
+// accumulate per chunk and are reduced in chunk order.
+inline constexpr int64_t kMlpChunk = 4096;
 
 struct MlpOptions {
   // Layer widths: input, hidden..., output (at least input and output).
@@ -45,10 +49,10 @@ struct MlpOptions {
 // Reuse one context across batches; it grows to the largest batch and never shrinks.
 struct MlpContext {
   int64_t n = 0;                     // samples of the last Forward with keep_for_backward
-  int num_threads = 0;               // thread count of that Forward
+  int num_threads = 0;               // thread count of that Forward (informational)
   AlignedVector<float> hidden;       // [n * hidden_per_sample], tile-major (see Mlp::Forward)
   AlignedVector<float> scratch;      // per thread: tile-sized work buffers
-  AlignedVector<float> weight_grads; // per thread: [num_params] gradient accumulators
+  AlignedVector<float> weight_grads; // per chunk: [num_params] gradient accumulators
   AlignedVector<float> w_transposed; // untransposed weights for the backward pass
 };
 
@@ -76,7 +80,7 @@ class Mlp {
   void Forward(const Executor& executor, int64_t n, const float* x, float* y, MlpContext* ctx,
                bool keep_for_backward = true) const;
 
-  // After Forward(keep_for_backward) on the same n, x, executor: dy [n, output_dims] ->
+  // After Forward(keep_for_backward) on the same n and x: dy [n, output_dims] ->
   // accumulates d loss / d weights into the store's gradient; writes dx [n, input_dims] unless
   // dx is null.
   void Backward(const Executor& executor, int64_t n, const float* x, const float* y,

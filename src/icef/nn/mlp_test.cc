@@ -171,3 +171,35 @@ TEST(MlpTest, InitialisationBoundsAndValidation) {
 
 }  // namespace
 }  // namespace icef::nn
+
+namespace icef::nn {
+namespace {
+
+// Chunked scheduling with per-chunk accumulators: 1 and 3 threads give the same bits.
+TEST(MlpTest, BackwardIsBitIdenticalForAnyThreadCount) {
+  const int64_t n = 3 * kMlpChunk + 77;
+  std::vector<std::vector<float>> results;
+  for (int threads : {1, 3}) {
+    ParameterStore store;
+    MlpOptions o;
+    o.widths = {32, 64, 64, 4};
+    Mlp mlp(o, &store, "mlp");
+    mlp.Initialize(9);
+    std::vector<float> x(n * 32), y(n * 4), dy(n * 4), dx(n * 32);
+    for (int64_t i = 0; i < n * 32; ++i) x[i] = float((i * 7919) % 201 - 100) / 100.0f;
+    for (int64_t i = 0; i < n * 4; ++i) dy[i] = float((i * 104729) % 101 - 50) / 500.0f;
+    MlpContext ctx;
+    const Executor ex(threads);
+    mlp.Forward(ex, n, x.data(), y.data(), &ctx);
+    mlp.Backward(ex, n, x.data(), y.data(), dy.data(), &ctx, dx.data());
+    std::vector<float> r(store.grads(), store.grads() + store.size());
+    r.insert(r.end(), dx.begin(), dx.end());
+    r.insert(r.end(), y.begin(), y.end());
+    results.push_back(std::move(r));
+  }
+  ASSERT_EQ(results[0].size(), results[1].size());
+  EXPECT_EQ(0, std::memcmp(results[0].data(), results[1].data(), results[0].size() * sizeof(float)));
+}
+
+}  // namespace
+}  // namespace icef::nn

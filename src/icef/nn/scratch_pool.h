@@ -56,3 +56,51 @@ class ScratchPool {
 };
 
 }  // namespace icef::nn
+
+#include <atomic>
+#include <cstdint>
+
+#include "icef/core/status.h"
+
+namespace icef::nn {
+
+// Hands out slot indices 0..num_slots-1 (num_slots <= 64) to concurrently running chunks, e.g. to
+// pick a per-worker region of a preallocated scratch buffer. Lock-free; a slot is always free as
+// long as no more than num_slots chunks run at once (ParallelForChunks runs at most
+// executor.num_threads()).
+class SlotAllocator {
+ public:
+  explicit SlotAllocator(int num_slots) : num_slots_(num_slots) {
+    ICEF_CHECK(num_slots >= 1 && num_slots <= 64, "SlotAllocator supports 1..64 slots");
+  }
+  int Acquire() {
+    for (;;) {
+      uint64_t used = used_.load(std::memory_order_relaxed);
+      for (int i = 0; i < num_slots_; ++i) {
+        const uint64_t bit = uint64_t{1} << i;
+        if (!(used & bit) && used_.compare_exchange_weak(used, used | bit, std::memory_order_acquire)) return i;
+      }
+    }
+  }
+  void Release(int slot) { used_.fetch_and(~(uint64_t{1} << slot), std::memory_order_release); }
+
+  // RAII slot.
+  class Slot {
+   public:
+    explicit Slot(SlotAllocator* a) : a_(a), index_(a->Acquire()) {}
+    ~Slot() { a_->Release(index_); }
+    Slot(const Slot&) = delete;
+    Slot& operator=(const Slot&) = delete;
+    int index() const { return index_; }
+
+   private:
+    SlotAllocator* a_;
+    int index_;
+  };
+
+ private:
+  int num_slots_;
+  std::atomic<uint64_t> used_{0};
+};
+
+}  // namespace icef::nn
