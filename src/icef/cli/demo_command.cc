@@ -1,15 +1,27 @@
 #include <iostream>
+#include <memory>
 
+#include "icef/app/demo_app.h"
 #include "icef/cli/commands.h"
 
 namespace icef::cli {
 
 CommandFn RegisterDemo(CLI::App& app) {
-  app.description("Run the built-in demo: today it lists what the tool can do.");
-  return []() -> Status {
-    std::cout << "icef demo: the synthetic-subject pipeline is not built yet; see README.\n";
-    return Status::Ok();
-  };
+  app.description(
+      "Run the whole pipeline on built-in synthetic data: synthesise a subject, train ICEF, render a turntable "
+      "and expression sweeps, and print where the files are.");
+  auto o = std::make_shared<DemoOptions>();
+  app.add_option("--out", o->out, "Output directory")->capture_default_str();
+  app.add_option("--identity-seed", o->identity_seed, "Which synthetic person")->capture_default_str();
+  app.add_option("--k", o->k, "Training frames (3, 5 or 10)")->capture_default_str()->check(CLI::Range(1, 100));
+  app.add_option("--res", o->resolution, "Image resolution")->capture_default_str()->check(CLI::Range(16, 1024));
+  app.add_option("--time-budget", o->time_budget, "Training time budget, seconds")->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--steps", o->steps, "Training step cap")->capture_default_str()->check(CLI::PositiveNumber);
+  app.add_option("--threads", o->threads, "Worker threads (0 = all cores)")->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  app.add_flag("--quick", o->quick, "Tiny settings that finish in seconds (for tests)");
+  return [o]() { return RunDemo(*o, std::cout); };
 }
 
 }  // namespace icef::cli

@@ -10,7 +10,10 @@ Result<ModelSetup> ModelSetup::FromDataset(const Dataset& dataset, const Executo
   s.aabb = dataset.aabb;
   s.expression_dim = dataset.expression_dim;
   s.expression_names = dataset.expression_names;
-  for (const Frame& f : dataset.train) s.training_expressions.push_back(f.expression);
+  for (const Frame& f : dataset.train) {
+    s.training_expressions.push_back(f.expression);
+    s.training_cameras.push_back(f.camera);
+  }
   s.background = dataset.background;
   ICEF_ASSIGN_OR_RETURN(const RegionMask mask, RegionMask::FromDataset(dataset, RegionMaskOptions{}, executor));
   s.mask_landmarks = mask.landmarks();
@@ -29,6 +32,16 @@ Json ModelSetup::ToJson() const {
   j["mask_landmarks"] = lm;
   j["mask_source"] = mask_source;
   j["background"] = {background.x(), background.y(), background.z()};
+  Json cams = Json::array();
+  for (const Camera& c : training_cameras) {
+    const Intrinsics& k = c.intrinsics();
+    Json m = Json::array();
+    for (int r = 0; r < 4; ++r) m.push_back({c.world_from_cam()(r, 0), c.world_from_cam()(r, 1), c.world_from_cam()(r, 2),
+                                             c.world_from_cam()(r, 3)});
+    cams.push_back({{"w", k.width}, {"h", k.height}, {"fl_x", k.fl_x}, {"fl_y", k.fl_y}, {"cx", k.cx}, {"cy", k.cy},
+                    {"transform_matrix", m}});
+  }
+  j["training_cameras"] = cams;
   return j;
 }
 
@@ -50,6 +63,25 @@ Result<ModelSetup> ModelSetup::FromJson(const Json& json, const std::string& ori
   ICEF_ASSIGN_OR_RETURN(s.mask_source, v.String("mask_source"));
   ICEF_ASSIGN_OR_RETURN(const auto bg, v.NumberArray("background", 3));
   s.background = Vec3f(bg[0], bg[1], bg[2]);
+  ICEF_ASSIGN_OR_RETURN(const std::vector<JsonObjectView> cams, v.ObjectArray("training_cameras"));
+  for (const JsonObjectView& c : cams) {
+    Intrinsics k;
+    ICEF_ASSIGN_OR_RETURN(k.width, c.Int("w"));
+    ICEF_ASSIGN_OR_RETURN(k.height, c.Int("h"));
+    ICEF_ASSIGN_OR_RETURN(k.fl_x, c.Number("fl_x"));
+    ICEF_ASSIGN_OR_RETURN(k.fl_y, c.Number("fl_y"));
+    ICEF_ASSIGN_OR_RETURN(k.cx, c.Number("cx"));
+    ICEF_ASSIGN_OR_RETURN(k.cy, c.Number("cy"));
+    ICEF_RETURN_IF_ERROR(k.Validate().WithContext(origin + ": training_cameras"));
+    ICEF_ASSIGN_OR_RETURN(const auto m, c.NumberMatrix("transform_matrix", 4, 4));
+    Mat4d pose;
+    for (int r = 0; r < 4; ++r)
+      for (int col = 0; col < 4; ++col) pose(r, col) = m[r][col];
+    ICEF_RETURN_IF_ERROR(ValidateRigid(pose).WithContext(origin + ": training_cameras transform_matrix"));
+    s.training_cameras.emplace_back(k, pose);
+  }
+  if (s.training_cameras.size() != s.training_expressions.size())
+    return v.Error("training_cameras", "expected one camera per training expression");
   return s;
 }
 

@@ -10,6 +10,7 @@
 #include "icef/core/parallel.h"
 #include "icef/data/dataset.h"
 #include "icef/io/json_util.h"
+#include "icef/math/camera.h"
 #include "icef/math/ray.h"
 
 namespace icef {
@@ -22,6 +23,7 @@ struct ModelSetup {
   std::vector<Vec3f> mask_landmarks;                  // [68] world frame
   std::string mask_source;                            // where the landmarks came from
   Vec3f background = Vec3f::Ones();
+  std::vector<Camera> training_cameras;               // [K] (renders default to their intrinsics and views)
 
   // From a loaded dataset's training split; the landmarks come from RegionMask::FromDataset's
   // rules (mean landmarks_3d, else triangulated landmarks_2d).

@@ -62,6 +62,13 @@ inline ModelSetup TinySetup(int expression_dim = 3) {
   }
   s.mask_landmarks = FaceLandmarks();
   s.mask_source = "test";
+  for (int k = 0; k < 3; ++k) {
+    Intrinsics in;
+    in.width = in.height = 16;
+    in.fl_x = in.fl_y = 20;
+    in.cx = in.cy = 8;
+    s.training_cameras.push_back(Camera::LookAt(in, Vec3d(0.5 * (k - 1), 0, 2), Vec3d::Zero()));
+  }
   return s;
 }
 

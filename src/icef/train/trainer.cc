@@ -36,13 +36,13 @@ std::string TrainSummary::BriefReport() const {
 }
 
 Trainer::Trainer(const Dataset& dataset, fs::path model_dir, RunConfig config, TrainingData data,
-                 std::unique_ptr<AvatarModel> model, const Executor& executor)
+                 std::unique_ptr<AvatarModel> model)
     : dataset_(dataset),
       model_dir_(std::move(model_dir)),
       config_(std::move(config)),
       data_(std::move(data)),
       model_(std::move(model)),
-      executor_(executor) {
+      executor_(config_.train.threads) {
   adam_ = std::make_unique<nn::Adam>(MakeAdamOptions(), &model_->store());
 }
 
@@ -71,8 +71,9 @@ static Status CheckDatasetMatches(const Dataset& dataset, const ModelSetup& setu
 }
 
 Result<std::unique_ptr<Trainer>> Trainer::Create(const Dataset& dataset, const fs::path& model_dir,
-                                                 const RunConfig& config, const Executor& executor) {
+                                                 const RunConfig& config) {
   ICEF_RETURN_IF_ERROR(config.Validate());
+  const Executor executor(config.train.threads);
   std::error_code ec;
   fs::create_directories(model_dir, ec);
   if (!fs::is_directory(model_dir)) return Status::Error(model_dir.string() + ": cannot create the model directory");
@@ -81,27 +82,27 @@ Result<std::unique_ptr<Trainer>> Trainer::Create(const Dataset& dataset, const f
   ICEF_ASSIGN_OR_RETURN(std::unique_ptr<AvatarModel> model, AvatarModel::Create(config.model, setup, executor));
   model->Initialize(static_cast<uint64_t>(config.train.seed));
   ICEF_RETURN_IF_ERROR(WriteFileAtomic(model_dir / "config.json", FormatJson(config.ToJson())));
-  return std::unique_ptr<Trainer>(new Trainer(dataset, model_dir, config, std::move(data), std::move(model), executor));
+  return std::unique_ptr<Trainer>(new Trainer(dataset, model_dir, config, std::move(data), std::move(model)));
 }
 
 Result<std::unique_ptr<Trainer>> Trainer::Resume(const Dataset& dataset, const fs::path& model_dir,
                                                  std::optional<int64_t> steps_override,
                                                  std::optional<double> time_budget_override,
-                                                 const Executor& executor) {
-  ICEF_ASSIGN_OR_RETURN(LoadedModel loaded, LoadModel(model_dir, executor));
+                                                 std::optional<int> threads_override) {
+  ICEF_ASSIGN_OR_RETURN(LoadedModel loaded, LoadModel(model_dir, Executor(threads_override.value_or(0))));
   ICEF_RETURN_IF_ERROR(CheckDatasetMatches(dataset, loaded.model->setup(), dataset.root.string()));
   RunConfig config = loaded.config;
   if (steps_override) config.train.steps = *steps_override;
   if (time_budget_override) config.train.time_budget_seconds = *time_budget_override;
+  if (threads_override) config.train.threads = *threads_override;
   ICEF_RETURN_IF_ERROR(config.Validate());
   ICEF_ASSIGN_OR_RETURN(TrainingData data, TrainingData::Load(dataset));
   std::unique_ptr<Trainer> trainer(
-      new Trainer(dataset, model_dir, loaded.config, std::move(data), std::move(loaded.model), executor));
+      new Trainer(dataset, model_dir, config, std::move(data), std::move(loaded.model)));
   if (!loaded.adam_state.empty()) {
     std::istringstream in(loaded.adam_state);
     ICEF_RETURN_IF_ERROR(trainer->adam_->Read(in).WithContext((model_dir / kCheckpointFile).string() + " [adam]"));
   }
-  trainer->config_ = config;  // the extended step count (the schedule keeps the original horizon)
   trainer->state_ = loaded.state;
   return trainer;
 }

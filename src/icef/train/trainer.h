@@ -46,15 +46,17 @@ class Trainer {
  public:
   using ProgressFn = std::function<void(const TrainProgress&)>;
 
-  // Fresh run: creates model_dir, writes config.json. With resume, continues from
-  // model_dir/checkpoint.icef (its config wins; `steps_override`/`time_budget_override` may
-  // extend it).
+  // Fresh run: creates model_dir, writes config.json; runs on config.train.threads threads. The
+  // dataset must outlive the trainer.
   static Result<std::unique_ptr<Trainer>> Create(const Dataset& dataset, const std::filesystem::path& model_dir,
-                                                 const RunConfig& config, const Executor& executor);
+                                                 const RunConfig& config);
+  // Continues from model_dir/checkpoint.icef: its config wins, but the overrides may extend the
+  // step count or time budget, or change the thread count (results are bit-identical to an
+  // uninterrupted run only with the same thread count).
   static Result<std::unique_ptr<Trainer>> Resume(const Dataset& dataset, const std::filesystem::path& model_dir,
                                                  std::optional<int64_t> steps_override,
                                                  std::optional<double> time_budget_override,
-                                                 const Executor& executor);
+                                                 std::optional<int> threads_override);
 
   // Runs to the configured step count or time budget, or until *stop becomes true (then a
   // checkpoint is written and summary.interrupted is set). A non-finite loss or gradient stops
@@ -75,7 +77,7 @@ class Trainer {
 
  private:
   Trainer(const Dataset& dataset, std::filesystem::path model_dir, RunConfig config, TrainingData data,
-          std::unique_ptr<AvatarModel> model, const Executor& executor);
+          std::unique_ptr<AvatarModel> model);
   nn::AdamOptions MakeAdamOptions() const;
   void ApplySchedules();
 
@@ -85,7 +87,7 @@ class Trainer {
   TrainingData data_;
   std::unique_ptr<AvatarModel> model_;
   std::unique_ptr<nn::Adam> adam_;
-  const Executor& executor_;
+  Executor executor_;  // a copy: a thread count
   TrainerState state_;
   TrainRays batch_;
   LossTerms last_terms_;

@@ -1,0 +1,61 @@
+#include <cmath>
+#include <iostream>
+#include <sstream>
+#include <memory>
+
+#include "icef/app/render_app.h"
+#include "icef/cli/commands.h"
+
+namespace icef::cli {
+
+CommandFn RegisterRender(CLI::App& app) {
+  app.description(
+      "Render a trained model: colour, depth, region mask M and deformation magnitude as PNGs per frame, "
+      "animated GIFs for sequences, and frames.json with delta, kappa and the nearest observed expression of "
+      "every frame (also printed).");
+  auto o = std::make_shared<RenderAppOptions>();
+  auto frame = std::make_shared<std::string>();
+  auto dataset = std::make_shared<std::string>();
+  auto expression_frame = std::make_shared<std::string>();
+  auto beta = std::make_shared<std::string>();
+  auto sweep = std::make_shared<std::string>();
+  auto res = std::make_shared<int>(0);
+  app.add_option("model", o->model, "Model directory (or checkpoint file)")->required();
+  app.add_option("--out", o->out, "Output directory")->required();
+  app.add_option("--dataset", *dataset, "Dataset for --frame / --expression-frame");
+  app.add_option("--frame", *frame, "Camera of a dataset frame, SPLIT:INDEX (e.g. test:2)");
+  app.add_option("--orbit", o->orbit, "Turntable of N views around the mean training view")->check(CLI::NonNegativeNumber);
+  app.add_option("--orbit-yaw", o->orbit_yaw, "Turntable yaw half-range, degrees")->capture_default_str();
+  app.add_option("--orbit-pitch", o->orbit_pitch, "Camera pitch, degrees")->capture_default_str();
+  app.add_option("--res", *res, "Image height of orbit/default cameras, pixels")->check(CLI::Range(8, 4096));
+  app.add_option("--expression-frame", *expression_frame, "Expression of a dataset frame, SPLIT:INDEX");
+  app.add_option("--beta", *beta, "Expression vector, comma-separated (expression_dim values)");
+  app.add_option("--set-expression", o->named, "NAME=VALUE on top of the expression, e.g. jaw_open=0.8 (repeatable)");
+  app.add_option("--sweep", *sweep, "NAME=VALUE: frames from the expression to VALUE x --sweep-beyond");
+  app.add_option("--sweep-frames", o->sweep_frames, "Frames of a sweep")->capture_default_str()->check(CLI::Range(2, 1000));
+  app.add_option("--sweep-beyond", o->sweep_beyond, "The sweep ends at this multiple of the target")->capture_default_str();
+  app.add_option("--threads", o->threads, "Worker threads (0 = all cores)")->check(CLI::NonNegativeNumber);
+  return [=]() -> Status {
+    RenderAppOptions opts = *o;
+    if (!frame->empty()) opts.frame = *frame;
+    if (!dataset->empty()) opts.dataset = *dataset;
+    if (!expression_frame->empty()) opts.expression_frame = *expression_frame;
+    if (!sweep->empty()) opts.sweep = *sweep;
+    if (*res > 0) opts.resolution = *res;
+    if (!beta->empty()) {
+      std::vector<float> v;
+      std::stringstream ss(*beta);
+      for (std::string item; std::getline(ss, item, ',');) {
+        char* end = nullptr;
+        const float x = std::strtof(item.c_str(), &end);
+        if (item.empty() || *end != '\0' || !std::isfinite(x))
+          return Status::Error("--beta: '" + item + "' is not a finite number");
+        v.push_back(x);
+      }
+      opts.beta = v;
+    }
+    return RunRender(opts, std::cout).status();
+  };
+}
+
+}  // namespace icef::cli

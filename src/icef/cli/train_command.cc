@@ -1,0 +1,46 @@
+#include <iostream>
+#include <memory>
+
+#include "icef/app/train_app.h"
+#include "icef/cli/commands.h"
+
+namespace icef::cli {
+
+CommandFn RegisterTrain(CLI::App& app) {
+  app.description(
+      "Train a model on a dataset. The run config is the defaults (docs/config.md), then --config FILE, then "
+      "--set overrides, then the dedicated flags. Writes MODEL/checkpoint.icef (periodically, atomically), "
+      "config.json, train_log.jsonl and summary.json. Ctrl-C stops after the current step with a checkpoint; "
+      "--resume continues it.");
+  auto o = std::make_shared<TrainAppOptions>();
+  auto method = std::make_shared<std::string>();
+  auto steps = std::make_shared<int64_t>(0);
+  auto budget = std::make_shared<double>(-1);
+  auto config = std::make_shared<std::string>();
+  auto seed = std::make_shared<int64_t>(-1);
+  auto threads = std::make_shared<int>(-1);
+  app.add_option("dataset", o->dataset, "Dataset directory (transforms_train.json ...)")->required();
+  app.add_option("--out", o->out, "Model directory to write")->required();
+  app.add_option("--method", *method, "icef | icef-no-id | icef-no-conf | warp | nerface (default icef)");
+  app.add_option("--steps", *steps, "Optimiser steps")->check(CLI::PositiveNumber);
+  app.add_option("--time-budget", *budget, "Stop after this many seconds of training")->check(CLI::NonNegativeNumber);
+  app.add_option("--config", *config, "Run config JSON ({\"parent\", \"model\": {...}, \"train\": {...}})");
+  app.add_option("--seed", *seed, "Root random seed")->check(CLI::NonNegativeNumber);
+  app.add_option("--threads", *threads, "Worker threads (0 = all cores)")->check(CLI::NonNegativeNumber);
+  app.add_option("--set", o->overrides, "Config override SECTION.KEY=VALUE, e.g. train.lambda_id=0.2 (repeatable)");
+  app.add_flag("--resume", o->resume, "Continue from MODEL/checkpoint.icef");
+  app.add_flag("--overwrite", o->overwrite, "Start afresh even if MODEL already holds a model");
+  app.add_flag("--quiet", o->quiet, "No progress bar");
+  return [=]() -> Status {
+    TrainAppOptions opts = *o;
+    if (!method->empty()) opts.method = *method;
+    if (*steps > 0) opts.steps = *steps;
+    if (*budget >= 0) opts.time_budget = *budget;
+    if (!config->empty()) opts.config_file = *config;
+    if (*seed >= 0) opts.seed = *seed;
+    if (*threads >= 0) opts.threads = *threads;
+    return RunTrain(opts, std::cout).status();
+  };
+}
+
+}  // namespace icef::cli
