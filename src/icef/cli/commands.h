@@ -17,6 +17,8 @@ CommandFn RegisterImport(CLI::App& app);
 CommandFn RegisterMask(CLI::App& app);
 CommandFn RegisterFaceId(CLI::App& app);
 CommandFn RegisterDemo(CLI::App& app);
+CommandFn RegisterTrain(CLI::App& app);
+CommandFn RegisterRender(CLI::App& app);
 CommandFn RegisterSynth(CLI::App& app);
 CommandFn RegisterSheet(CLI::App& app);
 

@@ -23,6 +23,8 @@ int main(int argc, char** argv) {
       {"synth", {"Render a synthetic ground-truth dataset of a procedural head", icef::cli::RegisterSynth}},
       {"sheet", {"Tile a dataset into a labelled contact sheet PNG", icef::cli::RegisterSheet}},
       {"import", {"Convert a NerFace / instant-ngp dataset into our format", icef::cli::RegisterImport}},
+      {"train", {"Train a model (icef or a baseline) on a dataset", icef::cli::RegisterTrain}},
+      {"render", {"Render a trained model: views, expressions, sweeps, turntables", icef::cli::RegisterRender}},
       {"mask", {"Show the expression-region mask (overlay + volume slices)", icef::cli::RegisterMask}},
       {"faceid", {"Face-identity descriptors of photos and their pairwise distances", icef::cli::RegisterFaceId}},
   };
