@@ -6,6 +6,7 @@
 #include <sys/resource.h>
 
 #include <cstdio>
+#include <ctime>
 #include <vector>
 
 #include "icef/core/parallel.h"
@@ -18,6 +19,27 @@ const ReferenceBatch& BenchBatch();
 int BenchThreads();
 
 namespace {
+
+double ProcessCpuSeconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+double WallSeconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+// cpu_utilisation = process CPU time / (wall time x threads): 1.0 on an idle machine, lower when
+// other processes take the cores (then samples_per_second understates the engine's speed and
+// samples_per_cpu_second x threads is the better estimate).
+void ReportCpu(benchmark::State& state, double samples, double cpu0, double wall0, int threads) {
+  const double cpu = ProcessCpuSeconds() - cpu0, wall = WallSeconds() - wall0;
+  state.counters["samples_per_cpu_second"] = samples / cpu;
+  state.counters["cpu_utilisation"] = cpu / (wall * threads);
+}
 
 double PeakRssMb() {
   rusage u{};
@@ -46,8 +68,10 @@ static void BM_ReferenceTrainStep(benchmark::State& state) {
   m.TrainStep(ex, batch);  // warm-up: buffers, page faults
   const ReferenceTimings before = m.timings();
   double loss = 0;
+  const double cpu0 = ProcessCpuSeconds(), wall0 = WallSeconds();
   for (auto _ : state) loss = m.TrainStep(ex, batch);
   const double samples = double(batch.num_samples()) * state.iterations();
+  ReportCpu(state, samples, cpu0, wall0, ex.num_threads());
   state.counters["samples_per_second"] = benchmark::Counter(samples, benchmark::Counter::kIsRate);
   const double mlp_flops = TrainMlpFlopsPerSample(m) * samples;
   state.counters["mlp_flops_per_second"] = benchmark::Counter(mlp_flops, benchmark::Counter::kIsRate);
@@ -67,8 +91,9 @@ static void BM_ReferenceTrainStep(benchmark::State& state) {
   state.counters["ms_reduce"] = 1e3 * (t.reduce - before.reduce) / steps;
   state.counters["ms_adam"] = 1e3 * (t.adam - before.adam) / steps;
   std::printf("BM_ReferenceTrainStep: %.3f M samples/s; MLPs at %.1f GFLOP/s = %.1f%% of the %.1f GFLOP/s "
-              "Eigen GEMM; peak RSS %.0f MB\n",
-              batch.num_samples() / step_s / 1e6, rate / 1e9, 100.0 * rate / gemm, gemm / 1e9, PeakRssMb());
+              "Eigen GEMM; peak RSS %.0f MB; CPU utilisation %.0f%%\n",
+              batch.num_samples() / step_s / 1e6, rate / 1e9, 100.0 * rate / gemm, gemm / 1e9, PeakRssMb(),
+              100.0 * state.counters["cpu_utilisation"]);
 }
 BENCHMARK(BM_ReferenceTrainStep)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
 
@@ -78,11 +103,13 @@ static void BM_ReferenceInference(benchmark::State& state) {
   const Executor ex(BenchThreads());
   std::vector<float> out(batch.num_samples() * 4);
   m.Infer(ex, batch, out.data());
+  const double cpu0 = ProcessCpuSeconds(), wall0 = WallSeconds();
   for (auto _ : state) {
     m.Infer(ex, batch, out.data());
     benchmark::DoNotOptimize(out.data());
   }
   const double samples = double(batch.num_samples()) * state.iterations();
+  ReportCpu(state, samples, cpu0, wall0, ex.num_threads());
   state.counters["samples_per_second"] = benchmark::Counter(samples, benchmark::Counter::kIsRate);
   const double macs = m.MlpMacsPerSample();
   state.counters["mlp_flops_per_second"] = benchmark::Counter(2.0 * macs * samples, benchmark::Counter::kIsRate);
