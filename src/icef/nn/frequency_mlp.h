@@ -69,7 +69,7 @@ template <typename T>
 void FrequencyMlpJvp(const FrequencyEncodingOptions& fo, const T* freq_weights, const MlpShape& s,
                      const T* w, int64_t n, const T* x, const T* c, const T* vx, const T* vc, T* y,
                      T* jy, T* scratch) {
-  const int D = fo.output_dims(), w0 = s.input_dims(), dc = w0 - D, d = fo.input_dims;
+  const int D = fo.output_dims(), w0 = s.input_dims(), dc = w0 - D;
   T* in = scratch;               // [n, w0]
   T* tin = scratch + n * w0;     // [n, w0]
   T* mlp_scratch = scratch + 2 * n * w0;
@@ -81,7 +81,6 @@ void FrequencyMlpJvp(const FrequencyEncodingOptions& fo, const T* freq_weights, 
   } else {
     FrequencyForward<T>(fo, freq_weights, n, x, enc);
   }
-  (void)d;
   for (int64_t r = 0; r < n; ++r) {
     std::copy(enc + r * D, enc + (r + 1) * D, in + r * w0);
     std::copy(c + r * dc, c + (r + 1) * dc, in + r * w0 + D);

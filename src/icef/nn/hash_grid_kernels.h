@@ -38,8 +38,8 @@ struct HashGridLayout {
 inline constexpr uint32_t kHashPrime1 = 2654435761u;
 inline constexpr uint32_t kHashPrime2 = 805459861u;
 
-// Corner c (bit 0: +x, bit 1: +y, bit 2: +z) entry indices (level-local) and cell fractions.
-// Returns false when nothing needs computing (never: positions are clamped), kept for clarity.
+// Level-local entry indices of the 8 cell corners (corner c: bit 0 = +x, bit 1 = +y, bit 2 = +z),
+// the cell fractions, and per axis whether p was inside [0,1] (else clamped: zero derivative).
 template <typename T>
 inline void HashGridCell(const HashGridLevel& lv, uint32_t table_size, const T* p, uint32_t idx[8],
                          T frac[3], bool inside[3]) {

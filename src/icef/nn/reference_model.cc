@@ -228,7 +228,7 @@ double ReferenceModel::BackwardTile(ThreadBuffers& b, const ReferenceBatch& batc
   HashGridBackwardInput<float>(grid_.layout(), m, b.jac.data(), d_feat, b.dp.data());
   // Level-major copy for the scatter pass: d_features_[l][s][2].
   const int64_t n = batch.num_samples();
-  for (int l = 0; l < 16; ++l) {
+  for (int l = 0; l < grid_.layout().num_levels; ++l) {
     float* dst = d_features_.data() + (l * n + s0) * 2;
     for (int64_t i = 0; i < m; ++i) {
       dst[2 * i] = d_feat[32 * i + 2 * l];
