@@ -61,18 +61,20 @@ static void BM_GemmFp32(benchmark::State& state) {
   const int n = 2048;
   Eigen::setNbThreads(BenchThreads());
   Eigen::MatrixXf a = Eigen::MatrixXf::Random(n, n), b = Eigen::MatrixXf::Random(n, n), c(n, n);
+  const auto t0 = std::chrono::steady_clock::now();
   for (auto _ : state) {
     c.noalias() = a * b;
     benchmark::DoNotOptimize(c.data());
     benchmark::ClobberMemory();
   }
-  state.counters["flops_per_second"] =
-      benchmark::Counter(2.0 * n * n * n * state.iterations(), benchmark::Counter::kIsRate);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  state.counters["flops_per_second"] = 2.0 * n * n * n * state.iterations() / seconds;  // wall clock
   state.SetLabel(std::string("Eigen ") + std::to_string(EIGEN_WORLD_VERSION) + "." +
                  std::to_string(EIGEN_MAJOR_VERSION) + "." + std::to_string(EIGEN_MINOR_VERSION) +
                  ", SIMD " + Eigen::SimdInstructionSetsInUse() + "; nn kernel " + GemmKernelName());
 }
-BENCHMARK(BM_GemmFp32)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+// Plain name (tracked in results.json); the counter uses the wall clock.
+BENCHMARK(BM_GemmFp32)->Unit(benchmark::kMillisecond);
 
 // ---- Hash encoding -------------------------------------------------------------------------
 
