@@ -38,6 +38,7 @@ Status StaticFieldOptions::Validate() const {
     if (w < 1) return Status::Error("color_hidden widths must be >= 1");
   if (sh_degree < 1 || sh_degree > 4) return Status::Error("sh_degree must be in [1, 4]");
   if (condition_dims < 0) return Status::Error("condition_dims must be >= 0");
+  if (!std::isfinite(density_bias)) return Status::Error("density_bias must be finite");
   return Status::Ok();
 }
 
@@ -109,7 +110,7 @@ void StaticField::Forward(const Executor& executor, int64_t n, const float* posi
   const float* h = ctx->density_output.data();
   ParallelFor(executor, n, [&](int64_t b, int64_t e, int) {
     for (int64_t i = b; i < e; ++i) {
-      sigma[i] = std::exp(std::min(h[i * geo], kMaxLogDensity));
+      sigma[i] = std::exp(std::min(h[i * geo] + options_.density_bias, kMaxLogDensity));
       std::copy(h + i * geo, h + (i + 1) * geo, cin + i * ci);
       nn::ShForward<float>(options_.sh_degree, 1, directions + 3 * i, cin + i * ci + geo);
     }
@@ -135,8 +136,8 @@ void StaticField::Backward(const Executor& executor, int64_t n, const float* sig
   ParallelFor(executor, n, [&](int64_t b, int64_t e, int) {
     for (int64_t i = b; i < e; ++i) {
       std::copy(dci + i * ci, dci + i * ci + geo, dh + i * geo);
-      // sigma = exp(min(h0, max)): d sigma / d h0 = sigma below the clamp, 0 above.
-      if (h[i * geo] < kMaxLogDensity) dh[i * geo] += d_sigma[i] * sigma[i];
+      // sigma = exp(min(h0 + bias, max)): d sigma / d h0 = sigma below the clamp, 0 above.
+      if (h[i * geo] + options_.density_bias < kMaxLogDensity) dh[i * geo] += d_sigma[i] * sigma[i];
     }
   });
   density_mlp_.Backward(executor, n, ctx->density_input.data(), ctx->density_output.data(), dh, &ctx->density_mlp,
@@ -162,7 +163,7 @@ void StaticField::Density(const Executor& executor, int64_t n, const float* posi
   DensityForward(executor, n, positions, condition, ctx, false, false);
   const int geo = options_.geo_features;
   const float* h = ctx->density_output.data();
-  for (int64_t i = 0; i < n; ++i) sigma[i] = std::exp(std::min(h[i * geo], kMaxLogDensity));
+  for (int64_t i = 0; i < n; ++i) sigma[i] = std::exp(std::min(h[i * geo] + options_.density_bias, kMaxLogDensity));
 }
 
 std::string StaticField::ToString() const {

@@ -7,7 +7,7 @@
 //
 //   features = HashGrid(aabb.Normalize(x_c))            [n, L*F]
 //   h        = DensityMlp([features, beta?])            [n, geo]   (no output activation)
-//   sigma    = exp(min(h_0, kMaxLogDensity))            [n]
+//   sigma    = exp(min(h_0 + bias, kMaxLogDensity))     [n]
 //   rgb      = ColorMlp([h, SH_4(d)])                   [n, 3]     (sigmoid)
 #pragma once
 
@@ -36,6 +36,8 @@ struct StaticFieldOptions {
   int sh_degree = 4;
   // Expression dimensions appended to the density MLP input (0 = no beta; nerface only).
   int condition_dims = 0;
+  // Added to the log-density before exp: sigma = exp(h_0 + density_bias).
+  float density_bias = 0.f;
 
   Status Validate() const;
   std::string ToString() const;

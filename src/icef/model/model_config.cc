@@ -21,6 +21,9 @@ void ModelConfig::Bind(ConfigSchema& s) {
   s.Float("mask_eye_margin", &mask_eye_margin, "region mask: eye capsule radius (fraction of inter-ocular distance)");
   s.Float("mask_mouth_margin", &mask_mouth_margin, "region mask: lip capsule radius (fraction of inter-ocular distance)");
   s.Float("mask_softness", &mask_softness, "region mask: half-width of the soft edge (fraction of inter-ocular distance)");
+  s.Bool("visual_hull", &visual_hull, "carve the occupancy grid to the visual hull of the training masks (images with alpha)");
+  s.Int("hull_margin_px", &hull_margin_px, "visual hull: footprint dilation in pixels");
+  s.Float("density_bias", &density_bias, "added to the log-density before exp (negative: space starts nearly empty)");
   s.Int("samples_per_ray", &samples_per_ray, "samples per ray over the ray/aabb interval");
   s.Int("occupancy_resolution", &occupancy_resolution, "occupancy grid cells per axis");
   s.Float("occupancy_threshold", &occupancy_threshold, "density above which an occupancy cell is occupied");
@@ -31,6 +34,7 @@ void ModelConfig::Bind(ConfigSchema& s) {
 Status ModelConfig::Validate() const {
   ICEF_RETURN_IF_ERROR(ParseMethod(method).status().WithContext("method"));
   ICEF_RETURN_IF_ERROR(StaticOptions(1).Validate());
+  if (hull_margin_px < 0) return Status::Error("hull_margin_px must be >= 0");
   ICEF_RETURN_IF_ERROR(DeformationOptions().Validate());
   ICEF_RETURN_IF_ERROR(MaskOptions().Validate().WithContext("mask"));
   ICEF_RETURN_IF_ERROR(ConfidenceOpts().Validate().WithContext("kappa_lambda"));
@@ -53,6 +57,7 @@ StaticFieldOptions ModelConfig::StaticOptions(int expression_dims) const {
   o.geo_features = geo_features;
   o.color_hidden = color_hidden;
   o.sh_degree = sh_degree;
+  o.density_bias = density_bias;
   auto m = ParseMethod(method);
   o.condition_dims = (m.ok() && TraitsOf(*m).entangled_beta) ? expression_dims : 0;
   return o;

@@ -41,6 +41,17 @@ OccupancyGrid::OccupancyGrid(const Aabb& aabb, const OccupancyGridOptions& optio
 void OccupancyGrid::Fill(bool occupied) {
   std::fill(density_.begin(), density_.end(), occupied ? std::max(2.f * options_.threshold, 1e-6f) : 0.f);
   std::fill(bits_.begin(), bits_.end(), occupied ? 1 : 0);
+  if (occupied && !allowed_.empty())
+    for (int64_t c = 0; c < num_cells(); ++c) bits_[c] = allowed_[c];
+}
+
+Status OccupancyGrid::SetAllowed(std::vector<uint8_t> allowed) {
+  if (!allowed.empty() && int64_t(allowed.size()) != num_cells())
+    return Status::Error("occupancy grid: expected " + std::to_string(num_cells()) + " allowed flags, got " +
+                         std::to_string(allowed.size()));
+  allowed_ = std::move(allowed);
+  RecomputeBits();
+  return Status::Ok();
 }
 
 int64_t OccupancyGrid::CellOf(const Vec3f& p) const {
@@ -122,6 +133,8 @@ void OccupancyGrid::RecomputeBits() {
         }
     a.swap(b);
   }
+  if (!allowed_.empty())
+    for (int64_t c = 0; c < num_cells(); ++c) a[c] &= allowed_[c];
   bits_.swap(a);
 }
 

@@ -46,7 +46,13 @@ class OccupancyGrid {
   bool IsOccupied(const Vec3f& p) const;
   bool IsCellOccupied(int x, int y, int z) const { return bits_[CellIndex(x, y, z)] != 0; }
   // Marks every cell occupied (or empty) and sets the stored densities to +threshold*2 (or 0).
+  // Cells outside the allowed set (SetAllowed) stay empty.
   void Fill(bool occupied);
+  // A hard prior (e.g. the visual hull of the training masks): cells with allowed[c] == 0 are
+  // never occupied, whatever their density. Empty vector = every cell allowed. Error on a size
+  // mismatch.
+  Status SetAllowed(std::vector<uint8_t> allowed);
+  const std::vector<uint8_t>& allowed() const { return allowed_; }
 
   int resolution() const { return options_.resolution; }
   const Aabb& aabb() const { return aabb_; }
@@ -72,6 +78,7 @@ class OccupancyGrid {
   Vec3f inv_cell_size_;
   std::vector<float> density_;   // [R^3]
   std::vector<uint8_t> bits_;    // [R^3] 1 = occupied (after dilation)
+  std::vector<uint8_t> allowed_; // [R^3] or empty: 0 = never occupied
 };
 
 }  // namespace icef

@@ -108,5 +108,26 @@ TEST(OccupancyGridTest, ValidateRejectsBadOptions) {
   EXPECT_FALSE(o.Validate().ok());
 }
 
+TEST(OccupancyGridTest, AllowedCellsAreAHardPrior) {
+  OccupancyGridOptions o;
+  o.resolution = 8;
+  o.dilation = 1;
+  OccupancyGrid grid(Aabb{}, o);
+  std::vector<uint8_t> allowed(grid.num_cells(), 0);
+  allowed[grid.CellIndex(3, 3, 3)] = 1;
+  allowed[grid.CellIndex(4, 3, 3)] = 1;
+  ASSERT_TRUE(grid.SetAllowed(allowed).ok());
+  EXPECT_EQ(grid.NumOccupied(), 2);  // fully occupied start, restricted to the allowed cells
+  grid.Update([](const float*, int64_t n, float* sigma) { std::fill(sigma, sigma + n, 100.f); }, 1, 1);
+  EXPECT_EQ(grid.NumOccupied(), 2);  // dense everywhere, dilated, but still only the allowed cells
+  EXPECT_TRUE(grid.IsCellOccupied(3, 3, 3));
+  EXPECT_FALSE(grid.IsCellOccupied(5, 3, 3));
+  grid.Fill(true);
+  EXPECT_EQ(grid.NumOccupied(), 2);
+  EXPECT_FALSE(grid.SetAllowed(std::vector<uint8_t>(5, 1)).ok());
+  ASSERT_TRUE(grid.SetAllowed({}).ok());
+  EXPECT_EQ(grid.NumOccupied(), grid.num_cells());
+}
+
 }  // namespace
 }  // namespace icef

@@ -24,6 +24,8 @@ Status SaveCheckpoint(const fs::path& path, const RunConfig& config, const Avata
   }
   const std::vector<float>& occ = model.occupancy().densities();
   w.Add("occupancy", std::string(reinterpret_cast<const char*>(occ.data()), occ.size() * sizeof(float)));
+  const std::vector<uint8_t>& allowed = model.occupancy().allowed();
+  w.Add("occupancy_allowed", std::string(allowed.begin(), allowed.end()));
   Json trainer;
   trainer["step"] = state.step;
   trainer["elapsed_seconds"] = state.elapsed_seconds;
@@ -58,6 +60,10 @@ Result<LoadedModel> LoadModel(const fs::path& given, const Executor& executor) {
   std::vector<float> densities(occ.size() / sizeof(float));
   std::memcpy(densities.data(), occ.data(), occ.size());
   ICEF_RETURN_IF_ERROR(out.model->occupancy().SetDensities(std::move(densities)).WithContext(origin + " [occupancy]"));
+  ICEF_ASSIGN_OR_RETURN(const std::string allowed, ckpt.Section("occupancy_allowed"));
+  ICEF_RETURN_IF_ERROR(out.model->occupancy()
+                           .SetAllowed(std::vector<uint8_t>(allowed.begin(), allowed.end()))
+                           .WithContext(origin + " [occupancy_allowed]"));
   if (ckpt.Has("adam")) {
     ICEF_ASSIGN_OR_RETURN(out.adam_state, ckpt.Section("adam"));
   }
@@ -67,6 +73,7 @@ Result<LoadedModel> LoadModel(const fs::path& given, const Executor& executor) {
   ICEF_ASSIGN_OR_RETURN(const double step, tv.Number("step"));
   ICEF_ASSIGN_OR_RETURN(out.state.elapsed_seconds, tv.Number("elapsed_seconds"));
   out.state.step = static_cast<int64_t>(step);
+  if (DeformationField* d = out.model->deformation()) d->SetAnnealing(DeformationAnnealing(out.config, out.state.step));
   if (ckpt.Has("log")) {
     ICEF_ASSIGN_OR_RETURN(const std::string log, ckpt.Section("log"));
     std::istringstream in(log);

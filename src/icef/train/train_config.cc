@@ -1,5 +1,6 @@
 #include "icef/train/train_config.h"
 
+#include <algorithm>
 #include <set>
 
 #include "icef/io/checkpoint.h"
@@ -128,6 +129,12 @@ Status RunConfig::ApplyOverride(const std::string& assignment) {
 }
 
 uint64_t RunConfig::Hash() const { return Fnv1a64(ToJson().dump()); }
+
+double DeformationAnnealing(const RunConfig& config, int64_t step) {
+  const double n = config.model.deform_frequencies;
+  const int anneal = config.train.anneal_steps;
+  return anneal > 0 ? std::min(n, n * double(step) / anneal) : n;
+}
 
 std::string ConfigDocumentation() {
   std::string out;

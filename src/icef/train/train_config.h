@@ -56,6 +56,10 @@ struct RunConfig {
   uint64_t Hash() const;
 };
 
+// The deformation encoding's coarse-to-fine parameter alpha after `step` steps (all frequencies
+// on once step >= train.anneal_steps). Training and every later render use the same value.
+double DeformationAnnealing(const RunConfig& config, int64_t step);
+
 // Markdown for docs/config.md: one table per section.
 std::string ConfigDocumentation();
 

@@ -6,6 +6,7 @@
 
 #include "icef/io/atomic_file.h"
 #include "icef/model/render_image.h"
+#include "icef/train/visual_hull.h"
 
 namespace icef {
 
@@ -81,6 +82,14 @@ Result<std::unique_ptr<Trainer>> Trainer::Create(const Dataset& dataset, const f
   ICEF_ASSIGN_OR_RETURN(const ModelSetup setup, ModelSetup::FromDataset(dataset, executor));
   ICEF_ASSIGN_OR_RETURN(std::unique_ptr<AvatarModel> model, AvatarModel::Create(config.model, setup, executor));
   model->Initialize(static_cast<uint64_t>(config.train.seed));
+  if (config.model.visual_hull && data.has_alpha()) {
+    std::vector<Image> alphas;
+    for (int k = 0; k < data.num_frames(); ++k) alphas.push_back(data.Alpha(k));
+    VisualHullOptions hull;
+    hull.margin_px = config.model.hull_margin_px;
+    ICEF_RETURN_IF_ERROR(model->occupancy().SetAllowed(VisualHullCells(
+        setup.aabb, config.model.occupancy_resolution, data.cameras(), alphas, hull, executor)));
+  }
   ICEF_RETURN_IF_ERROR(WriteFileAtomic(model_dir / "config.json", FormatJson(config.ToJson())));
   return std::unique_ptr<Trainer>(new Trainer(dataset, model_dir, config, std::move(data), std::move(model)));
 }
@@ -108,11 +117,7 @@ Result<std::unique_ptr<Trainer>> Trainer::Resume(const Dataset& dataset, const f
 }
 
 void Trainer::ApplySchedules() {
-  if (DeformationField* d = model_->deformation()) {
-    const int anneal = config_.train.anneal_steps;
-    const double n = config_.model.deform_frequencies;
-    d->SetAnnealing(anneal > 0 ? std::min(n, n * double(state_.step) / anneal) : n);
-  }
+  if (DeformationField* d = model_->deformation()) d->SetAnnealing(DeformationAnnealing(config_, state_.step));
 }
 
 Result<LossTerms> Trainer::Step() {

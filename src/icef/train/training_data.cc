@@ -21,6 +21,7 @@ Result<TrainingData> TrainingData::Load(const Dataset& dataset) {
   for (size_t k = 0; k < images.size(); ++k) {
     const Image& img = images[k];
     data.cameras_.push_back(dataset.train[k].camera);
+    data.frame_offset_.push_back(static_cast<int64_t>(data.frame_of_pixel_.size()));
     const bool bg_img = !background_image.empty() && background_image.width == img.width &&
                         background_image.height == img.height;
     for (int y = 0; y < img.height; ++y) {
@@ -37,6 +38,14 @@ Result<TrainingData> TrainingData::Load(const Dataset& dataset) {
     }
   }
   return data;
+}
+
+Image TrainingData::Alpha(int k) const {
+  const Camera& cam = cameras_[k];
+  Image out(cam.width(), cam.height(), 1, 1.f);
+  if (has_alpha_)
+    std::copy(alpha_.begin() + frame_offset_[k], alpha_.begin() + frame_offset_[k] + out.pixels.size(), out.pixels.begin());
+  return out;
 }
 
 void TrainingData::SampleBatch(int num_rays, uint64_t seed, int64_t step, TrainRays* batch) const {

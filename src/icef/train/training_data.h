@@ -19,6 +19,9 @@ class TrainingData {
   bool has_alpha() const { return has_alpha_; }
   int64_t num_pixels() const { return static_cast<int64_t>(frame_of_pixel_.size()); }
   const Camera& camera(int k) const { return cameras_[k]; }
+  const std::vector<Camera>& cameras() const { return cameras_; }
+  // Frame k's alpha as a 1-channel image (all ones without alpha).
+  Image Alpha(int k) const;
 
   // Fills `batch` with `num_rays` rays drawn uniformly over all training pixels, from
   // Rng(seed, "ray_batch", step): deterministic for (seed, step).
@@ -26,6 +29,7 @@ class TrainingData {
 
  private:
   std::vector<Camera> cameras_;
+  std::vector<int64_t> frame_offset_;    // [K] first global pixel of each frame
   std::vector<int32_t> frame_of_pixel_;  // [P] global pixel -> frame
   std::vector<int32_t> pixel_x_, pixel_y_;  // [P]
   std::vector<float> rgb_;                  // [P, 3] over the background

@@ -1,0 +1,189 @@
+#include "icef/train/trainer.h"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "icef/model/render_image.h"
+#include "icef/synth/synthesize.h"
+#include "icef/testing/tiny_dataset.h"
+
+namespace icef {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A small synthetic subject (the procedural head) shared by the tests of this file.
+const Dataset& TinySubject() {
+  static const Dataset* dataset = [] {
+    const fs::path dir = testing::MakeTempDir("trainer_subject");
+    synth::SynthOptions o;
+    o.out_dir = dir;
+    o.identity_seed = 3;
+    o.num_train = 3;
+    o.resolution = 32;
+    o.test_views = 1;
+    o.novel_per_tier = 1;
+    ICEF_CHECK(synth::SynthesizeDataset(o, Executor(2)).ok());
+    auto loaded = LoadDataset(dir);
+    ICEF_CHECK(loaded.ok(), loaded.status().message());
+    return new Dataset(std::move(loaded).value());
+  }();
+  return *dataset;
+}
+
+RunConfig SmallConfig(const std::string& method) {
+  RunConfig c;
+  c.model.method = method;
+  c.model.grid_levels = 8;
+  c.model.grid_log2_table_size = 14;
+  c.model.grid_finest_resolution = 128;
+  c.model.samples_per_ray = 24;
+  c.model.occupancy_resolution = 32;
+  c.train.batch_rays = 512;
+  c.train.threads = 2;
+  c.train.log_every = 10;
+  c.train.occupancy_warmup = 32;
+  c.train.occupancy_every = 8;
+  c.train.checkpoint_every = 0;
+  return c;
+}
+
+std::string ParamBytes(const AvatarModel& model) {
+  const nn::ParameterStore& s = model.store();
+  return std::string(reinterpret_cast<const char*>(s.params()), s.size() * sizeof(float));
+}
+
+TEST(TrainerTest, TrainingLowersLossAndRaisesPsnr) {
+  const Dataset& dataset = TinySubject();
+  RunConfig config = SmallConfig("icef");
+  config.train.steps = 200;
+  auto trainer = Trainer::Create(dataset, testing::MakeTempDir("trainer_learns"), config);
+  ASSERT_TRUE(trainer.ok()) << trainer.status().message();
+  // PSNR of the untrained model on the observed-tier test views.
+  int count = 0;
+  const auto psnr_before = Trainer::MeanTierPsnr((*trainer)->model(), dataset, Tier::kObserved, Executor(2), &count);
+  ASSERT_TRUE(psnr_before.has_value());
+  std::vector<double> losses;
+  auto summary = (*trainer)->Run([&](const TrainProgress& p) { losses.push_back(p.terms.total); }, nullptr);
+  ASSERT_TRUE(summary.ok()) << summary.status().message();
+  ASSERT_EQ(summary->steps, 200);
+  ASSERT_TRUE(summary->psnr_observed.has_value());
+  double first = 0, last = 0;
+  for (int i = 0; i < 20; ++i) first += losses[i], last += losses[losses.size() - 1 - i];
+  EXPECT_LT(last, 0.5 * first) << "loss did not fall: " << first / 20 << " -> " << last / 20;
+  EXPECT_GT(*summary->psnr_observed, *psnr_before + 5.0) << "held-out PSNR " << *psnr_before << " -> "
+                                                          << *summary->psnr_observed;
+  EXPECT_GT(*summary->psnr_observed, 18.0);
+}
+
+TEST(TrainerTest, ResumeContinuesBitIdentically) {
+  const Dataset& dataset = TinySubject();
+  RunConfig config = SmallConfig("icef");
+  config.train.steps = 48;
+  config.train.lambda_smooth = 1e-3;  // exercise every loss term
+  // Uninterrupted run.
+  const fs::path straight_dir = testing::MakeTempDir("trainer_straight");
+  auto straight = Trainer::Create(dataset, straight_dir, config);
+  ASSERT_TRUE(straight.ok());
+  ASSERT_TRUE((*straight)->Run(nullptr, nullptr).ok());
+  // Interrupted at step 40 (past the occupancy warm-up), then resumed from the checkpoint.
+  const fs::path split_dir = testing::MakeTempDir("trainer_split");
+  RunConfig first_half = config;
+  auto part = Trainer::Create(dataset, split_dir, first_half);
+  ASSERT_TRUE(part.ok());
+  std::atomic<bool> stop{false};
+  auto summary = (*part)->Run([&](const TrainProgress& p) { stop = p.step >= 40; }, &stop);
+  ASSERT_TRUE(summary.ok());
+  EXPECT_TRUE(summary->interrupted);
+  EXPECT_EQ(summary->steps, 40);
+  part->reset();
+  auto resumed = Trainer::Resume(dataset, split_dir, std::nullopt, std::nullopt, std::nullopt);
+  ASSERT_TRUE(resumed.ok()) << resumed.status().message();
+  EXPECT_EQ((*resumed)->step(), 40);
+  ASSERT_TRUE((*resumed)->Run(nullptr, nullptr).ok());
+  EXPECT_EQ((*resumed)->step(), 48);
+  EXPECT_TRUE(ParamBytes((*straight)->model()) == ParamBytes((*resumed)->model()))
+      << "resumed training diverged from the uninterrupted run";
+  EXPECT_EQ((*straight)->model().occupancy().densities(), (*resumed)->model().occupancy().densities());
+}
+
+TEST(TrainerTest, SameSeedSameNumbersDifferentSeedDifferent) {
+  const Dataset& dataset = TinySubject();
+  RunConfig config = SmallConfig("warp");
+  config.train.steps = 12;
+  std::string bytes[3];
+  for (int run = 0; run < 3; ++run) {
+    config.train.seed = run == 2 ? 1 : 0;
+    auto t = Trainer::Create(dataset, testing::MakeTempDir("trainer_seed" + std::to_string(run)), config);
+    ASSERT_TRUE(t.ok());
+    ASSERT_TRUE((*t)->Run(nullptr, nullptr).ok());
+    bytes[run] = ParamBytes((*t)->model());
+  }
+  EXPECT_TRUE(bytes[0] == bytes[1]);
+  EXPECT_FALSE(bytes[0] == bytes[2]);
+}
+
+TEST(TrainerTest, EveryMethodTrainsAndWritesItsModelDirectory) {
+  const Dataset& dataset = TinySubject();
+  for (Method m : AllMethods()) {
+    RunConfig config = SmallConfig(MethodName(m));
+    config.train.steps = 6;
+    config.train.anneal_steps = 100;  // still annealing when training stops
+    const fs::path dir = testing::MakeTempDir(std::string("trainer_method_") + MethodName(m));
+    auto t = Trainer::Create(dataset, dir, config);
+    ASSERT_TRUE(t.ok()) << MethodName(m);
+    auto s = (*t)->Run(nullptr, nullptr);
+    ASSERT_TRUE(s.ok()) << s.status().message();
+    for (const char* f : {"checkpoint.icef", "config.json", "summary.json", "train_log.jsonl"})
+      EXPECT_TRUE(fs::exists(dir / f)) << MethodName(m) << " " << f;
+    auto loaded = LoadModel(dir, Executor(1));
+    ASSERT_TRUE(loaded.ok()) << loaded.status().message();
+    EXPECT_EQ(loaded->model->method(), m);
+    EXPECT_TRUE(ParamBytes(*loaded->model) == ParamBytes((*t)->model()));
+    // The loaded model renders exactly what the trained one does (annealing, occupancy, hull).
+    const Frame& f = dataset.test.front();
+    const RenderedImage a = RenderImage((*t)->model(), f.camera, f.expression, dataset.background, Executor(2));
+    const RenderedImage b = RenderImage(*loaded->model, f.camera, f.expression, dataset.background, Executor(2));
+    EXPECT_EQ(a.color.pixels, b.color.pixels) << MethodName(m);
+  }
+}
+
+TEST(RunConfigTest, ParentsOverridesAndStrictKeys) {
+  const fs::path dir = testing::MakeTempDir("run_config");
+  std::ofstream(dir / "base.json") << R"({"model": {"method": "warp", "samples_per_ray": 40}, "train": {"steps": 7}})";
+  std::ofstream(dir / "child.json") << R"({"parent": "base.json", "train": {"steps": 9, "lambda_id": 0.5}})";
+  auto c = RunConfig::FromFile(dir / "child.json");
+  ASSERT_TRUE(c.ok()) << c.status().message();
+  EXPECT_EQ(c->model.method, "warp");
+  EXPECT_EQ(c->model.samples_per_ray, 40);
+  EXPECT_EQ(c->train.steps, 9);
+  EXPECT_EQ(c->train.lambda_id, 0.5);
+  ASSERT_TRUE(c->ApplyOverride("train.batch_rays=1024").ok());
+  EXPECT_EQ(c->train.batch_rays, 1024);
+  ASSERT_TRUE(c->ApplyOverride("model.method=nerface").ok());
+  EXPECT_EQ(c->model.method, "nerface");
+  auto bad = c->ApplyOverride("train.lambda_idd=1");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.message().find("lambda_idd"), std::string::npos);
+  EXPECT_NE(bad.message().find("valid keys"), std::string::npos);
+  EXPECT_FALSE(c->ApplyOverride("model.method=icef2").ok());
+  EXPECT_FALSE(c->ApplyOverride("train.lambda_id=-1").ok());
+  EXPECT_EQ(c->train.lambda_id, 0.5);  // a rejected override changes nothing
+  std::ofstream(dir / "typo.json") << R"({"trian": {}})";
+  EXPECT_FALSE(RunConfig::FromFile(dir / "typo.json").ok());
+  std::ofstream(dir / "nan.json") << R"({"train": {"lambda_id": NaN}})";
+  auto nan = RunConfig::FromFile(dir / "nan.json");
+  ASSERT_FALSE(nan.ok());
+  EXPECT_NE(nan.status().message().find("lambda_id"), std::string::npos);
+  std::ofstream(dir / "loop.json") << R"({"parent": "loop.json"})";
+  EXPECT_FALSE(RunConfig::FromFile(dir / "loop.json").ok());
+  // The resolved config round-trips through JSON.
+  auto back = RunConfig::FromJson(c->ToJson(), "mem");
+  ASSERT_TRUE(back.ok());
+  EXPECT_EQ(back->Hash(), c->Hash());
+  EXPECT_NE(ConfigDocumentation().find("| `lambda_id` | `0.1` |"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace icef

@@ -1,0 +1,62 @@
+#include "icef/train/visual_hull.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace icef {
+
+namespace {
+// Summed-area table of the foreground indicator, (w + 1) x (h + 1).
+struct ForegroundTable {
+  int w = 0, h = 0;
+  std::vector<int32_t> sum;
+  ForegroundTable(const Image& alpha, float threshold) : w(alpha.width), h(alpha.height), sum(size_t(w + 1) * (h + 1), 0) {
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x)
+        sum[size_t(y + 1) * (w + 1) + x + 1] = (alpha.At(x, y, 0) >= threshold ? 1 : 0) + sum[size_t(y) * (w + 1) + x + 1] +
+                                               sum[size_t(y + 1) * (w + 1) + x] - sum[size_t(y) * (w + 1) + x];
+  }
+  // Foreground pixels in columns [x0, x1), rows [y0, y1).
+  int32_t Count(int x0, int y0, int x1, int y1) const {
+    return sum[size_t(y1) * (w + 1) + x1] - sum[size_t(y0) * (w + 1) + x1] - sum[size_t(y1) * (w + 1) + x0] +
+           sum[size_t(y0) * (w + 1) + x0];
+  }
+};
+}  // namespace
+
+std::vector<uint8_t> VisualHullCells(const Aabb& aabb, int resolution, const std::vector<Camera>& cameras,
+                                     const std::vector<Image>& alphas, const VisualHullOptions& options,
+                                     const Executor& executor) {
+  ICEF_CHECK(cameras.size() == alphas.size(), "one alpha image per camera");
+  std::vector<ForegroundTable> tables;
+  for (const Image& a : alphas) tables.emplace_back(a, options.alpha_threshold);
+  const int r = resolution;
+  const Vec3d cell = (aabb.Extent() / float(r)).cast<double>();
+  const double radius = 0.5 * cell.norm();
+  std::vector<uint8_t> allowed(size_t(r) * r * r, 1);
+  ParallelFor(executor, int64_t(r) * r * r, [&](int64_t begin, int64_t end, int) {
+    for (int64_t c = begin; c < end; ++c) {
+      const int x = int(c % r), y = int((c / r) % r), z = int(c / (int64_t(r) * r));
+      const Vec3d centre = aabb.min.cast<double>() + cell.cwiseProduct(Vec3d(x + 0.5, y + 0.5, z + 0.5));
+      for (size_t k = 0; k < cameras.size(); ++k) {
+        const Camera& cam = cameras[k];
+        const auto proj = cam.Project(centre);
+        if (!proj || proj->depth <= radius) continue;
+        const double fl = std::max(cam.intrinsics().fl_x, cam.intrinsics().fl_y);
+        const double rad = fl * radius / (proj->depth - radius) + options.margin_px;
+        const double u0 = proj->uv.x() - rad, u1 = proj->uv.x() + rad, v0 = proj->uv.y() - rad, v1 = proj->uv.y() + rad;
+        if (u0 < 0 || v0 < 0 || u1 > cam.width() || v1 > cam.height()) continue;  // not wholly in view
+        const ForegroundTable& t = tables[k];
+        const int x0 = int(std::floor(u0)), y0 = int(std::floor(v0));
+        const int x1 = std::min(t.w, int(std::ceil(u1))), y1 = std::min(t.h, int(std::ceil(v1)));
+        if (t.Count(x0, y0, x1, y1) == 0) {
+          allowed[c] = 0;
+          break;
+        }
+      }
+    }
+  });
+  return allowed;
+}
+
+}  // namespace icef
