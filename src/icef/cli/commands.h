@@ -21,5 +21,6 @@ CommandFn RegisterTrain(CLI::App& app);
 CommandFn RegisterRender(CLI::App& app);
 CommandFn RegisterSynth(CLI::App& app);
 CommandFn RegisterSheet(CLI::App& app);
+CommandFn RegisterLandmarks(CLI::App& app);
 
 }  // namespace icef::cli

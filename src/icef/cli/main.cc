@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
       {"train", {"Train a model (icef or a baseline) on a dataset", icef::cli::RegisterTrain}},
       {"render", {"Render a trained model: views, expressions, sweeps, turntables", icef::cli::RegisterRender}},
       {"mask", {"Show the expression-region mask (overlay + volume slices)", icef::cli::RegisterMask}},
+      {"landmarks", {"Detect 68 face landmarks (dlib) and write them into a dataset", icef::cli::RegisterLandmarks}},
       {"faceid", {"Face-identity descriptors of photos and their pairwise distances", icef::cli::RegisterFaceId}},
   };
   std::map<CLI::App*, icef::cli::CommandFn> runners;

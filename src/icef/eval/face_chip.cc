@@ -1,7 +1,6 @@
 #include "icef/eval/face_chip.h"
 
 #include <dlib/image_processing.h>
-#include <dlib/image_processing/frontal_face_detector.h>
 #include <dlib/image_transforms.h>
 #include <dlib/serialize.h>
 
@@ -59,52 +58,6 @@ Result<Image> ExtractFaceChip(const Image& image, const std::vector<Vec2f>& land
   dlib::matrix<dlib::rgb_pixel> chip;
   dlib::extract_image_chip(ToDlib(image), details, chip);
   return FromDlib(chip);
-}
-
-struct FaceLandmarkDetector::Impl {
-  dlib::frontal_face_detector detector = dlib::get_frontal_face_detector();
-  dlib::shape_predictor predictor;
-};
-
-Result<FaceLandmarkDetector> FaceLandmarkDetector::Load(const std::filesystem::path& predictor_path) {
-  const std::filesystem::path path = predictor_path.empty() ? kDefaultShapePredictorPath : predictor_path;
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec))
-    return Status::Error(path.string() +
-                         ": 68-point shape predictor not found (Debian package libdlib-data; "
-                         "scripts/install-deps.sh installs it)");
-  FaceLandmarkDetector out;
-  out.impl_ = std::make_shared<Impl>();
-  try {
-    dlib::deserialize(path.string()) >> out.impl_->predictor;
-  } catch (const std::exception& e) {
-    return Status::Error(path.string() + ": cannot read shape predictor: " + e.what());
-  }
-  return out;
-}
-
-Result<std::vector<Vec2f>> FaceLandmarkDetector::Detect(const Image& image) const {
-  if (image.empty()) return Status::Error("face detector: empty image");
-  dlib::matrix<dlib::rgb_pixel> img = ToDlib(image);
-  bool upsampled = false;
-  std::vector<dlib::rectangle> faces = impl_->detector(img);
-  if (faces.empty()) {
-    dlib::pyramid_up(img);  // with dlib::pyramid_down<2>, whose point_down maps back
-    upsampled = true;
-    faces = impl_->detector(img);
-  }
-  if (faces.empty()) return Status::Error("no face found");
-  const auto largest = std::max_element(faces.begin(), faces.end(), [](const auto& a, const auto& b) {
-    return a.area() < b.area();
-  });
-  const dlib::full_object_detection shape = impl_->predictor(img, *largest);
-  std::vector<Vec2f> landmarks(shape.num_parts());
-  for (unsigned long i = 0; i < shape.num_parts(); ++i) {
-    dlib::dpoint p(shape.part(i));
-    if (upsampled) p = dlib::pyramid_down<2>().point_down(p);
-    landmarks[i] = Vec2f(float(p.x() + 0.5), float(p.y() + 0.5));
-  }
-  return landmarks;
 }
 
 }  // namespace icef::eval
