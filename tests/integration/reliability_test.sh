@@ -77,6 +77,7 @@ for case_dir in "$CORPUS"/cases/*/; do
   field() { sed -n "s/^$1: //p" "$spec"; }
   what=$(field what); run=$(field run); want_exit=$(field exit); expect=$(field expect)
   remove=$(field remove); needs=$(field needs); mutate=$(field mutate)
+  want_left=$(field leaves); want_left=${want_left:-nothing}  # a known gap is recorded, not hidden
 
   if [ -n "$needs" ] && ! has_command "$needs"; then
     printf '| %s | `icef %s` | not run: this build has no `icef %s` | | |\n' "$what" "$run" "$needs" >> "$ROWS"
@@ -125,7 +126,7 @@ for case_dir in "$CORPUS"/cases/*/; do
     [ -z "$needle" ] && continue
     grep -qF -- "$needle" "$WORK/errors" || fail "$name: message does not name '$needle': $message"
   done
-  [ "$left" = "nothing" ] || fail "$name: left on disk: $left"
+  [ "$left" = "$want_left" ] || fail "$name: left on disk: $left (expected: $want_left)"
 
   [ -z "$message" ] && message="(accepted; no error)"
   printf '| %s | `icef %s` | %s | %s | %s |\n' "$(echo "$what" | md_escape)" \
