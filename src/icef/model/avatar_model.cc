@@ -179,8 +179,10 @@ LossTerms AvatarModel::TrainForwardBackward(const TrainRays& batch, const LossWe
 
   // Compositing over the known background.
   const float bg[3] = {setup_.background.x(), setup_.background.y(), setup_.background.z()};
+  ICEF_CHECK(batch.background.empty() || int64_t(batch.background.size()) == 3 * num_rays, "background size");
   CompositeInputs<float> in{ws.sigma, ws.rgb, ws.samples.t, ws.samples.dt, ws.samples.ray_offset,
-                            ws.samples.ray_count, std::span<const float>(bg, 3)};
+                            ws.samples.ray_count,
+                            batch.background.empty() ? std::span<const float>(bg, 3) : std::span<const float>(batch.background)};
   CompositeForward(in, config_.CompositeOpts(), executor, &ws.composite);
 
   // Ray losses and their gradients.

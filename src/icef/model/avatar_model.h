@@ -49,6 +49,8 @@ struct TrainRays {
   std::vector<int32_t> frame;         // [R] training frame index (its expression is setup.training_expressions[k])
   std::vector<float> target_rgb;      // [R, 3] composited over the background
   std::vector<float> target_alpha;    // [R] foreground mask, or empty when the images have no alpha
+  std::vector<float> background;      // [R, 3] per-ray background the targets are composited over, or
+                                      // empty for setup.background
 };
 
 struct LossTerms {

@@ -21,6 +21,8 @@ void TrainConfig::Bind(ConfigSchema& s) {
   s.Number("lambda_distortion", &lambda_distortion, "weight of the mip-NeRF 360 distortion loss (auxiliary; 0 = off)");
   s.Number("smooth_epsilon", &smooth_epsilon, "finite-difference offset of L_smooth (half-extent units of the aabb)");
   s.Int("smooth_max_samples", &smooth_max_samples, "boundary samples per step used by L_smooth");
+  s.Bool("random_background", &random_background,
+         "composite targets over a random colour per ray, rendered over the same (images with alpha only)");
   s.Int("anneal_steps", &anneal_steps, "coarse-to-fine: deformation frequencies switch on over these steps (0 = off)");
   s.Int("occupancy_warmup", &occupancy_warmup, "steps before the occupancy grid starts skipping empty space");
   s.Int("occupancy_every", &occupancy_every, "steps between occupancy grid updates");

@@ -27,6 +27,7 @@ struct TrainConfig {
   double lambda_distortion = 1e-3;   // weight of the mip-NeRF 360 distortion loss (0 = off)
   double smooth_epsilon = 0.01;      // finite-difference offset of L_smooth (half-extent units)
   int smooth_max_samples = 4096;     // boundary samples per step used by L_smooth
+  bool random_background = true;     // train over random background colours (images with alpha only)
   int anneal_steps = 500;            // coarse-to-fine: deformation frequencies are switched on over these steps (0 = off)
   int occupancy_warmup = 256;        // steps before the occupancy grid starts skipping empty space
   int occupancy_every = 16;          // steps between occupancy grid updates

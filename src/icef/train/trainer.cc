@@ -45,6 +45,7 @@ Trainer::Trainer(const Dataset& dataset, fs::path model_dir, RunConfig config, T
       model_(std::move(model)),
       executor_(config_.train.threads) {
   adam_ = std::make_unique<nn::Adam>(MakeAdamOptions(), &model_->store());
+  ApplySchedules();
 }
 
 nn::AdamOptions Trainer::MakeAdamOptions() const {
@@ -113,6 +114,7 @@ Result<std::unique_ptr<Trainer>> Trainer::Resume(const Dataset& dataset, const f
     ICEF_RETURN_IF_ERROR(trainer->adam_->Read(in).WithContext((model_dir / kCheckpointFile).string() + " [adam]"));
   }
   trainer->state_ = loaded.state;
+  trainer->ApplySchedules();
   return trainer;
 }
 
@@ -126,7 +128,7 @@ Result<LossTerms> Trainer::Step() {
   ApplySchedules();
   if (state_.step >= t.occupancy_warmup && state_.step % t.occupancy_every == 0)
     model_->UpdateOccupancy(seed, state_.step, executor_);
-  data_.SampleBatch(t.batch_rays, seed, state_.step, &batch_);
+  data_.SampleBatch(t.batch_rays, seed, state_.step, t.random_background, &batch_);
   LossWeights w;
   w.lambda_id = t.lambda_id;
   w.lambda_smooth = t.lambda_smooth;
@@ -153,6 +155,7 @@ Result<LossTerms> Trainer::Step() {
                          ": a parameter gradient is not finite; training stopped, the last checkpoint is kept");
   adam_->Step(executor_);
   ++state_.step;
+  ApplySchedules();  // the model between steps is the model of `state_.step` completed steps
   last_terms_ = terms;
   return terms;
 }

@@ -28,11 +28,12 @@ Result<TrainingData> TrainingData::Load(const Dataset& dataset) {
       for (int x = 0; x < img.width; ++x) {
         const Vec3f bg = bg_img ? background_image.Rgb(x, y) : dataset.background;
         const float a = img.HasAlpha() ? img.At(x, y, 3) : 1.f;
-        const Vec3f c = a * img.Rgb(x, y) + (1.f - a) * bg;
+        const Vec3f c = a * img.Rgb(x, y);
         data.frame_of_pixel_.push_back(static_cast<int32_t>(k));
         data.pixel_x_.push_back(x);
         data.pixel_y_.push_back(y);
-        data.rgb_.insert(data.rgb_.end(), {c.x(), c.y(), c.z()});
+        data.premultiplied_.insert(data.premultiplied_.end(), {c.x(), c.y(), c.z()});
+        data.background_.insert(data.background_.end(), {bg.x(), bg.y(), bg.z()});
         if (data.has_alpha_) data.alpha_.push_back(a);
       }
     }
@@ -48,20 +49,29 @@ Image TrainingData::Alpha(int k) const {
   return out;
 }
 
-void TrainingData::SampleBatch(int num_rays, uint64_t seed, int64_t step, TrainRays* batch) const {
+void TrainingData::SampleBatch(int num_rays, uint64_t seed, int64_t step, bool random_background,
+                               TrainRays* batch) const {
   batch->rays.resize(num_rays);
   batch->frame.resize(num_rays);
   batch->target_rgb.resize(3 * size_t(num_rays));
   batch->target_alpha.resize(has_alpha_ ? num_rays : 0);
+  batch->background.resize(3 * size_t(num_rays));
+  const bool random = random_background && has_alpha_;
   Rng rng(seed, StreamId("ray_batch"), uint64_t(step));
+  Rng bg_rng(seed, StreamId("random_background"), uint64_t(step));
   const uint64_t total = frame_of_pixel_.size();
   for (int r = 0; r < num_rays; ++r) {
     const uint64_t p = rng.Below(total);
     const int k = frame_of_pixel_[p];
     batch->frame[r] = k;
     batch->rays[r] = cameras_[k].PixelRay(pixel_x_[p], pixel_y_[p]);
-    for (int a = 0; a < 3; ++a) batch->target_rgb[3 * r + a] = rgb_[3 * p + a];
-    if (has_alpha_) batch->target_alpha[r] = alpha_[p];
+    const float alpha = has_alpha_ ? alpha_[p] : 1.f;
+    for (int a = 0; a < 3; ++a) {
+      const float bg = random ? bg_rng.Uniform() : background_[3 * p + a];
+      batch->background[3 * r + a] = bg;
+      batch->target_rgb[3 * r + a] = premultiplied_[3 * p + a] + (1.f - alpha) * bg;
+    }
+    if (has_alpha_) batch->target_alpha[r] = alpha;
   }
 }
 

@@ -24,15 +24,18 @@ class TrainingData {
   Image Alpha(int k) const;
 
   // Fills `batch` with `num_rays` rays drawn uniformly over all training pixels, from
-  // Rng(seed, "ray_batch", step): deterministic for (seed, step).
-  void SampleBatch(int num_rays, uint64_t seed, int64_t step, TrainRays* batch) const;
+  // Rng(seed, "ray_batch", step): deterministic for (seed, step). With random_background (and
+  // alpha), each ray's target is its foreground composited over a random colour that the model
+  // also renders over, so the field cannot fake the background with haze (instant-ngp's trick).
+  void SampleBatch(int num_rays, uint64_t seed, int64_t step, bool random_background, TrainRays* batch) const;
 
  private:
   std::vector<Camera> cameras_;
   std::vector<int64_t> frame_offset_;    // [K] first global pixel of each frame
   std::vector<int32_t> frame_of_pixel_;  // [P] global pixel -> frame
   std::vector<int32_t> pixel_x_, pixel_y_;  // [P]
-  std::vector<float> rgb_;                  // [P, 3] over the background
+  std::vector<float> premultiplied_;        // [P, 3] foreground colour times alpha
+  std::vector<float> background_;           // [P, 3] the dataset's background behind each pixel
   std::vector<float> alpha_;                // [P] or empty
   bool has_alpha_ = false;
 };

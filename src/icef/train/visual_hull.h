@@ -1,8 +1,10 @@
 // The visual hull of the training masks as a hard prior on the occupancy grid (few-shot NeRFs
-// otherwise fill space that no training ray constrains with floaters): a cell is carved when some
-// training view sees the cell's whole projected footprint (plus a margin) inside the image and no
-// pixel of it is foreground (alpha >= threshold). Views that see the cell only partly, or not at
-// all, do not carve it, so the hull is conservative.
+// otherwise fill space that no training ray constrains with floaters). A cell is carved when
+//  - some training view sees the cell's centre inside its image and no pixel of the cell's
+//    projected footprint (plus a margin, clipped to the image) is foreground (alpha >= threshold),
+//    or
+//  - no training view sees any of it (nothing there is ever supervised: novel views then render
+//    background there rather than whatever the initial field holds).
 #pragma once
 
 #include <vector>
