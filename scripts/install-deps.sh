@@ -8,6 +8,7 @@ PACKAGES=(
   libeigen3-dev nlohmann-json3-dev libcli11-dev libstb-dev libgif-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libdlib-dev libdlib-data opencv-doc python3-skimage python-matplotlib-data  # eval: face alignment, test photos
+  gnuplot-nox  # bench: report plots (PNG + SVG)
 )
 
 missing=()

@@ -16,6 +16,8 @@ CommandFn RegisterInfo(CLI::App& app);
 CommandFn RegisterImport(CLI::App& app);
 CommandFn RegisterMask(CLI::App& app);
 CommandFn RegisterFaceId(CLI::App& app);
+CommandFn RegisterEval(CLI::App& app);
+CommandFn RegisterBench(CLI::App& app);
 CommandFn RegisterDemo(CLI::App& app);
 CommandFn RegisterTrain(CLI::App& app);
 CommandFn RegisterRender(CLI::App& app);

@@ -28,6 +28,8 @@ int main(int argc, char** argv) {
       {"mask", {"Show the expression-region mask (overlay + volume slices)", icef::cli::RegisterMask}},
       {"landmarks", {"Detect 68 face landmarks (dlib) and write them into a dataset", icef::cli::RegisterLandmarks}},
       {"faceid", {"Face-identity descriptors of photos and their pairwise distances", icef::cli::RegisterFaceId}},
+      {"eval", {"Evaluate a trained model: PSNR, SSIM, LPIPS, identity consistency per tier", icef::cli::RegisterEval}},
+      {"bench", {"Run the benchmark (synthesise, train, evaluate every method) and write the report", icef::cli::RegisterBench}},
   };
   std::map<CLI::App*, icef::cli::CommandFn> runners;
   for (const auto& [name, entry] : commands) {

@@ -1,0 +1,95 @@
+// icef bench --out DIR [--identities N] [--k 3,5,10] [--methods a,b] [--res R] [--steps S |
+//   --time-budget T] [--quick] [--shard i/n] [--threads N] [--set section.key=value ...]
+// icef bench merge DIR... --out DIR   (or icef bench --merge DIR... --out DIR)
+// The whole evaluation protocol (eval/bench_protocol.h): synthesise, train, evaluate every
+// identity x K x method, then report.md + report.json + plots.
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "icef/cli/commands.h"
+#include "icef/core/progress.h"
+#include "icef/eval/bench_protocol.h"
+
+namespace icef::cli {
+
+CommandFn RegisterBench(CLI::App& app) {
+  struct Args {
+    eval::BenchOptions options;
+    std::string out;
+    std::string ks;
+    std::vector<std::string> methods;
+    std::string shard;
+    bool quick = false;
+    std::vector<std::string> merge;
+    std::vector<std::string> merge_inputs;
+    std::string merge_out;
+  };
+  auto args = std::make_shared<Args>();
+  eval::BenchOptions& o = args->options;
+  app.description(
+      "Run the benchmark: for each identity seed x K x method, synthesise a dataset (cached in DIR/data/), train "
+      "with the same budget, evaluate, and write DIR/runs/<id>_k<K>_<method>/metrics.json; then DIR/report.md, "
+      "report.json and plots/. Re-running skips finished runs. `icef bench merge A B --out C` builds one "
+      "report from shard directories.");
+  app.add_option("--out,-o", args->out, "Output directory (created)");
+  app.add_option("--identities", o.identities, "Number of identities (seeds 1..N)")->capture_default_str();
+  app.add_option("--first-seed", o.first_identity_seed, "Seed of the first identity")->capture_default_str();
+  app.add_option("--k", args->ks, "Training-frame counts K, comma-separated (default 3,5,10)");
+  app.add_option("--methods", args->methods, "Methods (default: all five)")->delimiter(',');
+  app.add_option("--res", o.resolution, "Image width = height")->capture_default_str();
+  app.add_option("--test-views", o.test_views, "Held-out test views per dataset")->capture_default_str();
+  app.add_option("--novel-per-tier", o.novel_per_tier, "Novel test expressions per tier")->capture_default_str();
+  app.add_option("--steps", o.steps, "Training steps per run (same for every run)")->capture_default_str();
+  app.add_option("--time-budget", o.time_budget_seconds, "Training wall-clock budget per run, seconds (0 = none)")
+      ->capture_default_str();
+  app.add_option("--config", o.config_path, "Base run config file (default: built-in defaults)");
+  app.add_option("--set", o.overrides, "Config override for every run, e.g. train.batch_rays=2048 (repeatable)");
+  app.add_flag("--quick", args->quick, "Tiny settings for CI: 1 identity, K=3, 32x32, 20 steps of a tiny model");
+  app.add_option("--shard", args->shard, "Run only shard i of n (i/n, 0-based): runs i, i+n, ... of the stable order");
+  app.add_option("--threads", o.threads, "Worker threads (0 = all cores)")->capture_default_str();
+  app.add_option("--faceid-model", o.faceid_model_dir, "Face-identity model directory");
+  app.add_option("--lpips-weights", o.lpips_weights, "LPIPS weights file (without it LPIPS is null)");
+  app.add_flag("--keep-models", o.keep_models, "Keep each run's trained model under runs/<name>/model/");
+  app.add_option("--merge", args->merge, "Merge these bench directories into --out instead of running");
+  CLI::App* merge = app.add_subcommand("merge", "Build one report from several bench (shard) directories");
+  merge->add_option("dirs", args->merge_inputs, "Bench directories")->required();
+  merge->add_option("--out,-o", args->merge_out, "Output directory")->required();
+  CLI::App* self = &app;
+  return [args, merge, self]() -> Status {
+    const bool interactive = StdoutIsTerminal();
+    if (merge->parsed() || !args->merge.empty()) {
+      std::vector<std::filesystem::path> inputs;
+      for (const auto& d : merge->parsed() ? args->merge_inputs : args->merge) inputs.emplace_back(d);
+      const std::string out = merge->parsed() ? args->merge_out : args->out;
+      if (out.empty()) return Status::Error("bench merge: --out is required");
+      return eval::MergeBench(inputs, out, std::cout);
+    }
+    eval::BenchOptions options = args->options;
+    if (args->quick) {
+      const std::vector<std::string> user = options.overrides;
+      options.overrides.clear();
+      options.ApplyQuick();
+      // Options given explicitly win over the quick settings.
+      const eval::BenchOptions& given = args->options;
+      if (self->count("--identities")) options.identities = given.identities;
+      if (self->count("--res")) options.resolution = given.resolution;
+      if (self->count("--test-views")) options.test_views = given.test_views;
+      if (self->count("--novel-per-tier")) options.novel_per_tier = given.novel_per_tier;
+      if (self->count("--steps")) options.steps = given.steps;
+      if (self->count("--time-budget")) options.time_budget_seconds = given.time_budget_seconds;
+      options.overrides.insert(options.overrides.end(), user.begin(), user.end());
+    }
+    options.out_dir = args->out;
+    if (!args->ks.empty()) {
+      ICEF_ASSIGN_OR_RETURN(options.ks, eval::ParseIntList(args->ks, "--k"));
+    }
+    if (!args->methods.empty()) options.methods = args->methods;
+    if (!args->shard.empty()) ICEF_RETURN_IF_ERROR(eval::ParseShard(args->shard, &options.shard_index, &options.shard_count));
+    return eval::RunBench(options, std::cout, interactive);
+  };
+}
+
+}  // namespace icef::cli

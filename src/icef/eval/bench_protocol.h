@@ -1,0 +1,90 @@
+// The whole benchmark of DESIGN.md §6 (`icef bench`): for each identity seed x K x method,
+// synthesise the dataset (once per identity x K, cached in OUT/data/), train with the same budget,
+// evaluate (eval/evaluate.h) and write OUT/runs/<id>_k<K>_<method>/metrics.json; then aggregate
+// into OUT/report.md + report.json + plots (eval/report.h). Resumable: a run whose metrics.json
+// exists is skipped. Runs are ordered stably (identity, K, method); --shard i/n takes runs i,
+// i + n, i + 2n, ... so several machines can share a bench, and MergeBench builds one report from
+// their output directories.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "icef/core/status.h"
+#include "icef/eval/report.h"
+#include "icef/io/json_util.h"
+
+namespace icef::eval {
+
+// Default training steps of every bench run (the same for every method).
+constexpr int64_t kDefaultBenchSteps = 1000;
+
+struct BenchOptions {
+  // Output directory (created): data/, runs/, plots/, report.md, report.json, bench.json.
+  std::filesystem::path out_dir;
+  // Number of identities N; their seeds are first_identity_seed .. first_identity_seed + N - 1.
+  int identities = 3;
+  // Seed of the first identity.
+  uint64_t first_identity_seed = 1;
+  // Training-frame counts K.
+  std::vector<int> ks = {3, 5, 10};
+  // Methods (names of model/method.h).
+  std::vector<std::string> methods = {"icef", "icef-no-id", "icef-no-conf", "warp", "nerface"};
+  // Image width = height in pixels.
+  int resolution = 128;
+  // Held-out test views per dataset.
+  int test_views = 3;
+  // Novel test expressions per tier (near, moderate, far).
+  int novel_per_tier = 2;
+  // Training steps per run (the same budget for every run).
+  int64_t steps = kDefaultBenchSteps;
+  // Wall-clock budget per run in seconds (0 = none; with it, steps is only an upper bound).
+  double time_budget_seconds = 0;
+  // Base run config file ("" = built-in defaults); method, steps, budget, seed and threads are set per run.
+  std::string config_path;
+  // "section.key=value" overrides applied to every run's config (RunConfig::ApplyOverride).
+  std::vector<std::string> overrides;
+  // Shard i of n (0 <= i < n): runs i, i + n, ... of the stable run order.
+  int shard_index = 0;
+  int shard_count = 1;
+  // Worker threads (0 = all cores).
+  int threads = 0;
+  // Face-identity model directory ("" = default lookup) and LPIPS weights file ("" = unavailable).
+  std::string faceid_model_dir;
+  std::string lpips_weights;
+  // Keep each run's trained model (runs/<name>/model/); by default it is deleted after evaluation.
+  bool keep_models = false;
+
+  // The --quick settings: 1 identity, K = 3, all methods, 32x32, 1 test view, 1 novel expression
+  // per tier, 20 steps on a tiny model (seconds in all, for CI).
+  void ApplyQuick();
+  Status Validate() const;
+  std::string ToString() const;
+  Json ToJson() const;  // what report.md / bench.json show (no paths)
+};
+
+// Parses "i/n" (0 <= i < n).
+Status ParseShard(const std::string& text, int* index, int* count);
+// Parses "3,5,10".
+Result<std::vector<int>> ParseIntList(const std::string& text, const std::string& what);
+
+// Every run in the stable order: identity-major, then K, then method as given.
+std::vector<RunId> PlanRuns(const BenchOptions& options);
+// Runs index, index + count, index + 2 count, ... of `runs`.
+std::vector<RunId> ShardRuns(const std::vector<RunId>& runs, int index, int count);
+
+// Runs the bench (progress and a summary go to `log`; bars redraw in place when interactive) and
+// writes the report of every run finished in out_dir so far.
+Status RunBench(const BenchOptions& options, std::ostream& log, bool interactive);
+
+// Builds one report in out_dir from the runs/ of several bench (shard) directories: each run's
+// metrics.json is copied to out_dir/runs/<name>/; of a run present in several inputs the first is
+// kept (with a warning on `log` when their metrics differ). Inputs with different bench settings
+// (bench.json, shard aside) are an error.
+Status MergeBench(const std::vector<std::filesystem::path>& inputs, const std::filesystem::path& out_dir,
+                  std::ostream& log);
+
+}  // namespace icef::eval

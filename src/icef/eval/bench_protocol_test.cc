@@ -1,0 +1,157 @@
+#include "icef/eval/bench_protocol.h"
+
+#include <gtest/gtest.h>
+
+#include <set>
+#include <sstream>
+
+#include "icef/io/atomic_file.h"
+
+namespace icef::eval {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path TempDir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("icef_bench_test_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+TEST(BenchProtocolTest, PlansRunsInStableOrder) {
+  BenchOptions o;
+  o.out_dir = "x";
+  const std::vector<RunId> runs = PlanRuns(o);
+  ASSERT_EQ(runs.size(), 3u * 3u * 5u);
+  EXPECT_EQ(runs[0].Name(), "id1_k3_icef");
+  EXPECT_EQ(runs[1].Name(), "id1_k3_icef-no-id");
+  EXPECT_EQ(runs[4].Name(), "id1_k3_nerface");
+  EXPECT_EQ(runs[5].Name(), "id1_k5_icef");
+  EXPECT_EQ(runs[15].Name(), "id2_k3_icef");
+  EXPECT_EQ(runs.back().Name(), "id3_k10_nerface");
+  std::set<std::string> names;
+  for (const RunId& r : runs) names.insert(r.Name());
+  EXPECT_EQ(names.size(), runs.size());
+}
+
+TEST(BenchProtocolTest, ShardsPartitionTheRuns) {
+  BenchOptions o;
+  const std::vector<RunId> runs = PlanRuns(o);
+  for (int n : {1, 2, 4, 7, 45, 50}) {
+    std::multiset<std::string> seen;
+    for (int i = 0; i < n; ++i) {
+      const std::vector<RunId> shard = ShardRuns(runs, i, n);
+      // Every n-th run starting at i.
+      for (size_t j = 0; j < shard.size(); ++j) EXPECT_EQ(shard[j], runs[i + j * n]);
+      EXPECT_LE(shard.size(), (runs.size() + n - 1) / n);
+      for (const RunId& r : shard) seen.insert(r.Name());
+    }
+    EXPECT_EQ(seen.size(), runs.size()) << n;
+    for (const RunId& r : runs) EXPECT_EQ(seen.count(r.Name()), 1u) << n;
+  }
+  const std::vector<RunId> s1 = ShardRuns(runs, 1, 4);
+  ASSERT_GE(s1.size(), 2u);
+  EXPECT_EQ(s1[0].Name(), "id1_k3_icef-no-id");
+  EXPECT_EQ(s1[1].Name(), "id1_k5_icef");
+}
+
+TEST(BenchProtocolTest, ParsesShardAndLists) {
+  int i = -1, n = -1;
+  ASSERT_TRUE(ParseShard("2/5", &i, &n).ok());
+  EXPECT_EQ(i, 2);
+  EXPECT_EQ(n, 5);
+  for (const char* bad : {"5/5", "-1/3", "1/0", "1", "1/2x", "a/b"}) EXPECT_FALSE(ParseShard(bad, &i, &n).ok()) << bad;
+  const Result<std::vector<int>> ks = ParseIntList("3,5,10", "--k");
+  ASSERT_TRUE(ks.ok());
+  EXPECT_EQ(*ks, std::vector<int>({3, 5, 10}));
+  EXPECT_FALSE(ParseIntList("3,,5", "--k").ok());
+  EXPECT_FALSE(ParseIntList("3,x", "--k").ok());
+  EXPECT_FALSE(ParseIntList("", "--k").ok());
+}
+
+TEST(BenchProtocolTest, ValidatesOptions) {
+  BenchOptions o;
+  EXPECT_FALSE(o.Validate().ok());  // no --out
+  o.out_dir = "x";
+  EXPECT_TRUE(o.Validate().ok());
+  BenchOptions bad = o;
+  bad.methods = {"icef", "fdnerf"};
+  const Status s = bad.Validate();
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("fdnerf"), std::string::npos) << s.message();
+  bad = o;
+  bad.ks = {0};
+  EXPECT_FALSE(bad.Validate().ok());
+  bad = o;
+  bad.shard_index = 3;
+  bad.shard_count = 3;
+  EXPECT_FALSE(bad.Validate().ok());
+  BenchOptions quick = o;
+  quick.ApplyQuick();
+  EXPECT_TRUE(quick.Validate().ok());
+  EXPECT_EQ(PlanRuns(quick).size(), 5u);
+  EXPECT_EQ(quick.resolution, 32);
+}
+
+// Merging two shard directories: runs are unioned; the same run in both must be identical.
+TEST(BenchProtocolTest, MergesShardDirectories) {
+  const fs::path dir = TempDir("merge");
+  auto write_run = [&](const fs::path& bench, const RunId& id, double psnr) {
+    RunRecord r;
+    r.id = id;
+    r.metrics.method = id.method;
+    FrameMetrics f;
+    f.file_path = "f.png";
+    f.tier = Tier::kFar;
+    f.delta = 1.0;
+    f.psnr = psnr;
+    r.metrics.frames = {f};
+    r.metrics.tiers = AggregateTiers(r.metrics.frames);
+    fs::create_directories(bench / "runs" / id.Name());
+    ASSERT_TRUE(WriteFileAtomic(bench / "runs" / id.Name() / "metrics.json", FormatJson(RunRecordJson(r))).ok());
+  };
+  write_run(dir / "a", RunId{1, 3, "icef"}, 20);
+  write_run(dir / "a", RunId{1, 3, "warp"}, 19);
+  write_run(dir / "b", RunId{2, 3, "icef"}, 22);
+  write_run(dir / "b", RunId{2, 3, "warp"}, 23);
+  write_run(dir / "b", RunId{1, 3, "icef"}, 20);  // duplicate, identical
+  std::ostringstream log;
+  ASSERT_TRUE(MergeBench({dir / "a", dir / "b"}, dir / "merged", log).ok()) << log.str();
+  const Result<std::vector<RunRecord>> runs = ReadRunRecords(dir / "merged");
+  ASSERT_TRUE(runs.ok());
+  EXPECT_EQ(runs->size(), 4u);
+  const Result<Json> report = ReadJsonFile(dir / "merged" / "report.json");
+  ASSERT_TRUE(report.ok());
+  for (const Json& cell : (*report)["aggregate"]) {
+    if (cell["method"] == "icef" && cell["tier"] == "far") {
+      EXPECT_DOUBLE_EQ(cell["psnr"]["mean"].get<double>(), 21.0);
+    }
+  }
+
+  EXPECT_EQ(log.str().find("warning"), std::string::npos) << log.str();
+
+  write_run(dir / "c", RunId{1, 3, "icef"}, 25);  // conflicting duplicate: the first is kept, with a warning
+  std::ostringstream log2;
+  ASSERT_TRUE(MergeBench({dir / "a", dir / "c"}, dir / "merged2", log2).ok());
+  EXPECT_NE(log2.str().find("warning: " + (dir / "c" / "runs" / "id1_k3_icef" / "metrics.json").string()),
+            std::string::npos)
+      << log2.str();
+  const Result<RunRecord> kept = ReadRunRecord(dir / "merged2" / "runs" / "id1_k3_icef" / "metrics.json");
+  ASSERT_TRUE(kept.ok());
+  EXPECT_DOUBLE_EQ(*kept->metrics.frames[0].psnr, 20.0);
+
+  // Different bench settings cannot be merged; a directory without runs/ is an error.
+  ASSERT_TRUE(WriteFileAtomic(dir / "a" / "bench.json", R"({"steps": 10, "shard": "0/2"})").ok());
+  ASSERT_TRUE(WriteFileAtomic(dir / "b" / "bench.json", R"({"steps": 10, "shard": "1/2"})").ok());
+  EXPECT_TRUE(MergeBench({dir / "a", dir / "b"}, dir / "merged4", log).ok());
+  ASSERT_TRUE(WriteFileAtomic(dir / "b" / "bench.json", R"({"steps": 20, "shard": "1/2"})").ok());
+  const Status differ = MergeBench({dir / "a", dir / "b"}, dir / "merged5", log);
+  ASSERT_FALSE(differ.ok());
+  EXPECT_NE(differ.message().find("settings differ"), std::string::npos) << differ.message();
+  EXPECT_FALSE(MergeBench({dir / "missing"}, dir / "merged3", log).ok());
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace icef::eval

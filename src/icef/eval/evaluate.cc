@@ -1,0 +1,446 @@
+#include "icef/eval/evaluate.h"
+
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <sstream>
+
+#include "icef/eval/metrics.h"
+#include "icef/io/atomic_file.h"
+#include "icef/model/render_image.h"
+
+namespace fs = std::filesystem;
+
+namespace icef::eval {
+
+const std::array<Tier, kNumTiers>& AllTiers() {
+  static const std::array<Tier, kNumTiers> kTiers = {Tier::kObserved, Tier::kNear, Tier::kModerate, Tier::kFar};
+  return kTiers;
+}
+
+namespace {
+
+Json OptionalJson(const std::optional<double>& v) { return v.has_value() ? Json(*v) : Json(nullptr); }
+
+std::optional<double> Finite(double v) { return std::isfinite(v) ? std::optional<double>(v) : std::nullopt; }
+
+// A required number, or null; errors name `where` and the key.
+Result<std::optional<double>> OptionalNumber(const Json& j, const std::string& where, const char* key) {
+  const auto it = j.find(key);
+  if (it == j.end()) return Status::Error(where + "." + key + ": missing required field (a number or null)");
+  if (it->is_null()) return std::optional<double>();
+  if (!it->is_number()) return Status::Error(where + "." + key + ": expected a number or null, got " + JsonTypeDescription(*it));
+  const double v = it->get<double>();
+  if (!std::isfinite(v)) return Status::Error(where + "." + key + ": non-finite number");
+  return std::optional<double>(v);
+}
+
+Result<double> RequiredNumber(const Json& j, const std::string& where, const char* key) {
+  ICEF_ASSIGN_OR_RETURN(const std::optional<double> v, OptionalNumber(j, where, key));
+  if (!v) return Status::Error(where + "." + key + ": expected a number, got null");
+  return *v;
+}
+
+std::string OptionalString(const Json& j, const char* key) {
+  const auto it = j.find(key);
+  return it != j.end() && it->is_string() ? it->get<std::string>() : std::string();
+}
+
+std::string Fmt(const std::optional<double>& v, const char* format) {
+  if (!v) return "-";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, format, *v);
+  return buf;
+}
+
+}  // namespace
+
+Json FrameMetrics::ToJson() const {
+  Json j;
+  j["file_path"] = file_path;
+  j["tier"] = TierName(tier);
+  j["delta"] = delta;
+  j["psnr"] = OptionalJson(psnr);
+  j["ssim"] = OptionalJson(ssim);
+  j["lpips"] = OptionalJson(lpips);
+  j["id_cosine"] = OptionalJson(id_cosine);
+  j["id_distance"] = OptionalJson(id_distance);
+  j["id_distance_gt"] = OptionalJson(id_distance_gt);
+  j["nearest_index"] = nearest_index;
+  j["model_delta"] = model_delta;
+  j["kappa"] = kappa;
+  j["landmarks"] = landmarks;
+  j["neutral_landmarks"] = neutral_landmarks;
+  j["render"] = render_path;
+  return j;
+}
+
+Result<FrameMetrics> FrameMetrics::FromJson(const Json& j, const std::string& where) {
+  if (!j.is_object()) return Status::Error(where + ": expected an object, got " + JsonTypeDescription(j));
+  FrameMetrics f;
+  const auto path = j.find("file_path");
+  if (path == j.end() || !path->is_string()) return Status::Error(where + ".file_path: expected a string");
+  f.file_path = path->get<std::string>();
+  const auto tier = j.find("tier");
+  if (tier == j.end() || !tier->is_string()) return Status::Error(where + ".tier: expected a string");
+  const std::optional<Tier> parsed = ParseTier(tier->get<std::string>());
+  if (!parsed)
+    return Status::Error(where + ".tier: unknown tier '" + tier->get<std::string>() +
+                         "' (expected observed, near, moderate or far)");
+  f.tier = *parsed;
+  ICEF_ASSIGN_OR_RETURN(f.delta, RequiredNumber(j, where, "delta"));
+  ICEF_ASSIGN_OR_RETURN(f.psnr, OptionalNumber(j, where, "psnr"));
+  ICEF_ASSIGN_OR_RETURN(f.ssim, OptionalNumber(j, where, "ssim"));
+  ICEF_ASSIGN_OR_RETURN(f.lpips, OptionalNumber(j, where, "lpips"));
+  ICEF_ASSIGN_OR_RETURN(f.id_cosine, OptionalNumber(j, where, "id_cosine"));
+  ICEF_ASSIGN_OR_RETURN(f.id_distance, OptionalNumber(j, where, "id_distance"));
+  ICEF_ASSIGN_OR_RETURN(f.id_distance_gt, OptionalNumber(j, where, "id_distance_gt"));
+  // Extras are optional (hand-written metrics files may omit them).
+  if (j.contains("nearest_index") && j["nearest_index"].is_number_integer()) f.nearest_index = j["nearest_index"].get<int>();
+  if (j.contains("model_delta") && j["model_delta"].is_number()) f.model_delta = j["model_delta"].get<double>();
+  if (j.contains("kappa") && j["kappa"].is_number()) f.kappa = j["kappa"].get<double>();
+  f.landmarks = OptionalString(j, "landmarks");
+  f.neutral_landmarks = OptionalString(j, "neutral_landmarks");
+  f.render_path = OptionalString(j, "render");
+  return f;
+}
+
+Json TierMetrics::ToJson() const {
+  Json j;
+  j["count"] = count;
+  j["psnr"] = OptionalJson(psnr);
+  j["ssim"] = OptionalJson(ssim);
+  j["lpips"] = OptionalJson(lpips);
+  j["id_cosine"] = OptionalJson(id_cosine);
+  j["id_distance"] = OptionalJson(id_distance);
+  j["id_distance_gt"] = OptionalJson(id_distance_gt);
+  j["id_share_under_0_6"] = OptionalJson(id_share_under_0_6);
+  j["id_count"] = id_count;
+  j["mean_delta"] = mean_delta;
+  return j;
+}
+
+Result<TierMetrics> TierMetrics::FromJson(const Json& j, const std::string& where) {
+  if (!j.is_object()) return Status::Error(where + ": expected an object, got " + JsonTypeDescription(j));
+  TierMetrics t;
+  ICEF_ASSIGN_OR_RETURN(const double count, RequiredNumber(j, where, "count"));
+  if (count < 0 || count != std::floor(count)) return Status::Error(where + ".count: expected a count");
+  t.count = static_cast<int>(count);
+  ICEF_ASSIGN_OR_RETURN(t.psnr, OptionalNumber(j, where, "psnr"));
+  ICEF_ASSIGN_OR_RETURN(t.ssim, OptionalNumber(j, where, "ssim"));
+  ICEF_ASSIGN_OR_RETURN(t.lpips, OptionalNumber(j, where, "lpips"));
+  ICEF_ASSIGN_OR_RETURN(t.id_cosine, OptionalNumber(j, where, "id_cosine"));
+  ICEF_ASSIGN_OR_RETURN(t.id_distance, OptionalNumber(j, where, "id_distance"));
+  ICEF_ASSIGN_OR_RETURN(t.id_distance_gt, OptionalNumber(j, where, "id_distance_gt"));
+  ICEF_ASSIGN_OR_RETURN(t.id_share_under_0_6, OptionalNumber(j, where, "id_share_under_0_6"));
+  if (j.contains("id_count") && j["id_count"].is_number_integer()) t.id_count = j["id_count"].get<int>();
+  if (j.contains("mean_delta") && j["mean_delta"].is_number()) t.mean_delta = j["mean_delta"].get<double>();
+  return t;
+}
+
+std::array<TierMetrics, kNumTiers> AggregateTiers(const std::vector<FrameMetrics>& frames) {
+  struct Acc {
+    double sum = 0;
+    int n = 0;
+    void Add(const std::optional<double>& v) {
+      if (v) sum += *v, ++n;
+    }
+    std::optional<double> Mean() const { return n > 0 ? std::optional<double>(sum / n) : std::nullopt; }
+  };
+  struct TierAcc {
+    Acc psnr, ssim, lpips, id_cosine, id_distance, id_distance_gt, under, delta;
+  };
+  std::array<TierAcc, kNumTiers> acc;
+  std::array<TierMetrics, kNumTiers> out;
+  for (const FrameMetrics& f : frames) {
+    const int t = TierIndex(f.tier);
+    TierAcc& a = acc[t];
+    ++out[t].count;
+    a.delta.Add(f.delta);
+    a.psnr.Add(f.psnr);
+    a.ssim.Add(f.ssim);
+    a.lpips.Add(f.lpips);
+    a.id_cosine.Add(f.id_cosine);
+    a.id_distance.Add(f.id_distance);
+    a.id_distance_gt.Add(f.id_distance_gt);
+    if (f.id_distance) a.under.Add(*f.id_distance < kSamePersonThreshold ? 1.0 : 0.0);
+  }
+  for (int t = 0; t < kNumTiers; ++t) {
+    const TierAcc& a = acc[t];
+    TierMetrics& m = out[t];
+    m.psnr = a.psnr.Mean();
+    m.ssim = a.ssim.Mean();
+    m.lpips = a.lpips.Mean();
+    m.id_cosine = a.id_cosine.Mean();
+    m.id_distance = a.id_distance.Mean();
+    m.id_distance_gt = a.id_distance_gt.Mean();
+    m.id_share_under_0_6 = a.under.Mean();
+    m.id_count = a.id_distance.n;
+    m.mean_delta = a.delta.Mean().value_or(0.0);
+  }
+  return out;
+}
+
+Json EvalResult::ToJson() const {
+  Json j;
+  j["method"] = method;
+  j["identity_available"] = identity_available;
+  if (!identity_note.empty()) j["identity_note"] = identity_note;
+  j["lpips_available"] = lpips_available;
+  j["identity_missing"] = identity_missing;
+  Json frames_json = Json::array();
+  for (const FrameMetrics& f : frames) frames_json.push_back(f.ToJson());
+  j["frames"] = std::move(frames_json);
+  Json tiers_json = Json::object();
+  for (Tier t : AllTiers()) tiers_json[TierName(t)] = tiers[TierIndex(t)].ToJson();
+  j["tiers"] = std::move(tiers_json);
+  return j;
+}
+
+Result<EvalResult> EvalResult::FromJson(const Json& j, const std::string& origin) {
+  if (!j.is_object()) return Status::Error(origin + ": expected a JSON object");
+  EvalResult r;
+  const auto method = j.find("method");
+  if (method == j.end() || !method->is_string()) return Status::Error(origin + ": method: expected a string");
+  r.method = method->get<std::string>();
+  if (j.contains("identity_available") && j["identity_available"].is_boolean())
+    r.identity_available = j["identity_available"].get<bool>();
+  if (j.contains("lpips_available") && j["lpips_available"].is_boolean())
+    r.lpips_available = j["lpips_available"].get<bool>();
+  if (j.contains("identity_missing") && j["identity_missing"].is_number_integer())
+    r.identity_missing = j["identity_missing"].get<int>();
+  r.identity_note = OptionalString(j, "identity_note");
+  const auto frames = j.find("frames");
+  if (frames == j.end() || !frames->is_array()) return Status::Error(origin + ": frames: expected an array");
+  for (size_t i = 0; i < frames->size(); ++i) {
+    ICEF_ASSIGN_OR_RETURN(FrameMetrics f,
+                          FrameMetrics::FromJson((*frames)[i], origin + ": frames[" + std::to_string(i) + "]"));
+    r.frames.push_back(std::move(f));
+  }
+  const auto tiers = j.find("tiers");
+  if (tiers == j.end() || !tiers->is_object()) return Status::Error(origin + ": tiers: expected an object");
+  for (Tier t : AllTiers()) {
+    const auto it = tiers->find(TierName(t));
+    if (it == tiers->end()) return Status::Error(origin + ": tiers." + TierName(t) + ": missing");
+    ICEF_ASSIGN_OR_RETURN(r.tiers[TierIndex(t)],
+                          TierMetrics::FromJson(*it, origin + ": tiers." + std::string(TierName(t))));
+  }
+  return r;
+}
+
+std::string EvalResult::Table() const {
+  std::ostringstream s;
+  char line[256];
+  std::snprintf(line, sizeof line, "%-9s %5s %7s %6s %6s %9s %7s %9s %7s\n", "tier", "count", "psnr", "ssim", "lpips",
+                "id_cosine", "id_dist", "id_dist_gt", "id<0.6");
+  s << line;
+  for (Tier t : AllTiers()) {
+    const TierMetrics& m = tiers[TierIndex(t)];
+    std::snprintf(line, sizeof line, "%-9s %5d %7s %6s %6s %9s %7s %9s %7s\n", TierName(t), m.count,
+                  Fmt(m.psnr, "%.2f").c_str(), Fmt(m.ssim, "%.3f").c_str(), Fmt(m.lpips, "%.3f").c_str(),
+                  Fmt(m.id_cosine, "%.4f").c_str(), Fmt(m.id_distance, "%.3f").c_str(),
+                  Fmt(m.id_distance_gt, "%.3f").c_str(),
+                  m.id_share_under_0_6 ? Fmt(100.0 * *m.id_share_under_0_6, "%.0f%%").c_str() : "-");
+    s << line;
+  }
+  if (!lpips_available) s << "lpips: unavailable (no weights file given; see docs/evaluation.md)\n";
+  if (!identity_available)
+    s << "identity: unavailable" << (identity_note.empty() ? "" : " (" + identity_note + ")") << "\n";
+  else if (identity_missing > 0)
+    s << "identity: no face found in " << identity_missing << " of " << frames.size() << " frames (null there)\n";
+  return s.str();
+}
+
+Status WriteMetricsFile(const fs::path& path, const EvalResult& result) {
+  return WriteFileAtomic(path, FormatJson(result.ToJson()));
+}
+
+Result<EvalResult> ReadMetricsFile(const fs::path& path) {
+  ICEF_ASSIGN_OR_RETURN(const Json j, ReadJsonFile(path));
+  return EvalResult::FromJson(j, path.string());
+}
+
+std::string EvalOptions::ToString() const {
+  return "EvalOptions(out_dir=" + out_dir.string() +
+         ", write_neutral_renders=" + (write_neutral_renders ? "true" : "false") + ")";
+}
+
+namespace {
+
+// One test view: the model's neutral render and its descriptor (computed once per view).
+struct NeutralView {
+  int index = 0;
+  Image render;
+  std::optional<FaceDescriptor> descriptor;
+  std::string landmarks = "none";
+  std::string render_path;
+};
+
+// Frames of the same view share a neutral render: keyed by the neutral file when the dataset names
+// one, else by the exact camera.
+std::string ViewKey(const Frame& frame) {
+  if (frame.neutral_file_path) return "file:" + *frame.neutral_file_path;
+  std::ostringstream s;
+  s.precision(17);
+  const Intrinsics& k = frame.camera.intrinsics();
+  s << "cam:" << k.width << ' ' << k.height << ' ' << k.fl_x << ' ' << k.fl_y << ' ' << k.cx << ' ' << k.cy;
+  const Mat4d& m = frame.camera.world_from_cam();
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c) s << ' ' << m(r, c);
+  return s.str();
+}
+
+// The 68 landmarks of a dataset frame whose image is `file_path` (any split), if any.
+std::optional<std::vector<Vec2f>> DatasetLandmarksOf(const Dataset& dataset, const std::string& file_path) {
+  for (const auto* split : {&dataset.train, &dataset.test, &dataset.val})
+    for (const Frame& f : *split)
+      if (f.file_path == file_path && f.landmarks_2d) return f.landmarks_2d;
+  return std::nullopt;
+}
+
+std::optional<FaceDescriptor> TryDescribe(FaceIdentity& identity, const Image& image,
+                                          const std::optional<std::vector<Vec2f>>& landmarks) {
+  Result<FaceIdentityResult> r = identity.Describe(image, landmarks);
+  if (!r.ok()) return std::nullopt;
+  return r->descriptor;
+}
+
+std::string RenderName(const std::string& file_path) {
+  return "renders/" + fs::path(file_path).stem().string() + ".png";
+}
+
+}  // namespace
+
+Result<EvalResult> EvaluateModel(const AvatarModel& model, const Dataset& dataset, const EvalOptions& options,
+                                 const EvalNetworks& networks, const Executor& executor, ProgressBar* progress) {
+  ICEF_RETURN_IF_ERROR(options.Validate());
+  if (dataset.test.empty()) return Status::Error(dataset.root.string() + ": the dataset has no test frames");
+  if (dataset.expression_dim != model.setup().expression_dim)
+    return Status::Error(dataset.root.string() + ": expression_dim " + std::to_string(dataset.expression_dim) +
+                         " does not match the model's " + std::to_string(model.setup().expression_dim));
+  const bool write = !options.out_dir.empty();
+  const fs::path& out_root = options.out_dir;
+  if (write) {
+    std::error_code ec;
+    fs::create_directories(out_root / "renders", ec);
+    if (ec) return Status::Error((out_root / "renders").string() + ": cannot create directory: " + ec.message());
+  }
+  EvalResult result;
+  result.method = MethodName(model.method());
+  result.identity_available = networks.identity != nullptr;
+  result.identity_note = networks.identity ? "" : networks.identity_note;
+  result.lpips_available = networks.lpips != nullptr;
+  const Vec3f background = dataset.background;
+  const std::vector<float> neutral_beta(dataset.expression_dim, 0.f);
+  std::map<std::string, NeutralView> views;
+
+  for (size_t i = 0; i < dataset.test.size(); ++i) {
+    const Frame& frame = dataset.test[i];
+    const std::string where = dataset.root.string() + ": test frame " + std::to_string(i) + " (" + frame.file_path + ")";
+    ICEF_ASSIGN_OR_RETURN(const Image gt_raw, LoadFrameImage(dataset, frame));
+    const Image gt = CompositeOver(gt_raw, background);
+    if (gt.width != frame.camera.width() || gt.height != frame.camera.height())
+      return Status::Error(where + ": image is " + std::to_string(gt.width) + "x" + std::to_string(gt.height) +
+                           ", camera says " + std::to_string(frame.camera.width()) + "x" +
+                           std::to_string(frame.camera.height()));
+    const RenderedImage render = RenderImage(model, frame.camera, frame.expression, background, executor);
+
+    FrameMetrics m;
+    m.file_path = frame.file_path;
+    m.tier = frame.tier.value_or(Tier::kObserved);
+    m.delta = frame.delta.value_or(render.nearest.delta);
+    m.nearest_index = render.nearest.index;
+    m.model_delta = render.nearest.delta;
+    m.kappa = render.nearest.kappa;
+    ICEF_ASSIGN_OR_RETURN(const double psnr, Psnr(render.color, gt));
+    m.psnr = Finite(psnr);
+    ICEF_ASSIGN_OR_RETURN(const double ssim, Ssim(render.color, gt));
+    m.ssim = Finite(ssim);
+    if (networks.lpips) {
+      ICEF_ASSIGN_OR_RETURN(const double lpips, networks.lpips->Distance(render.color, gt));
+      m.lpips = Finite(lpips);
+    }
+    if (write) {
+      m.render_path = RenderName(frame.file_path);
+      ICEF_RETURN_IF_ERROR(WritePng(out_root / m.render_path, render.color));
+    }
+
+    // The model's neutral render of this view (once per view).
+    const std::string key = ViewKey(frame);
+    auto it = views.find(key);
+    if (it == views.end()) {
+      NeutralView view;
+      view.index = static_cast<int>(views.size());
+      view.render = RenderImage(model, frame.camera, neutral_beta, background, executor).color;
+      if (write && options.write_neutral_renders) {
+        char name[64];
+        std::snprintf(name, sizeof name, "renders/neutral_%03d.png", view.index);
+        view.render_path = name;
+        ICEF_RETURN_IF_ERROR(WritePng(out_root / view.render_path, view.render));
+      }
+      if (networks.identity) {
+        // Landmarks of the neutral: from the dataset when a frame holds the neutral image, else
+        // detected on the neutral ground truth, else (below) the frame's own, else detected on
+        // the neutral render.
+        std::optional<std::vector<Vec2f>> lm;
+        if (frame.neutral_file_path) {
+          lm = DatasetLandmarksOf(dataset, *frame.neutral_file_path);
+          if (lm) {
+            view.landmarks = "dataset";
+          } else {
+            Result<Image> neutral_gt = ReadImage(dataset.root / *frame.neutral_file_path);
+            if (neutral_gt.ok()) {
+              Result<FaceIdentityResult> d = networks.identity->Describe(CompositeOver(*neutral_gt, background), {});
+              if (d.ok()) lm = d->landmarks, view.landmarks = "detector (ground truth)";
+            }
+          }
+        }
+        if (!lm && frame.landmarks_2d) lm = frame.landmarks_2d, view.landmarks = "frame";
+        if (lm) {
+          view.descriptor = TryDescribe(*networks.identity, view.render, lm);
+        } else {
+          view.descriptor = TryDescribe(*networks.identity, view.render, std::nullopt);
+          if (view.descriptor) view.landmarks = "detector (render)";
+        }
+        if (!view.descriptor) view.landmarks = "none";
+      }
+      it = views.emplace(key, std::move(view)).first;
+    }
+    const NeutralView& view = it->second;
+    m.neutral_landmarks = view.landmarks;
+
+    if (networks.identity) {
+      FaceIdentity& identity = *networks.identity;
+      std::optional<FaceDescriptor> render_desc, gt_desc;
+      if (frame.landmarks_2d) {
+        m.landmarks = "dataset";
+        render_desc = TryDescribe(identity, render.color, frame.landmarks_2d);
+        gt_desc = TryDescribe(identity, gt, frame.landmarks_2d);
+      } else {
+        m.landmarks = "detector";
+        render_desc = TryDescribe(identity, render.color, std::nullopt);
+        gt_desc = TryDescribe(identity, gt, std::nullopt);
+      }
+      if (!render_desc) m.landmarks = "none";
+      if (render_desc && view.descriptor) {
+        m.id_distance = DescriptorDistance(*render_desc, *view.descriptor);
+        m.id_cosine = DescriptorCosine(*render_desc, *view.descriptor);
+      }
+      if (render_desc && gt_desc) m.id_distance_gt = DescriptorDistance(*render_desc, *gt_desc);
+      if (!m.id_distance) ++result.identity_missing;
+    } else {
+      m.landmarks = "none";
+    }
+    result.frames.push_back(std::move(m));
+    if (progress) {
+      const FrameMetrics& last = result.frames.back();
+      progress->Update(static_cast<int64_t>(i) + 1, std::string(TierName(last.tier)) + " psnr " +
+                                                        Fmt(last.psnr, "%.2f") + " id " + Fmt(last.id_distance, "%.3f"));
+    }
+  }
+  result.tiers = AggregateTiers(result.frames);
+  if (progress) progress->Finish();
+  return result;
+}
+
+}  // namespace icef::eval

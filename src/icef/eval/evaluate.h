@@ -1,0 +1,120 @@
+// The per-model evaluation protocol of DESIGN.md §6 (`icef eval MODEL DATASET --out DIR`): every
+// test frame is rendered at its camera and expression and compared with its ground truth (PSNR,
+// SSIM over the full image composited on the background, LPIPS when weights are given), and its
+// identity is measured with the face-descriptor network: the Euclidean distance and cosine between
+// the descriptor of the render and that of the model's OWN neutral render (expression zero, same
+// view) — the paper's drift measure — and, beside it, the distance to the ground-truth image.
+// Results are aggregated per tier and written as metrics.json:
+//   {"method", "frames": [{"file_path", "tier", "delta", "psnr", "ssim", "lpips", "id_cosine",
+//    "id_distance", "id_distance_gt", ...extras}], "tiers": {"observed": {"count", "psnr", "ssim",
+//    "lpips", "id_cosine", "id_distance", "id_distance_gt", "id_share_under_0_6", ...}, "near", ...}}
+// with null wherever a value could not be computed (no LPIPS weights, no face found, ...).
+#pragma once
+
+#include <array>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "icef/core/parallel.h"
+#include "icef/core/progress.h"
+#include "icef/data/dataset.h"
+#include "icef/eval/face_identity.h"
+#include "icef/eval/lpips.h"
+#include "icef/io/json_util.h"
+#include "icef/model/avatar_model.h"
+
+namespace icef::eval {
+
+constexpr int kNumTiers = 4;
+// observed, near, moderate, far (the order of every per-tier array).
+const std::array<Tier, kNumTiers>& AllTiers();
+inline int TierIndex(Tier tier) { return static_cast<int>(tier); }
+
+// The metrics of one test frame.
+struct FrameMetrics {
+  std::string file_path;               // the frame's ground-truth image, relative to the dataset
+  Tier tier = Tier::kObserved;
+  double delta = 0;                    // the dataset's delta of the frame
+  std::optional<double> psnr;          // dB (null only when infinite: a pixel-perfect render)
+  std::optional<double> ssim;
+  std::optional<double> lpips;         // null without LPIPS weights
+  std::optional<double> id_cosine;     // render vs the model's neutral render, same view
+  std::optional<double> id_distance;   // Euclidean, same pair
+  std::optional<double> id_distance_gt;  // render vs the ground-truth image of the frame
+  int nearest_index = -1;              // the model's nearest training expression k
+  double model_delta = 0;              // ||beta - beta_n|| as the model sees it
+  double kappa = 1;                    // confidence at that distance
+  std::string landmarks;               // "dataset", "detector" or "none" (render chip)
+  std::string neutral_landmarks;       // "dataset", "detector (ground truth)", "detector (render)", "frame", "none"
+  std::string render_path;             // relative to the output directory (empty when not written)
+
+  Json ToJson() const;
+  // `where` names the object in errors, e.g. "run/metrics.json: frames[3]".
+  static Result<FrameMetrics> FromJson(const Json& json, const std::string& where);
+};
+
+// Means over the frames of one tier. Identity means are over the frames where identity could be
+// measured (id_count of them); a metric with no value in any frame is null.
+struct TierMetrics {
+  int count = 0;
+  std::optional<double> psnr;
+  std::optional<double> ssim;
+  std::optional<double> lpips;
+  std::optional<double> id_cosine;
+  std::optional<double> id_distance;
+  std::optional<double> id_distance_gt;
+  std::optional<double> id_share_under_0_6;  // share of id_distance values under 0.6
+  int id_count = 0;                          // frames with identity metrics
+  double mean_delta = 0;                     // mean dataset delta (0 when count is 0)
+
+  Json ToJson() const;
+  static Result<TierMetrics> FromJson(const Json& json, const std::string& where);
+};
+
+// Per-tier means of frame metrics (plain arithmetic means in frame order).
+std::array<TierMetrics, kNumTiers> AggregateTiers(const std::vector<FrameMetrics>& frames);
+
+// One model evaluated on one dataset: the content of metrics.json.
+struct EvalResult {
+  std::string method;
+  std::vector<FrameMetrics> frames;
+  std::array<TierMetrics, kNumTiers> tiers;
+  bool identity_available = false;   // the face-descriptor network was loaded
+  bool lpips_available = false;      // LPIPS weights were given
+  int identity_missing = 0;          // frames whose identity could not be measured (no face)
+  std::string identity_note;         // why identity is unavailable, when it is
+
+  Json ToJson() const;
+  static Result<EvalResult> FromJson(const Json& json, const std::string& origin);
+  // The per-tier table printed by `icef eval`.
+  std::string Table() const;
+};
+
+Status WriteMetricsFile(const std::filesystem::path& path, const EvalResult& result);
+Result<EvalResult> ReadMetricsFile(const std::filesystem::path& path);
+
+struct EvalOptions {
+  // Output directory: renders go to out_dir/renders/ (paths in the result are relative to it);
+  // empty: renders are not written.
+  std::filesystem::path out_dir;
+  // Also write each frame's model neutral render (renders/neutral_<view>.png).
+  bool write_neutral_renders = true;
+  Status Validate() const { return Status::Ok(); }
+  std::string ToString() const;
+};
+
+// The networks an evaluation may use; null members are unavailable (their metrics are null).
+struct EvalNetworks {
+  FaceIdentity* identity = nullptr;  // not thread-safe: frames are described one at a time
+  const LpipsNet* lpips = nullptr;
+  std::string identity_note;         // why `identity` is null (copied into the result)
+};
+
+// Evaluates `model` on the test frames of `dataset`. Errors: unreadable images, size mismatches.
+// progress (may be null) counts frames.
+Result<EvalResult> EvaluateModel(const AvatarModel& model, const Dataset& dataset, const EvalOptions& options,
+                                 const EvalNetworks& networks, const Executor& executor, ProgressBar* progress);
+
+}  // namespace icef::eval

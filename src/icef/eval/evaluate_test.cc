@@ -1,0 +1,230 @@
+#include "icef/eval/evaluate.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "icef/eval/metrics.h"
+#include "icef/io/atomic_file.h"
+#include "icef/model/render_image.h"
+#include "icef/synth/synthesize.h"
+#include "icef/train/trainer.h"
+
+namespace icef::eval {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path TempDir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("icef_evaluate_test_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+// A hand-made metrics file: two observed frames, three far frames (one without identity), no
+// near/moderate frames, LPIPS null everywhere.
+constexpr const char* kHandMade = R"({
+  "method": "icef",
+  "frames": [
+    {"file_path": "a.png", "tier": "observed", "delta": 0, "psnr": 20.0, "ssim": 0.5, "lpips": null,
+     "id_cosine": 0.98, "id_distance": 0.2, "id_distance_gt": 0.3},
+    {"file_path": "b.png", "tier": "observed", "delta": 0, "psnr": 22.0, "ssim": 0.7, "lpips": null,
+     "id_cosine": 0.96, "id_distance": 0.4, "id_distance_gt": 0.5},
+    {"file_path": "c.png", "tier": "far", "delta": 1.0, "psnr": 15.0, "ssim": 0.25, "lpips": null,
+     "id_cosine": 0.9, "id_distance": 0.5, "id_distance_gt": 0.7},
+    {"file_path": "d.png", "tier": "far", "delta": 1.5, "psnr": 18.0, "ssim": 0.5, "lpips": null,
+     "id_cosine": 0.8, "id_distance": 0.75, "id_distance_gt": 0.9},
+    {"file_path": "e.png", "tier": "far", "delta": 2.0, "psnr": 12.0, "ssim": 0.75, "lpips": null,
+     "id_cosine": null, "id_distance": null, "id_distance_gt": null}
+  ],
+  "tiers": {
+    "observed": {"count": 0, "psnr": null, "ssim": null, "lpips": null, "id_cosine": null,
+                 "id_distance": null, "id_distance_gt": null, "id_share_under_0_6": null},
+    "near": {"count": 0, "psnr": null, "ssim": null, "lpips": null, "id_cosine": null,
+             "id_distance": null, "id_distance_gt": null, "id_share_under_0_6": null},
+    "moderate": {"count": 0, "psnr": null, "ssim": null, "lpips": null, "id_cosine": null,
+                 "id_distance": null, "id_distance_gt": null, "id_share_under_0_6": null},
+    "far": {"count": 0, "psnr": null, "ssim": null, "lpips": null, "id_cosine": null,
+            "id_distance": null, "id_distance_gt": null, "id_share_under_0_6": null}
+  }
+})";
+
+TEST(EvaluateTest, AggregatesHandMadeMetricsFilePerTier) {
+  const fs::path dir = TempDir("handmade");
+  ASSERT_TRUE(WriteFileAtomic(dir / "metrics.json", kHandMade).ok());
+  const Result<EvalResult> read = ReadMetricsFile(dir / "metrics.json");
+  ASSERT_TRUE(read.ok()) << read.status().message();
+  ASSERT_EQ(read->frames.size(), 5u);
+  const auto tiers = AggregateTiers(read->frames);
+
+  const TierMetrics& obs = tiers[TierIndex(Tier::kObserved)];
+  EXPECT_EQ(obs.count, 2);
+  EXPECT_DOUBLE_EQ(*obs.psnr, 21.0);
+  EXPECT_DOUBLE_EQ(*obs.ssim, 0.6);
+  EXPECT_FALSE(obs.lpips.has_value());
+  EXPECT_DOUBLE_EQ(*obs.id_cosine, 0.97);
+  EXPECT_DOUBLE_EQ(*obs.id_distance, 0.3);
+  EXPECT_DOUBLE_EQ(*obs.id_distance_gt, 0.4);
+  EXPECT_DOUBLE_EQ(*obs.id_share_under_0_6, 1.0);
+  EXPECT_EQ(obs.id_count, 2);
+  EXPECT_DOUBLE_EQ(obs.mean_delta, 0.0);
+
+  const TierMetrics& far = tiers[TierIndex(Tier::kFar)];
+  EXPECT_EQ(far.count, 3);
+  EXPECT_DOUBLE_EQ(*far.psnr, 15.0);
+  EXPECT_DOUBLE_EQ(*far.ssim, 0.5);
+  // Identity means over the two frames that have it.
+  EXPECT_DOUBLE_EQ(*far.id_cosine, 0.85);
+  EXPECT_DOUBLE_EQ(*far.id_distance, 0.625);
+  EXPECT_DOUBLE_EQ(*far.id_distance_gt, 0.8);
+  EXPECT_DOUBLE_EQ(*far.id_share_under_0_6, 0.5);
+  EXPECT_EQ(far.id_count, 2);
+  EXPECT_DOUBLE_EQ(far.mean_delta, 1.5);
+
+  for (Tier t : {Tier::kNear, Tier::kModerate}) {
+    const TierMetrics& m = tiers[TierIndex(t)];
+    EXPECT_EQ(m.count, 0);
+    EXPECT_FALSE(m.psnr.has_value());
+    EXPECT_FALSE(m.id_share_under_0_6.has_value());
+  }
+
+  // Written back: nulls stay null, the tiers are the aggregates, and it reads back equal.
+  EvalResult result = *read;
+  result.tiers = tiers;
+  ASSERT_TRUE(WriteMetricsFile(dir / "out.json", result).ok());
+  const Result<Json> json = ReadJsonFile(dir / "out.json");
+  ASSERT_TRUE(json.ok());
+  EXPECT_TRUE((*json)["frames"][0]["lpips"].is_null());
+  EXPECT_TRUE((*json)["frames"][4]["id_distance"].is_null());
+  EXPECT_TRUE((*json)["tiers"]["near"]["psnr"].is_null());
+  EXPECT_DOUBLE_EQ((*json)["tiers"]["far"]["id_distance"].get<double>(), 0.625);
+  for (const char* key : {"count", "psnr", "ssim", "lpips", "id_cosine", "id_distance", "id_distance_gt",
+                          "id_share_under_0_6"})
+    EXPECT_TRUE((*json)["tiers"]["observed"].contains(key)) << key;
+  const Result<EvalResult> again = ReadMetricsFile(dir / "out.json");
+  ASSERT_TRUE(again.ok()) << again.status().message();
+  EXPECT_DOUBLE_EQ(*again->tiers[TierIndex(Tier::kFar)].id_cosine, 0.85);
+  EXPECT_EQ(again->tiers[TierIndex(Tier::kFar)].count, 3);
+  const std::string table = again->Table();
+  EXPECT_NE(table.find("observed"), std::string::npos);
+  EXPECT_NE(table.find("21.00"), std::string::npos);
+  EXPECT_NE(table.find("50%"), std::string::npos);
+  fs::remove_all(dir);
+}
+
+TEST(EvaluateTest, MetricsFileErrorsNameTheField) {
+  const fs::path dir = TempDir("errors");
+  std::string text = kHandMade;
+  text.replace(text.find("\"tier\": \"far\""), 13, "\"tier\": \"farther\"");
+  ASSERT_TRUE(WriteFileAtomic(dir / "bad.json", text).ok());
+  Result<EvalResult> r = ReadMetricsFile(dir / "bad.json");
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.status().message().find("frames[2].tier"), std::string::npos) << r.status().message();
+
+  text = kHandMade;
+  text.replace(text.find("\"psnr\": 22.0"), 12, "\"psnr\": \"x\"");
+  ASSERT_TRUE(WriteFileAtomic(dir / "bad2.json", text).ok());
+  r = ReadMetricsFile(dir / "bad2.json");
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.status().message().find("frames[1].psnr"), std::string::npos) << r.status().message();
+  fs::remove_all(dir);
+}
+
+// A tiny model trained for a few steps on a tiny synthetic dataset, evaluated end to end.
+TEST(EvaluateTest, EvaluatesTinyTrainedModel) {
+  const fs::path dir = TempDir("model");
+  const Executor executor(2);
+  synth::SynthOptions so;
+  so.out_dir = dir / "data";
+  so.num_train = 3;
+  so.resolution = 32;
+  so.test_views = 1;
+  so.novel_per_tier = 1;
+  so.render.supersample = 1;
+  Dataset written;
+  ASSERT_TRUE(synth::SynthesizeDataset(so, executor, nullptr, &written).ok());
+  Result<Dataset> dataset = LoadDataset(so.out_dir);
+  ASSERT_TRUE(dataset.ok()) << dataset.status().message();
+
+  RunConfig config;
+  config.model.method = "icef";
+  config.model.grid_levels = 4;
+  config.model.grid_log2_table_size = 10;
+  config.model.grid_finest_resolution = 32;
+  config.model.density_hidden = 16;
+  config.model.color_hidden = {16};
+  config.model.deform_hidden = {16, 16};
+  config.model.samples_per_ray = 16;
+  config.model.occupancy_resolution = 16;
+  config.train.steps = 5;
+  config.train.batch_rays = 256;
+  config.train.checkpoint_every = 0;
+  config.train.threads = 2;
+  Result<std::unique_ptr<Trainer>> trainer = Trainer::Create(*dataset, dir / "model", config);
+  ASSERT_TRUE(trainer.ok()) << trainer.status().message();
+  ASSERT_TRUE((*trainer)->Run(nullptr, nullptr).ok());
+  const AvatarModel& model = (*trainer)->model();
+
+  EvalOptions options;
+  options.out_dir = dir / "eval";
+  EvalNetworks networks;  // no identity network, no LPIPS: those metrics must be null
+  networks.identity_note = "test";
+  const Result<EvalResult> result = EvaluateModel(model, *dataset, options, networks, executor, nullptr);
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  EXPECT_EQ(result->method, "icef");
+  ASSERT_EQ(result->frames.size(), dataset->test.size());
+  int total = 0;
+  for (Tier t : AllTiers()) total += result->tiers[TierIndex(t)].count;
+  EXPECT_EQ(total, static_cast<int>(dataset->test.size()));
+  EXPECT_EQ(result->tiers[TierIndex(Tier::kObserved)].count, 3);
+  EXPECT_EQ(result->tiers[TierIndex(Tier::kFar)].count, 1);
+  EXPECT_FALSE(result->identity_available);
+  for (size_t i = 0; i < result->frames.size(); ++i) {
+    const FrameMetrics& f = result->frames[i];
+    const Frame& frame = dataset->test[i];
+    EXPECT_EQ(f.file_path, frame.file_path);
+    EXPECT_EQ(f.tier, *frame.tier);
+    EXPECT_DOUBLE_EQ(f.delta, *frame.delta);
+    EXPECT_FALSE(f.lpips.has_value());
+    EXPECT_FALSE(f.id_distance.has_value());
+    ASSERT_TRUE(f.psnr.has_value());
+    ASSERT_TRUE(f.ssim.has_value());
+    EXPECT_TRUE(fs::exists(options.out_dir / f.render_path)) << f.render_path;
+    // The same numbers from an independent render at the frame's camera and expression.
+    const RenderedImage r = RenderImage(model, frame.camera, frame.expression, dataset->background, executor);
+    const Image gt = CompositeOver(*LoadFrameImage(*dataset, frame), dataset->background);
+    EXPECT_DOUBLE_EQ(*f.psnr, *Psnr(r.color, gt));
+    EXPECT_DOUBLE_EQ(*f.ssim, *Ssim(r.color, gt));
+    EXPECT_NEAR(f.model_delta, *frame.delta, 1e-5);
+    EXPECT_EQ(f.nearest_index, r.nearest.index);
+  }
+  EXPECT_TRUE(fs::exists(options.out_dir / "renders" / "neutral_000.png"));
+
+  // With the face-identity network (when installed): identity metrics on every frame where a
+  // face chip could be made (the dataset has landmarks, so all of them).
+  Result<FaceIdentity> identity = FaceIdentity::Load({});
+  if (identity.ok()) {
+    networks.identity = &*identity;
+    options.out_dir.clear();
+    const Result<EvalResult> with_id = EvaluateModel(model, *dataset, options, networks, executor, nullptr);
+    ASSERT_TRUE(with_id.ok()) << with_id.status().message();
+    EXPECT_TRUE(with_id->identity_available);
+    for (const FrameMetrics& f : with_id->frames) {
+      EXPECT_EQ(f.landmarks, "dataset");
+      ASSERT_TRUE(f.id_distance_gt.has_value());
+      EXPECT_GE(*f.id_distance_gt, 0.0);
+      if (f.id_distance) {
+        EXPECT_GE(*f.id_distance, 0.0);
+        EXPECT_LE(*f.id_cosine, 1.0 + 1e-9);
+      }
+    }
+    EXPECT_EQ(with_id->identity_missing + with_id->tiers[0].id_count + with_id->tiers[1].id_count +
+                  with_id->tiers[2].id_count + with_id->tiers[3].id_count,
+              static_cast<int>(with_id->frames.size()));
+  }
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace icef::eval

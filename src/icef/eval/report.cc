@@ -1,0 +1,547 @@
+#include "icef/eval/report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <set>
+#include <sstream>
+#include <cstdlib>
+
+#include "icef/core/progress.h"
+
+#include "icef/io/atomic_file.h"
+#include "icef/model/method.h"
+
+namespace fs = std::filesystem;
+
+namespace icef::eval {
+
+std::string RunId::Name() const { return "id" + std::to_string(identity_seed) + "_k" + std::to_string(k) + "_" + method; }
+
+const std::array<Metric, kNumMetrics>& AllMetrics() {
+  static const std::array<Metric, kNumMetrics> kAll = {Metric::kPsnr,       Metric::kSsim,          Metric::kLpips,
+                                                       Metric::kIdCosine,   Metric::kIdDistance,    Metric::kIdDistanceGt,
+                                                       Metric::kIdShareUnder06};
+  return kAll;
+}
+
+const char* MetricName(Metric m) {
+  switch (m) {
+    case Metric::kPsnr: return "psnr";
+    case Metric::kSsim: return "ssim";
+    case Metric::kLpips: return "lpips";
+    case Metric::kIdCosine: return "id_cosine";
+    case Metric::kIdDistance: return "id_distance";
+    case Metric::kIdDistanceGt: return "id_distance_gt";
+    case Metric::kIdShareUnder06: return "id_share_under_0_6";
+  }
+  return "?";
+}
+
+const char* MetricLabel(Metric m) {
+  switch (m) {
+    case Metric::kPsnr: return "PSNR, dB (higher = better)";
+    case Metric::kSsim: return "SSIM (higher = better)";
+    case Metric::kLpips: return "LPIPS (lower = better)";
+    case Metric::kIdCosine: return "identity cosine to own neutral render (higher = better)";
+    case Metric::kIdDistance: return "identity distance to own neutral render (lower = better)";
+    case Metric::kIdDistanceGt: return "identity distance to ground truth (lower = better)";
+    case Metric::kIdShareUnder06: return "share of renders under 0.6 from own neutral (higher = better)";
+  }
+  return "?";
+}
+
+bool HigherIsBetter(Metric m) {
+  return m == Metric::kPsnr || m == Metric::kSsim || m == Metric::kIdCosine || m == Metric::kIdShareUnder06;
+}
+
+std::optional<double> TierValue(const TierMetrics& t, Metric m) {
+  switch (m) {
+    case Metric::kPsnr: return t.psnr;
+    case Metric::kSsim: return t.ssim;
+    case Metric::kLpips: return t.lpips;
+    case Metric::kIdCosine: return t.id_cosine;
+    case Metric::kIdDistance: return t.id_distance;
+    case Metric::kIdDistanceGt: return t.id_distance_gt;
+    case Metric::kIdShareUnder06: return t.id_share_under_0_6;
+  }
+  return std::nullopt;
+}
+
+std::optional<Spread> Spread::Of(const std::vector<double>& values) {
+  if (values.empty()) return std::nullopt;
+  Spread s;
+  s.n = static_cast<int>(values.size());
+  double sum = 0;
+  s.min = s.max = values[0];
+  for (double v : values) sum += v, s.min = std::min(s.min, v), s.max = std::max(s.max, v);
+  s.mean = sum / s.n;
+  if (s.n > 1) {
+    double ss = 0;
+    for (double v : values) ss += (v - s.mean) * (v - s.mean);
+    s.std = std::sqrt(ss / (s.n - 1));
+  }
+  return s;
+}
+
+Json Spread::ToJson() const { return Json{{"n", n}, {"mean", mean}, {"std", std}, {"min", min}, {"max", max}}; }
+
+Json Comparison::ToJson() const {
+  return Json{{"k", k},
+              {"other", other},
+              {"metric", MetricName(metric)},
+              {"icef_mean", icef_mean},
+              {"other_mean", other_mean},
+              {"icef_better", icef_better},
+              {"paired_identities", paired},
+              {"icef_wins", icef_wins}};
+}
+
+const AggregateCell* Aggregate::Find(int k, const std::string& method, Tier tier) const {
+  for (const AggregateCell& c : cells)
+    if (c.k == k && c.method == method && c.tier == tier) return &c;
+  return nullptr;
+}
+
+namespace {
+
+int MethodOrder(const std::string& name) {
+  const auto& all = AllMethods();
+  for (size_t i = 0; i < all.size(); ++i)
+    if (name == MethodName(all[i])) return static_cast<int>(i);
+  return static_cast<int>(all.size());
+}
+
+bool MethodLess(const std::string& a, const std::string& b) {
+  const int oa = MethodOrder(a), ob = MethodOrder(b);
+  return oa != ob ? oa < ob : a < b;
+}
+
+std::string Pm(const std::optional<Spread>& s, const char* format) {
+  if (!s) return "-";
+  char m[32], d[32], lo[32], hi[32];
+  std::snprintf(m, sizeof m, format, s->mean);
+  if (s->n == 1) return m;
+  std::snprintf(d, sizeof d, format, s->std);
+  std::snprintf(lo, sizeof lo, format, s->min);
+  std::snprintf(hi, sizeof hi, format, s->max);
+  return std::string(m) + " ± " + d + " [" + lo + ", " + hi + "]";
+}
+
+const char* MetricFormat(Metric m) {
+  switch (m) {
+    case Metric::kPsnr: return "%.2f";
+    case Metric::kIdShareUnder06: return "%.2f";
+    case Metric::kIdCosine: return "%.4f";
+    default: return "%.3f";
+  }
+}
+
+const std::vector<std::string>& Baselines() {
+  static const std::vector<std::string> kBaselines = {"warp", "nerface"};
+  return kBaselines;
+}
+
+}  // namespace
+
+Aggregate AggregateRuns(const std::vector<RunRecord>& runs) {
+  Aggregate a;
+  std::set<int> ks;
+  std::set<uint64_t> ids;
+  std::vector<std::string> methods;
+  for (const RunRecord& r : runs) {
+    ks.insert(r.id.k);
+    ids.insert(r.id.identity_seed);
+    if (std::find(methods.begin(), methods.end(), r.id.method) == methods.end()) methods.push_back(r.id.method);
+  }
+  std::sort(methods.begin(), methods.end(), MethodLess);
+  a.ks.assign(ks.begin(), ks.end());
+  a.identities.assign(ids.begin(), ids.end());
+  a.methods = methods;
+
+  // (k, method) -> runs in identity order.
+  std::map<std::pair<int, std::string>, std::vector<const RunRecord*>> by_cell;
+  for (const RunRecord& r : runs) by_cell[{r.id.k, r.id.method}].push_back(&r);
+  for (auto& [key, list] : by_cell)
+    std::sort(list.begin(), list.end(),
+              [](const RunRecord* x, const RunRecord* y) { return x->id.identity_seed < y->id.identity_seed; });
+
+  for (int k : a.ks)
+    for (const std::string& method : a.methods) {
+      const auto it = by_cell.find({k, method});
+      if (it == by_cell.end()) continue;
+      for (Tier tier : AllTiers()) {
+        AggregateCell cell;
+        cell.k = k;
+        cell.method = method;
+        cell.tier = tier;
+        std::vector<double> deltas;
+        std::array<std::vector<double>, kNumMetrics> values;
+        for (const RunRecord* r : it->second) {
+          const TierMetrics& t = r->metrics.tiers[TierIndex(tier)];
+          if (t.count == 0) continue;
+          ++cell.runs;
+          cell.frames += t.count;
+          deltas.push_back(t.mean_delta);
+          for (Metric m : AllMetrics())
+            if (const std::optional<double> v = TierValue(t, m)) values[static_cast<int>(m)].push_back(*v);
+        }
+        cell.delta = Spread::Of(deltas);
+        for (int m = 0; m < kNumMetrics; ++m) cell.metrics[m] = Spread::Of(values[m]);
+        a.cells.push_back(std::move(cell));
+      }
+    }
+
+  // Far tier: icef against every other method, per K, on PSNR and identity similarity.
+  const Metric compared[] = {Metric::kPsnr, Metric::kIdDistance, Metric::kIdCosine};
+  for (int k : a.ks) {
+    const auto icef_runs = by_cell.find({k, "icef"});
+    if (icef_runs == by_cell.end()) continue;
+    for (const std::string& other : a.methods) {
+      if (other == "icef") continue;
+      const auto other_runs = by_cell.find({k, other});
+      if (other_runs == by_cell.end()) continue;
+      for (Metric m : compared) {
+        const AggregateCell* ci = a.Find(k, "icef", Tier::kFar);
+        const AggregateCell* co = a.Find(k, other, Tier::kFar);
+        if (!ci || !co || !ci->Get(m) || !co->Get(m)) continue;
+        Comparison c;
+        c.k = k;
+        c.other = other;
+        c.metric = m;
+        c.icef_mean = ci->Get(m)->mean;
+        c.other_mean = co->Get(m)->mean;
+        c.icef_better = HigherIsBetter(m) ? c.icef_mean > c.other_mean : c.icef_mean < c.other_mean;
+        for (const RunRecord* ri : icef_runs->second)
+          for (const RunRecord* ro : other_runs->second) {
+            if (ri->id.identity_seed != ro->id.identity_seed) continue;
+            const auto vi = TierValue(ri->metrics.tiers[TierIndex(Tier::kFar)], m);
+            const auto vo = TierValue(ro->metrics.tiers[TierIndex(Tier::kFar)], m);
+            if (!vi || !vo) continue;
+            ++c.paired;
+            if (HigherIsBetter(m) ? *vi > *vo : *vi < *vo) ++c.icef_wins;
+          }
+        a.far_comparisons.push_back(c);
+      }
+    }
+  }
+  return a;
+}
+
+std::vector<std::string> Verdict(const Aggregate& a) {
+  std::vector<std::string> lines;
+  std::vector<std::string> baselines;
+  for (const std::string& b : Baselines())
+    if (std::find(a.methods.begin(), a.methods.end(), b) != a.methods.end()) baselines.push_back(b);
+  const bool has_icef = std::find(a.methods.begin(), a.methods.end(), "icef") != a.methods.end();
+  if (!has_icef || baselines.empty()) {
+    lines.push_back("No verdict: the bench did not run icef together with a baseline (warp, nerface).");
+    return lines;
+  }
+  auto describe = [&](Metric m, const char* what) {
+    int cells = 0, better = 0;
+    std::string detail;
+    for (int k : a.ks)
+      for (const std::string& b : baselines)
+        for (const Comparison& c : a.far_comparisons) {
+          if (c.k != k || c.other != b || c.metric != m) continue;
+          ++cells;
+          if (c.icef_better) ++better;
+          char buf[256];
+          std::snprintf(buf, sizeof buf, "%sK=%d vs %s: %s (%s %s vs %s; icef better in %d/%d identities)",
+                        detail.empty() ? "" : "; ", k, b.c_str(), c.icef_better ? "better" : "not better",
+                        MetricName(m), Pm(a.Find(k, "icef", Tier::kFar)->Get(m), MetricFormat(m)).c_str(),
+                        Pm(a.Find(k, b, Tier::kFar)->Get(m), MetricFormat(m)).c_str(), c.icef_wins, c.paired);
+          detail += buf;
+        }
+    if (cells == 0) {
+      lines.push_back(std::string("**") + what + "**: not measured in the far tier (no values).");
+      return;
+    }
+    std::string head;
+    if (better == cells)
+      head = "icef **beats** the baselines in every far-tier comparison";
+    else if (better == 0)
+      head = "icef does **not** beat the baselines in any far-tier comparison";
+    else
+      head = "icef beats the baselines in **" + std::to_string(better) + " of " + std::to_string(cells) +
+             "** far-tier comparisons only";
+    lines.push_back(std::string("**") + what + "** (" + MetricName(m) + ", mean ± std [min, max] over identities): " +
+                    head + ". " + detail + ".");
+  };
+  describe(Metric::kIdDistance, "Identity similarity");
+  describe(Metric::kIdCosine, "Identity similarity (cosine)");
+  describe(Metric::kPsnr, "PSNR");
+  return lines;
+}
+
+std::string ReportMarkdown(const Aggregate& a, const std::vector<RunRecord>& runs, const ReportContext& ctx,
+                           const std::vector<std::string>& plots) {
+  std::ostringstream s;
+  s << "# " << ctx.title << "\n\n";
+  s << "Generated by `icef bench` from " << runs.size() << " runs (every number below is computed from the runs' "
+    << "`metrics.json` files; `report.json` holds the same numbers).\n\n";
+  s << "- identities (seeds): ";
+  for (size_t i = 0; i < a.identities.size(); ++i) s << (i ? ", " : "") << a.identities[i];
+  s << "\n- K (training frames): ";
+  for (size_t i = 0; i < a.ks.size(); ++i) s << (i ? ", " : "") << a.ks[i];
+  s << "\n- methods: ";
+  for (size_t i = 0; i < a.methods.size(); ++i) s << (i ? ", " : "") << "`" << a.methods[i] << "`";
+  s << "\n";
+  if (ctx.wall_seconds > 0) s << "- bench wall time: " << ProgressBar::FormatDuration(ctx.wall_seconds) << "\n";
+  double train_total = 0;
+  int64_t steps_min = -1, steps_max = -1;
+  for (const RunRecord& r : runs) {
+    train_total += r.train_seconds;
+    steps_min = steps_min < 0 ? r.train_steps : std::min(steps_min, r.train_steps);
+    steps_max = std::max(steps_max, r.train_steps);
+  }
+  if (!runs.empty()) {
+    s << "- training: " << (steps_min == steps_max ? std::to_string(steps_min) : std::to_string(steps_min) + "-" + std::to_string(steps_max))
+      << " steps per run, " << ProgressBar::FormatDuration(train_total) << " of training in all ("
+      << ProgressBar::FormatDuration(train_total / runs.size()) << " per run on average)\n";
+  }
+  if (!ctx.settings.empty()) s << "- settings: `" << ctx.settings.dump() << "`\n";
+  s << "\n## Verdict (far tier, computed)\n\n";
+  for (const std::string& line : Verdict(a)) s << "- " << line << "\n";
+  s << "\n## Methods and caveats\n\n"
+    << "- `icef`: deformation + static canonical field + L_id + L_smooth + confidence-weighted warping; "
+    << "`icef-no-id` and `icef-no-conf` are its ablations.\n"
+    << "- Baselines are stand-ins built on the same engine: `warp` (a single learned warp, no identity losses, "
+    << "no confidence) stands in for FDNeRF-style deformation methods, `nerface` (expression concatenated into "
+    << "the radiance field, no warp) for NeRFFaceEditing/NerFace-style entangled methods. **FDNeRF and "
+    << "NeRFFaceEditing proper are not available here and were not run.**\n"
+    << "- Identity: dlib's ResNet face descriptor; `id_distance` / `id_cosine` compare a render with the model's "
+    << "own neutral (expression zero) render of the same view (the paper's drift measure); `id_distance_gt` "
+    << "compares it with the ground-truth image. 0.6 is the network's same-person threshold. For scale: "
+    << "different real people have a median cosine of about 0.84 on this network, the same person 0.93-0.99.\n";
+  bool lpips = false;
+  for (const RunRecord& r : runs) lpips = lpips || r.metrics.lpips_available;
+  if (!lpips) s << "- LPIPS: unavailable (no weights file given), reported as `-` / null.\n";
+  int id_missing = 0, frames = 0;
+  bool id_unavailable = false;
+  for (const RunRecord& r : runs) {
+    id_missing += r.metrics.identity_missing;
+    frames += static_cast<int>(r.metrics.frames.size());
+    id_unavailable = id_unavailable || !r.metrics.identity_available;
+  }
+  if (id_unavailable) s << "- Identity metrics unavailable in some runs (face-identity model not installed).\n";
+  if (id_missing > 0)
+    s << "- No face could be aligned in " << id_missing << " of " << frames
+      << " evaluated frames; their identity metrics are null and left out of the means.\n";
+  for (const std::string& n : ctx.notes) s << "- " << n << "\n";
+
+  s << "\n## Results\n\nCells: mean ± sample std [min, max] over identities of the per-run tier means; "
+    << "`runs` = identities contributing, `delta` = mean expression distance of the tier's frames.\n";
+  for (int k : a.ks) {
+    s << "\n### K = " << k << "\n\n| tier | method | runs | delta |";
+    for (Metric m : AllMetrics()) s << " " << MetricName(m) << " |";
+    s << "\n|---|---|---|---|";
+    for (int i = 0; i < kNumMetrics; ++i) s << "---|";
+    s << "\n";
+    for (Tier tier : AllTiers())
+      for (const std::string& method : a.methods) {
+        const AggregateCell* c = a.Find(k, method, tier);
+        if (!c || c->runs == 0) continue;
+        char d[32];
+        std::snprintf(d, sizeof d, "%.2f", c->delta ? c->delta->mean : 0.0);
+        s << "| " << TierName(tier) << " | `" << method << "` | " << c->runs << " | " << d << " |";
+        for (Metric m : AllMetrics()) s << " " << Pm(c->Get(m), MetricFormat(m)) << " |";
+        s << "\n";
+      }
+  }
+  if (!plots.empty()) {
+    s << "\n## Plots\n\nEach metric against delta (x = mean delta of each tier), one line per method, error bars "
+      << "= std over identities; one panel per K. SVG versions beside the PNGs.\n\n";
+    for (const std::string& p : plots) s << "![" << p << "](" << p << ")\n\n";
+  }
+  s << "\n## Runs\n\n| run | steps | train | eval | frames | no face |\n|---|---|---|---|---|---|\n";
+  for (const RunRecord& r : runs)
+    s << "| " << r.id.Name() << " | " << r.train_steps << " | " << ProgressBar::FormatDuration(r.train_seconds)
+      << " | " << ProgressBar::FormatDuration(r.eval_seconds) << " | " << r.metrics.frames.size() << " | "
+      << r.metrics.identity_missing << " |\n";
+  return s.str();
+}
+
+Json ReportJson(const Aggregate& a, const std::vector<RunRecord>& runs, const ReportContext& ctx) {
+  Json j;
+  j["title"] = ctx.title;
+  j["settings"] = ctx.settings;
+  if (ctx.wall_seconds > 0) j["wall_seconds"] = ctx.wall_seconds;
+  j["identities"] = a.identities;
+  j["ks"] = a.ks;
+  j["methods"] = a.methods;
+  Json cells = Json::array();
+  for (const AggregateCell& c : a.cells) {
+    Json cj;
+    cj["k"] = c.k;
+    cj["method"] = c.method;
+    cj["tier"] = TierName(c.tier);
+    cj["runs"] = c.runs;
+    cj["frames"] = c.frames;
+    cj["delta"] = c.delta ? c.delta->ToJson() : Json(nullptr);
+    for (Metric m : AllMetrics()) cj[MetricName(m)] = c.Get(m) ? c.Get(m)->ToJson() : Json(nullptr);
+    cells.push_back(std::move(cj));
+  }
+  j["aggregate"] = std::move(cells);
+  Json comps = Json::array();
+  for (const Comparison& c : a.far_comparisons) comps.push_back(c.ToJson());
+  j["far_comparisons"] = std::move(comps);
+  j["verdict"] = Verdict(a);
+  Json rj = Json::array();
+  for (const RunRecord& r : runs)
+    rj.push_back(Json{{"name", r.id.Name()},
+                      {"identity_seed", r.id.identity_seed},
+                      {"k", r.id.k},
+                      {"method", r.id.method},
+                      {"train_steps", r.train_steps},
+                      {"train_seconds", r.train_seconds},
+                      {"eval_seconds", r.eval_seconds},
+                      {"identity_missing", r.metrics.identity_missing}});
+  j["runs"] = std::move(rj);
+  return j;
+}
+
+Json RunRecordJson(const RunRecord& r) {
+  Json j = r.metrics.ToJson();
+  j["run"] = Json{{"identity_seed", r.id.identity_seed}, {"k", r.id.k},
+                  {"method", r.id.method},               {"train_steps", r.train_steps},
+                  {"train_seconds", r.train_seconds},    {"eval_seconds", r.eval_seconds}};
+  return j;
+}
+
+Result<RunRecord> ReadRunRecord(const fs::path& path) {
+  ICEF_ASSIGN_OR_RETURN(const Json j, ReadJsonFile(path));
+  RunRecord r;
+  ICEF_ASSIGN_OR_RETURN(r.metrics, EvalResult::FromJson(j, path.string()));
+  const auto run = j.find("run");
+  if (run == j.end() || !run->is_object()) return Status::Error(path.string() + ": run: missing (not a bench run)");
+  ICEF_ASSIGN_OR_RETURN(const JsonObjectView v, JsonObjectView::Make(*run, path.string(), "run"));
+  ICEF_ASSIGN_OR_RETURN(const double seed, v.Number("identity_seed"));
+  if (seed < 0 || seed != std::floor(seed)) return v.Error("identity_seed", "expected a non-negative integer");
+  r.id.identity_seed = static_cast<uint64_t>(seed);
+  ICEF_ASSIGN_OR_RETURN(r.id.k, v.Int("k"));
+  ICEF_ASSIGN_OR_RETURN(r.id.method, v.String("method"));
+  ICEF_ASSIGN_OR_RETURN(const double steps, v.Number("train_steps"));
+  r.train_steps = static_cast<int64_t>(steps);
+  ICEF_ASSIGN_OR_RETURN(r.train_seconds, v.Number("train_seconds"));
+  ICEF_ASSIGN_OR_RETURN(r.eval_seconds, v.Number("eval_seconds"));
+  if (r.id.method != r.metrics.method)
+    return Status::Error(path.string() + ": run.method '" + r.id.method + "' differs from method '" +
+                         r.metrics.method + "'");
+  return r;
+}
+
+Result<std::vector<RunRecord>> ReadRunRecords(const fs::path& dir) {
+  std::vector<RunRecord> out;
+  const fs::path runs_dir = dir / "runs";
+  std::error_code ec;
+  if (!fs::is_directory(runs_dir, ec)) return out;
+  std::vector<fs::path> files;
+  for (const fs::directory_entry& e : fs::directory_iterator(runs_dir, ec))
+    if (e.is_directory() && fs::exists(e.path() / "metrics.json")) files.push_back(e.path() / "metrics.json");
+  if (ec) return Status::Error(runs_dir.string() + ": cannot list: " + ec.message());
+  for (const fs::path& f : files) {
+    ICEF_ASSIGN_OR_RETURN(RunRecord r, ReadRunRecord(f));
+    out.push_back(std::move(r));
+  }
+  std::sort(out.begin(), out.end(), [](const RunRecord& x, const RunRecord& y) {
+    if (x.id.identity_seed != y.id.identity_seed) return x.id.identity_seed < y.id.identity_seed;
+    if (x.id.k != y.id.k) return x.id.k < y.id.k;
+    return MethodLess(x.id.method, y.id.method);
+  });
+  return out;
+}
+
+namespace {
+
+std::string ShellQuote(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+// The gnuplot commands drawing one metric: one panel per K, one line per method.
+std::string PlotCommands(const Aggregate& a, Metric m, const std::string& dat) {
+  std::ostringstream s;
+  s << "set multiplot layout 1," << a.ks.size() << " title \"" << MetricName(m) << " against delta (mean +- std over "
+    << a.identities.size() << " identities)\"\n";
+  s << "set xlabel \"delta (distance to the nearest training expression)\"\n";
+  s << "set ylabel \"" << MetricLabel(m) << "\"\nset grid\nset key bottom left\nset offsets 0.05, 0.05, 0, 0\n";
+  for (size_t ki = 0; ki < a.ks.size(); ++ki) {
+    s << "set title \"K = " << a.ks[ki] << "\"\nplot ";
+    for (size_t mi = 0; mi < a.methods.size(); ++mi) {
+      s << (mi ? ", " : "") << "'" << dat << "' index " << ki * a.methods.size() + mi
+        << " using 1:2:3 with yerrorlines lw 2 pt 7 title \"" << a.methods[mi] << "\"";
+    }
+    s << "\n";
+  }
+  s << "unset multiplot\n";
+  return s.str();
+}
+
+}  // namespace
+
+Result<std::vector<std::string>> WritePlots(const fs::path& dir, const Aggregate& a, std::string* note) {
+  std::vector<std::string> pngs;
+  if (a.ks.empty() || a.methods.empty()) return pngs;
+  const fs::path plot_dir = dir / "plots";
+  std::error_code ec;
+  fs::create_directories(plot_dir, ec);
+  if (ec) return Status::Error(plot_dir.string() + ": cannot create directory: " + ec.message());
+  const bool have_gnuplot = std::system("command -v gnuplot >/dev/null 2>&1") == 0;
+  const int width = 380 * static_cast<int>(a.ks.size()) + 80;
+  for (Metric m : AllMetrics()) {
+    bool any = false;
+    std::ostringstream dat;
+    dat.precision(9);
+    dat << "# " << MetricName(m) << ": blocks per (K, method) in order; columns: mean delta, mean, std, min, max, runs\n";
+    for (int k : a.ks)
+      for (const std::string& method : a.methods) {
+        dat << "# K=" << k << " method=" << method << "\n";
+        bool rows = false;
+        for (Tier tier : AllTiers()) {
+          const AggregateCell* c = a.Find(k, method, tier);
+          if (!c || !c->Get(m) || !c->delta) continue;
+          const Spread v = *c->Get(m);
+          dat << c->delta->mean << " " << v.mean << " " << v.std << " " << v.min << " " << v.max << " " << v.n << "\n";
+          rows = any = true;
+        }
+        if (!rows) dat << "NaN NaN NaN NaN NaN 0\n";
+        dat << "\n\n";
+      }
+    if (!any) continue;
+    const std::string name = MetricName(m);
+    ICEF_RETURN_IF_ERROR(WriteFileAtomic(plot_dir / (name + ".dat"), dat.str()));
+    const std::string commands = PlotCommands(a, m, name + ".dat");
+    std::ostringstream gp;
+    gp << "# gnuplot " << name << ".gp (run in this directory) draws " << name << ".png and " << name << ".svg\n"
+       << "set terminal pngcairo size " << width << ",420 font \"sans,9\"\nset output \"" << name << ".png\"\n"
+       << commands << "set terminal svg size " << width << ",420 font \"sans,9\"\nset output \"" << name
+       << ".svg\"\n" << commands;
+    ICEF_RETURN_IF_ERROR(WriteFileAtomic(plot_dir / (name + ".gp"), gp.str()));
+    if (!have_gnuplot) continue;
+    const std::string cmd = "cd " + ShellQuote(plot_dir.string()) + " && gnuplot " + ShellQuote(name + ".gp") +
+                            " >" + ShellQuote(name + ".log") + " 2>&1";
+    if (std::system(cmd.c_str()) != 0)
+      return Status::Error((plot_dir / (name + ".gp")).string() + ": gnuplot failed (see " +
+                           (plot_dir / (name + ".log")).string() + ")");
+    fs::remove(plot_dir / (name + ".log"), ec);
+    pngs.push_back("plots/" + name + ".png");
+  }
+  if (!have_gnuplot && note)
+    *note = "Plots not drawn: gnuplot is not installed (apt-get install gnuplot-nox); run `gnuplot X.gp` in plots/.";
+  return pngs;
+}
+
+Status WriteReport(const fs::path& dir, const std::vector<RunRecord>& runs, ReportContext context) {
+  const Aggregate aggregate = AggregateRuns(runs);
+  std::string note;
+  ICEF_ASSIGN_OR_RETURN(const std::vector<std::string> plots, WritePlots(dir, aggregate, &note));
+  if (!note.empty()) context.notes.push_back(note);
+  ICEF_RETURN_IF_ERROR(WriteFileAtomic(dir / "report.md", ReportMarkdown(aggregate, runs, context, plots)));
+  return WriteFileAtomic(dir / "report.json", FormatJson(ReportJson(aggregate, runs, context)));
+}
+
+}  // namespace icef::eval

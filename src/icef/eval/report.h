@@ -1,0 +1,129 @@
+// The bench report (DESIGN.md §6): per tier, per method, per K, the mean and spread (sample std,
+// min, max) over identities of every metric, computed from the per-run metrics.json files; a
+// verdict on the paper's claim (does icef beat the baselines in the far tier on identity
+// similarity and PSNR?) derived from those numbers; written as report.md + report.json, and plots
+// of each metric against delta (one line per method, mean +- std over identities) drawn by gnuplot
+// as PNG + SVG.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "icef/eval/evaluate.h"
+#include "icef/io/json_util.h"
+
+namespace icef::eval {
+
+// One bench run: an identity seed, a number of training frames K and a method.
+struct RunId {
+  uint64_t identity_seed = 1;
+  int k = 3;
+  std::string method;
+  // Directory name under runs/: "id<seed>_k<K>_<method>", e.g. "id1_k3_icef".
+  std::string Name() const;
+  bool operator==(const RunId& o) const = default;
+};
+
+// A finished run: its metrics.json plus how it was trained.
+struct RunRecord {
+  RunId id;
+  EvalResult metrics;
+  int64_t train_steps = 0;
+  double train_seconds = 0;
+  double eval_seconds = 0;
+};
+
+// The metrics a report aggregates, in table order.
+enum class Metric { kPsnr, kSsim, kLpips, kIdCosine, kIdDistance, kIdDistanceGt, kIdShareUnder06 };
+constexpr int kNumMetrics = 7;
+const std::array<Metric, kNumMetrics>& AllMetrics();
+const char* MetricName(Metric metric);   // the metrics.json key, e.g. "id_distance"
+const char* MetricLabel(Metric metric);  // axis label, e.g. "identity distance to own neutral (lower = better)"
+bool HigherIsBetter(Metric metric);
+std::optional<double> TierValue(const TierMetrics& tier, Metric metric);
+
+// Mean and spread of values over identities.
+struct Spread {
+  int n = 0;
+  double mean = 0;
+  double std = 0;  // sample standard deviation (n - 1); 0 when n == 1
+  double min = 0;
+  double max = 0;
+  static std::optional<Spread> Of(const std::vector<double>& values);  // nullopt when empty
+  Json ToJson() const;
+};
+
+// One (K, method, tier) cell: spreads over the runs (identities) that have a value.
+struct AggregateCell {
+  int k = 0;
+  std::string method;
+  Tier tier = Tier::kObserved;
+  int runs = 0;                                          // runs contributing (identities)
+  int frames = 0;                                        // test frames over those runs
+  std::optional<Spread> delta;                           // of the runs' mean delta
+  std::array<std::optional<Spread>, kNumMetrics> metrics;
+  std::optional<Spread> Get(Metric m) const { return metrics[static_cast<int>(m)]; }
+};
+
+// The far-tier comparison of icef against one other method at one K, on one metric.
+struct Comparison {
+  int k = 0;
+  std::string other;
+  Metric metric = Metric::kPsnr;
+  double icef_mean = 0;
+  double other_mean = 0;
+  bool icef_better = false;  // by the mean, in the metric's direction
+  int paired = 0;            // identities with both values
+  int icef_wins = 0;         // of those, where icef is better
+  Json ToJson() const;
+};
+
+struct Aggregate {
+  std::vector<int> ks;                     // ascending
+  std::vector<std::string> methods;        // in AllMethods() order, then others by name
+  std::vector<uint64_t> identities;        // ascending
+  std::vector<AggregateCell> cells;        // k-major, then method, then tier
+  std::vector<Comparison> far_comparisons;  // icef vs every other method, far tier, per K
+  const AggregateCell* Find(int k, const std::string& method, Tier tier) const;
+};
+
+Aggregate AggregateRuns(const std::vector<RunRecord>& runs);
+
+// What the report says about the setup (copied into report.md / report.json).
+struct ReportContext {
+  std::string title = "ICEF benchmark";
+  Json settings = Json::object();        // bench options, shown verbatim
+  std::vector<std::string> notes;        // extra lines for report.md
+  double wall_seconds = 0;               // whole bench (0: not shown)
+};
+
+// The verdict lines (markdown bullets) derived from the far-tier comparisons against the
+// baselines warp and nerface; the ablations are reported separately.
+std::vector<std::string> Verdict(const Aggregate& aggregate);
+
+std::string ReportMarkdown(const Aggregate& aggregate, const std::vector<RunRecord>& runs, const ReportContext& context,
+                           const std::vector<std::string>& plots);
+Json ReportJson(const Aggregate& aggregate, const std::vector<RunRecord>& runs, const ReportContext& context);
+
+// Writes dir/plots/<metric>.{dat,gp,png,svg} (one panel per K, x = mean delta of each tier, one
+// line per method with std error bars) for each metric with values. Returns the PNG paths
+// relative to dir; when gnuplot is not installed, only the .dat/.gp files are written and
+// `*note` says so.
+Result<std::vector<std::string>> WritePlots(const std::filesystem::path& dir, const Aggregate& aggregate,
+                                            std::string* note);
+
+// Aggregates, plots and writes dir/report.md + dir/report.json.
+Status WriteReport(const std::filesystem::path& dir, const std::vector<RunRecord>& runs, ReportContext context);
+
+// Run records as stored under runs/<name>/metrics.json (metrics + a "run" object with
+// identity_seed, k, method, train_steps, train_seconds, eval_seconds).
+Json RunRecordJson(const RunRecord& record);
+Result<RunRecord> ReadRunRecord(const std::filesystem::path& metrics_path);
+// Every runs/*/metrics.json under dir, sorted by (identity, K, method order).
+Result<std::vector<RunRecord>> ReadRunRecords(const std::filesystem::path& dir);
+
+}  // namespace icef::eval

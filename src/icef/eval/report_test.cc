@@ -1,0 +1,197 @@
+#include "icef/eval/report.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include "icef/io/atomic_file.h"
+
+namespace icef::eval {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path TempDir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("icef_report_test_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+// A run whose far tier has the given PSNR and identity distance (cosine = 1 - distance / 2) and
+// whose observed tier has PSNR + 10.
+RunRecord MakeRun(uint64_t seed, int k, const std::string& method, double far_psnr, double far_id) {
+  RunRecord r;
+  r.id = RunId{seed, k, method};
+  r.metrics.method = method;
+  r.metrics.identity_available = true;
+  r.train_steps = 100;
+  r.train_seconds = 2.0;
+  r.eval_seconds = 0.5;
+  FrameMetrics obs;
+  obs.file_path = "o.png";
+  obs.tier = Tier::kObserved;
+  obs.psnr = far_psnr + 10;
+  obs.ssim = 0.9;
+  obs.id_distance = 0.1;
+  obs.id_cosine = 0.99;
+  obs.id_distance_gt = 0.2;
+  FrameMetrics far;
+  far.file_path = "f.png";
+  far.tier = Tier::kFar;
+  far.delta = 1.0 + 0.1 * seed;
+  far.psnr = far_psnr;
+  far.ssim = 0.5;
+  far.id_distance = far_id;
+  far.id_cosine = 1.0 - far_id / 2;
+  far.id_distance_gt = far_id + 0.1;
+  r.metrics.frames = {obs, far};
+  r.metrics.tiers = AggregateTiers(r.metrics.frames);
+  return r;
+}
+
+std::vector<RunRecord> ThreeIdentities() {
+  // icef: better identity than warp on all identities, worse PSNR on 2 of 3.
+  return {MakeRun(1, 3, "icef", 20, 0.30), MakeRun(2, 3, "icef", 22, 0.40), MakeRun(3, 3, "icef", 24, 0.50),
+          MakeRun(1, 3, "warp", 21, 0.50), MakeRun(2, 3, "warp", 23, 0.60), MakeRun(3, 3, "warp", 23, 0.70)};
+}
+
+TEST(ReportTest, SpreadOverIdentities) {
+  const auto s = Spread::Of({1.0, 2.0, 6.0});
+  ASSERT_TRUE(s.has_value());
+  EXPECT_EQ(s->n, 3);
+  EXPECT_DOUBLE_EQ(s->mean, 3.0);
+  EXPECT_DOUBLE_EQ(s->std, std::sqrt(7.0));  // sample std: (4 + 1 + 9) / 2
+  EXPECT_DOUBLE_EQ(s->min, 1.0);
+  EXPECT_DOUBLE_EQ(s->max, 6.0);
+  EXPECT_FALSE(Spread::Of({}).has_value());
+  EXPECT_DOUBLE_EQ(Spread::Of({4.0})->std, 0.0);
+}
+
+TEST(ReportTest, AggregatesPerKMethodTierAndComparesFarTier) {
+  const Aggregate a = AggregateRuns(ThreeIdentities());
+  EXPECT_EQ(a.ks, std::vector<int>({3}));
+  EXPECT_EQ(a.methods, std::vector<std::string>({"icef", "warp"}));  // AllMethods() order
+  EXPECT_EQ(a.identities, std::vector<uint64_t>({1, 2, 3}));
+  const AggregateCell* far = a.Find(3, "icef", Tier::kFar);
+  ASSERT_NE(far, nullptr);
+  EXPECT_EQ(far->runs, 3);
+  EXPECT_DOUBLE_EQ(far->Get(Metric::kPsnr)->mean, 22.0);
+  EXPECT_DOUBLE_EQ(far->Get(Metric::kPsnr)->std, 2.0);
+  EXPECT_DOUBLE_EQ(far->Get(Metric::kIdDistance)->mean, 0.4);
+  EXPECT_DOUBLE_EQ(far->Get(Metric::kIdDistance)->min, 0.3);
+  EXPECT_DOUBLE_EQ(far->Get(Metric::kIdDistance)->max, 0.5);
+  EXPECT_NEAR(far->delta->mean, 1.2, 1e-12);
+  EXPECT_DOUBLE_EQ(far->Get(Metric::kIdShareUnder06)->mean, 1.0);
+  EXPECT_FALSE(far->Get(Metric::kLpips).has_value());
+  const AggregateCell* warp_far = a.Find(3, "warp", Tier::kFar);
+  EXPECT_NEAR(warp_far->Get(Metric::kIdShareUnder06)->mean, 1.0 / 3.0, 1e-12);
+  const AggregateCell* near = a.Find(3, "icef", Tier::kNear);
+  ASSERT_NE(near, nullptr);
+  EXPECT_EQ(near->runs, 0);
+  EXPECT_FALSE(near->Get(Metric::kPsnr).has_value());
+
+  int checked = 0;
+  for (const Comparison& c : a.far_comparisons) {
+    EXPECT_EQ(c.other, "warp");
+    EXPECT_EQ(c.paired, 3);
+    if (c.metric == Metric::kPsnr) {
+      EXPECT_FALSE(c.icef_better);  // 22 vs 22.33
+      EXPECT_EQ(c.icef_wins, 1);    // identity 3: 24 > 23
+      ++checked;
+    } else if (c.metric == Metric::kIdDistance) {
+      EXPECT_TRUE(c.icef_better);
+      EXPECT_EQ(c.icef_wins, 3);
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, 2);
+
+  const std::vector<std::string> verdict = Verdict(a);
+  ASSERT_EQ(verdict.size(), 3u);
+  EXPECT_NE(verdict[0].find("icef **beats** the baselines"), std::string::npos) << verdict[0];
+  EXPECT_NE(verdict[0].find("better in 3/3 identities"), std::string::npos) << verdict[0];
+  EXPECT_NE(verdict[2].find("does **not** beat"), std::string::npos) << verdict[2];
+  EXPECT_NE(verdict[2].find("better in 1/3 identities"), std::string::npos) << verdict[2];
+}
+
+TEST(ReportTest, NoVerdictWithoutBaseline) {
+  const Aggregate a = AggregateRuns({MakeRun(1, 3, "icef", 20, 0.3), MakeRun(1, 3, "icef-no-id", 20, 0.4)});
+  const std::vector<std::string> verdict = Verdict(a);
+  ASSERT_EQ(verdict.size(), 1u);
+  EXPECT_NE(verdict[0].find("No verdict"), std::string::npos);
+}
+
+TEST(ReportTest, WritesMarkdownJsonAndPlots) {
+  const fs::path dir = TempDir("write");
+  const std::vector<RunRecord> runs = ThreeIdentities();
+  // Stored as bench runs and read back (sorted by identity, K, method).
+  for (auto it = runs.rbegin(); it != runs.rend(); ++it) {
+    fs::create_directories(dir / "runs" / it->id.Name());
+    ASSERT_TRUE(WriteFileAtomic(dir / "runs" / it->id.Name() / "metrics.json", FormatJson(RunRecordJson(*it))).ok());
+  }
+  const Result<std::vector<RunRecord>> read = ReadRunRecords(dir);
+  ASSERT_TRUE(read.ok()) << read.status().message();
+  ASSERT_EQ(read->size(), 6u);
+  EXPECT_EQ((*read)[0].id.Name(), "id1_k3_icef");
+  EXPECT_EQ((*read)[1].id.Name(), "id1_k3_warp");
+  EXPECT_EQ((*read)[5].id.Name(), "id3_k3_warp");
+  EXPECT_DOUBLE_EQ((*read)[0].train_seconds, 2.0);
+
+  ReportContext context;
+  context.settings = Json{{"steps", 100}};
+  ASSERT_TRUE(WriteReport(dir, *read, context).ok());
+  const Result<std::string> md = ReadFile(dir / "report.md");
+  ASSERT_TRUE(md.ok());
+  EXPECT_NE(md->find("## Verdict (far tier, computed)"), std::string::npos);
+  EXPECT_NE(md->find("FDNeRF and NeRFFaceEditing proper are not available"), std::string::npos);
+  EXPECT_NE(md->find("| far | `icef` | 3 | 1.20 | 22.00 ± 2.00 [20.00, 24.00] |"), std::string::npos) << *md;
+  EXPECT_NE(md->find("LPIPS: unavailable"), std::string::npos);
+  EXPECT_NE(md->find("| id2_k3_warp | 100 |"), std::string::npos);
+  const Result<Json> json = ReadJsonFile(dir / "report.json");
+  ASSERT_TRUE(json.ok());
+  bool found = false;
+  for (const Json& cell : (*json)["aggregate"])
+    if (cell["method"] == "warp" && cell["tier"] == "far") {
+      EXPECT_NEAR(cell["psnr"]["mean"].get<double>(), 67.0 / 3.0, 1e-12);
+      EXPECT_DOUBLE_EQ(cell["id_distance"]["max"].get<double>(), 0.7);
+      EXPECT_TRUE(cell["lpips"].is_null());
+      found = true;
+    }
+  EXPECT_TRUE(found);
+  EXPECT_EQ((*json)["runs"].size(), 6u);
+  EXPECT_EQ((*json)["verdict"].size(), 3u);
+  // Plot data: one block per (K, method), rows (delta, mean, std, ...) per tier with values.
+  const Result<std::string> dat = ReadFile(dir / "plots" / "psnr.dat");
+  ASSERT_TRUE(dat.ok());
+  EXPECT_NE(dat->find("# K=3 method=icef\n0 32 2 30 34 3\n1.2"), std::string::npos) << *dat;
+  EXPECT_FALSE(fs::exists(dir / "plots" / "lpips.dat"));  // no values, no plot
+  if (std::system("command -v gnuplot >/dev/null 2>&1") == 0) {
+    EXPECT_GT(fs::file_size(dir / "plots" / "psnr.png"), 1000u);
+    EXPECT_GT(fs::file_size(dir / "plots" / "id_distance.svg"), 1000u);
+    EXPECT_NE(md->find("![plots/psnr.png](plots/psnr.png)"), std::string::npos);
+  }
+  fs::remove_all(dir);
+}
+
+TEST(ReportTest, RunRecordErrors) {
+  const fs::path dir = TempDir("errors");
+  RunRecord r = MakeRun(1, 3, "icef", 20, 0.3);
+  Json j = RunRecordJson(r);
+  j.erase("run");
+  ASSERT_TRUE(WriteFileAtomic(dir / "a.json", FormatJson(j)).ok());
+  Result<RunRecord> read = ReadRunRecord(dir / "a.json");
+  ASSERT_FALSE(read.ok());
+  EXPECT_NE(read.status().message().find("run: missing"), std::string::npos);
+  j = RunRecordJson(r);
+  j["run"]["method"] = "warp";
+  ASSERT_TRUE(WriteFileAtomic(dir / "b.json", FormatJson(j)).ok());
+  read = ReadRunRecord(dir / "b.json");
+  ASSERT_FALSE(read.ok());
+  EXPECT_NE(read.status().message().find("differs"), std::string::npos);
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace icef::eval
