@@ -42,8 +42,8 @@ CommandFn RegisterBench(CLI::App& app) {
   app.add_option("--res", o.resolution, "Image width = height")->capture_default_str();
   app.add_option("--test-views", o.test_views, "Held-out test views per dataset")->capture_default_str();
   app.add_option("--novel-per-tier", o.novel_per_tier, "Novel test expressions per tier")->capture_default_str();
-  app.add_option("--steps", o.steps, "Training steps per run (same for every run)")->capture_default_str();
-  app.add_option("--time-budget", o.time_budget_seconds, "Training wall-clock budget per run, seconds (0 = none)")
+  app.add_option("--steps", o.steps, "Training steps per run (same for every run; alone: no time cap)")->capture_default_str();
+  app.add_option("--time-budget", o.time_budget_seconds, "Training wall-clock cap per run, seconds (0 = none)")
       ->capture_default_str();
   app.add_option("--config", o.config_path, "Base run config file (default: built-in defaults)");
   app.add_option("--set", o.overrides, "Config override for every run, e.g. train.batch_rays=2048 (repeatable)");
@@ -82,6 +82,8 @@ CommandFn RegisterBench(CLI::App& app) {
       if (self->count("--time-budget")) options.time_budget_seconds = given.time_budget_seconds;
       options.overrides.insert(options.overrides.end(), user.begin(), user.end());
     }
+    // --steps alone is a pure step budget (reproducible); the default caps steps by time.
+    if (self->count("--steps") && !self->count("--time-budget")) options.time_budget_seconds = 0;
     options.out_dir = args->out;
     if (!args->ks.empty()) {
       ICEF_ASSIGN_OR_RETURN(options.ks, eval::ParseIntList(args->ks, "--k"));

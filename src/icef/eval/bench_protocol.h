@@ -19,8 +19,11 @@
 
 namespace icef::eval {
 
-// Default training steps of every bench run (the same for every method).
+// Default training budget of every bench run (the same for every method): this many steps, but
+// no more than kDefaultBenchTimeBudget seconds of training, so that the default bench (45 runs at
+// 128x128) fits in about 90 minutes on a 2-core machine. The report gives the steps each run made.
 constexpr int64_t kDefaultBenchSteps = 1000;
+constexpr double kDefaultBenchTimeBudget = 90.0;
 
 struct BenchOptions {
   // Output directory (created): data/, runs/, plots/, report.md, report.json, bench.json.
@@ -42,7 +45,7 @@ struct BenchOptions {
   // Training steps per run (the same budget for every run).
   int64_t steps = kDefaultBenchSteps;
   // Wall-clock budget per run in seconds (0 = none; with it, steps is only an upper bound).
-  double time_budget_seconds = 0;
+  double time_budget_seconds = kDefaultBenchTimeBudget;
   // Base run config file ("" = built-in defaults); method, steps, budget, seed and threads are set per run.
   std::string config_path;
   // "section.key=value" overrides applied to every run's config (RunConfig::ApplyOverride).

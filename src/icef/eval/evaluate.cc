@@ -66,6 +66,7 @@ Json FrameMetrics::ToJson() const {
   j["id_cosine"] = OptionalJson(id_cosine);
   j["id_distance"] = OptionalJson(id_distance);
   j["id_distance_gt"] = OptionalJson(id_distance_gt);
+  j["id_distance_reference"] = OptionalJson(id_distance_reference);
   j["nearest_index"] = nearest_index;
   j["model_delta"] = model_delta;
   j["kappa"] = kappa;
@@ -96,6 +97,9 @@ Result<FrameMetrics> FrameMetrics::FromJson(const Json& j, const std::string& wh
   ICEF_ASSIGN_OR_RETURN(f.id_distance, OptionalNumber(j, where, "id_distance"));
   ICEF_ASSIGN_OR_RETURN(f.id_distance_gt, OptionalNumber(j, where, "id_distance_gt"));
   // Extras are optional (hand-written metrics files may omit them).
+  if (j.contains("id_distance_reference")) {
+    ICEF_ASSIGN_OR_RETURN(f.id_distance_reference, OptionalNumber(j, where, "id_distance_reference"));
+  }
   if (j.contains("nearest_index") && j["nearest_index"].is_number_integer()) f.nearest_index = j["nearest_index"].get<int>();
   if (j.contains("model_delta") && j["model_delta"].is_number()) f.model_delta = j["model_delta"].get<double>();
   if (j.contains("kappa") && j["kappa"].is_number()) f.kappa = j["kappa"].get<double>();
@@ -115,6 +119,7 @@ Json TierMetrics::ToJson() const {
   j["id_distance"] = OptionalJson(id_distance);
   j["id_distance_gt"] = OptionalJson(id_distance_gt);
   j["id_share_under_0_6"] = OptionalJson(id_share_under_0_6);
+  j["id_distance_reference"] = OptionalJson(id_distance_reference);
   j["id_count"] = id_count;
   j["mean_delta"] = mean_delta;
   return j;
@@ -133,6 +138,9 @@ Result<TierMetrics> TierMetrics::FromJson(const Json& j, const std::string& wher
   ICEF_ASSIGN_OR_RETURN(t.id_distance, OptionalNumber(j, where, "id_distance"));
   ICEF_ASSIGN_OR_RETURN(t.id_distance_gt, OptionalNumber(j, where, "id_distance_gt"));
   ICEF_ASSIGN_OR_RETURN(t.id_share_under_0_6, OptionalNumber(j, where, "id_share_under_0_6"));
+  if (j.contains("id_distance_reference")) {
+    ICEF_ASSIGN_OR_RETURN(t.id_distance_reference, OptionalNumber(j, where, "id_distance_reference"));
+  }
   if (j.contains("id_count") && j["id_count"].is_number_integer()) t.id_count = j["id_count"].get<int>();
   if (j.contains("mean_delta") && j["mean_delta"].is_number()) t.mean_delta = j["mean_delta"].get<double>();
   return t;
@@ -148,7 +156,7 @@ std::array<TierMetrics, kNumTiers> AggregateTiers(const std::vector<FrameMetrics
     std::optional<double> Mean() const { return n > 0 ? std::optional<double>(sum / n) : std::nullopt; }
   };
   struct TierAcc {
-    Acc psnr, ssim, lpips, id_cosine, id_distance, id_distance_gt, under, delta;
+    Acc psnr, ssim, lpips, id_cosine, id_distance, id_distance_gt, under, delta, reference;
   };
   std::array<TierAcc, kNumTiers> acc;
   std::array<TierMetrics, kNumTiers> out;
@@ -163,6 +171,7 @@ std::array<TierMetrics, kNumTiers> AggregateTiers(const std::vector<FrameMetrics
     a.id_cosine.Add(f.id_cosine);
     a.id_distance.Add(f.id_distance);
     a.id_distance_gt.Add(f.id_distance_gt);
+    a.reference.Add(f.id_distance_reference);
     if (f.id_distance) a.under.Add(*f.id_distance < kSamePersonThreshold ? 1.0 : 0.0);
   }
   for (int t = 0; t < kNumTiers; ++t) {
@@ -175,6 +184,7 @@ std::array<TierMetrics, kNumTiers> AggregateTiers(const std::vector<FrameMetrics
     m.id_distance = a.id_distance.Mean();
     m.id_distance_gt = a.id_distance_gt.Mean();
     m.id_share_under_0_6 = a.under.Mean();
+    m.id_distance_reference = a.reference.Mean();
     m.id_count = a.id_distance.n;
     m.mean_delta = a.delta.Mean().value_or(0.0);
   }
@@ -231,18 +241,21 @@ Result<EvalResult> EvalResult::FromJson(const Json& j, const std::string& origin
 std::string EvalResult::Table() const {
   std::ostringstream s;
   char line[256];
-  std::snprintf(line, sizeof line, "%-9s %5s %7s %6s %6s %9s %7s %9s %7s\n", "tier", "count", "psnr", "ssim", "lpips",
-                "id_cosine", "id_dist", "id_dist_gt", "id<0.6");
+  std::snprintf(line, sizeof line, "%-9s %5s %7s %6s %6s %9s %7s %10s %7s %7s\n", "tier", "count", "psnr", "ssim",
+                "lpips", "id_cosine", "id_dist", "id_dist_gt", "id<0.6", "gt_ref");
   s << line;
   for (Tier t : AllTiers()) {
     const TierMetrics& m = tiers[TierIndex(t)];
-    std::snprintf(line, sizeof line, "%-9s %5d %7s %6s %6s %9s %7s %9s %7s\n", TierName(t), m.count,
+    std::snprintf(line, sizeof line, "%-9s %5d %7s %6s %6s %9s %7s %10s %7s %7s\n", TierName(t), m.count,
                   Fmt(m.psnr, "%.2f").c_str(), Fmt(m.ssim, "%.3f").c_str(), Fmt(m.lpips, "%.3f").c_str(),
                   Fmt(m.id_cosine, "%.4f").c_str(), Fmt(m.id_distance, "%.3f").c_str(),
                   Fmt(m.id_distance_gt, "%.3f").c_str(),
-                  m.id_share_under_0_6 ? Fmt(100.0 * *m.id_share_under_0_6, "%.0f%%").c_str() : "-");
+                  m.id_share_under_0_6 ? Fmt(100.0 * *m.id_share_under_0_6, "%.0f%%").c_str() : "-",
+                  Fmt(m.id_distance_reference, "%.3f").c_str());
     s << line;
   }
+  s << "id_*: face-descriptor distance/cosine of each render to the model's own neutral render (same view); "
+       "id_dist_gt: to the ground truth; gt_ref: the ground truth's own distance to its neutral\n";
   if (!lpips_available) s << "lpips: unavailable (no weights file given; see docs/evaluation.md)\n";
   if (!identity_available)
     s << "identity: unavailable" << (identity_note.empty() ? "" : " (" + identity_note + ")") << "\n";
@@ -272,6 +285,7 @@ struct NeutralView {
   int index = 0;
   Image render;
   std::optional<FaceDescriptor> descriptor;
+  std::optional<FaceDescriptor> gt_descriptor;  // of the ground-truth neutral, same landmarks
   std::string landmarks = "none";
   std::string render_path;
 };
@@ -383,21 +397,22 @@ Result<EvalResult> EvaluateModel(const AvatarModel& model, const Dataset& datase
         // detected on the neutral ground truth, else (below) the frame's own, else detected on
         // the neutral render.
         std::optional<std::vector<Vec2f>> lm;
+        std::optional<Image> neutral_gt;
         if (frame.neutral_file_path) {
+          Result<Image> read = ReadImage(dataset.root / *frame.neutral_file_path);
+          if (read.ok()) neutral_gt = CompositeOver(*read, background);
           lm = DatasetLandmarksOf(dataset, *frame.neutral_file_path);
           if (lm) {
             view.landmarks = "dataset";
-          } else {
-            Result<Image> neutral_gt = ReadImage(dataset.root / *frame.neutral_file_path);
-            if (neutral_gt.ok()) {
-              Result<FaceIdentityResult> d = networks.identity->Describe(CompositeOver(*neutral_gt, background), {});
-              if (d.ok()) lm = d->landmarks, view.landmarks = "detector (ground truth)";
-            }
+          } else if (neutral_gt) {
+            Result<FaceIdentityResult> d = networks.identity->Describe(*neutral_gt, std::nullopt);
+            if (d.ok()) lm = d->landmarks, view.landmarks = "detector (ground truth)";
           }
         }
         if (!lm && frame.landmarks_2d) lm = frame.landmarks_2d, view.landmarks = "frame";
         if (lm) {
           view.descriptor = TryDescribe(*networks.identity, view.render, lm);
+          if (neutral_gt) view.gt_descriptor = TryDescribe(*networks.identity, *neutral_gt, lm);
         } else {
           view.descriptor = TryDescribe(*networks.identity, view.render, std::nullopt);
           if (view.descriptor) view.landmarks = "detector (render)";
@@ -427,6 +442,7 @@ Result<EvalResult> EvaluateModel(const AvatarModel& model, const Dataset& datase
         m.id_cosine = DescriptorCosine(*render_desc, *view.descriptor);
       }
       if (render_desc && gt_desc) m.id_distance_gt = DescriptorDistance(*render_desc, *gt_desc);
+      if (gt_desc && view.gt_descriptor) m.id_distance_reference = DescriptorDistance(*gt_desc, *view.gt_descriptor);
       if (!m.id_distance) ++result.identity_missing;
     } else {
       m.landmarks = "none";

@@ -43,6 +43,9 @@ struct FrameMetrics {
   std::optional<double> id_cosine;     // render vs the model's neutral render, same view
   std::optional<double> id_distance;   // Euclidean, same pair
   std::optional<double> id_distance_gt;  // render vs the ground-truth image of the frame
+  // Ground truth vs the ground-truth neutral of the view, chips made exactly as for id_distance:
+  // the drift a perfect model would show (null without a neutral image in the dataset).
+  std::optional<double> id_distance_reference;
   int nearest_index = -1;              // the model's nearest training expression k
   double model_delta = 0;              // ||beta - beta_n|| as the model sees it
   double kappa = 1;                    // confidence at that distance
@@ -66,6 +69,7 @@ struct TierMetrics {
   std::optional<double> id_distance;
   std::optional<double> id_distance_gt;
   std::optional<double> id_share_under_0_6;  // share of id_distance values under 0.6
+  std::optional<double> id_distance_reference;  // mean ground-truth drift (see FrameMetrics)
   int id_count = 0;                          // frames with identity metrics
   double mean_delta = 0;                     // mean dataset delta (0 when count is 0)
 

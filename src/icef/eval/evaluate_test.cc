@@ -63,6 +63,7 @@ TEST(EvaluateTest, AggregatesHandMadeMetricsFilePerTier) {
   EXPECT_DOUBLE_EQ(*obs.psnr, 21.0);
   EXPECT_DOUBLE_EQ(*obs.ssim, 0.6);
   EXPECT_FALSE(obs.lpips.has_value());
+  EXPECT_FALSE(obs.id_distance_reference.has_value());  // absent from the file: null
   EXPECT_DOUBLE_EQ(*obs.id_cosine, 0.97);
   EXPECT_DOUBLE_EQ(*obs.id_distance, 0.3);
   EXPECT_DOUBLE_EQ(*obs.id_distance_gt, 0.4);
@@ -213,6 +214,11 @@ TEST(EvaluateTest, EvaluatesTinyTrainedModel) {
     for (const FrameMetrics& f : with_id->frames) {
       EXPECT_EQ(f.landmarks, "dataset");
       ASSERT_TRUE(f.id_distance_gt.has_value());
+      // The dataset has neutral images, so the ground-truth reference drift is measured too.
+      if (f.neutral_landmarks != "none") {
+        ASSERT_TRUE(f.id_distance_reference.has_value());
+        EXPECT_GE(*f.id_distance_reference, 0.0);
+      }
       EXPECT_GE(*f.id_distance_gt, 0.0);
       if (f.id_distance) {
         EXPECT_GE(*f.id_distance, 0.0);

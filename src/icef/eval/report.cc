@@ -22,7 +22,7 @@ std::string RunId::Name() const { return "id" + std::to_string(identity_seed) + 
 const std::array<Metric, kNumMetrics>& AllMetrics() {
   static const std::array<Metric, kNumMetrics> kAll = {Metric::kPsnr,       Metric::kSsim,          Metric::kLpips,
                                                        Metric::kIdCosine,   Metric::kIdDistance,    Metric::kIdDistanceGt,
-                                                       Metric::kIdShareUnder06};
+                                                       Metric::kIdShareUnder06, Metric::kIdDistanceReference};
   return kAll;
 }
 
@@ -35,6 +35,7 @@ const char* MetricName(Metric m) {
     case Metric::kIdDistance: return "id_distance";
     case Metric::kIdDistanceGt: return "id_distance_gt";
     case Metric::kIdShareUnder06: return "id_share_under_0_6";
+    case Metric::kIdDistanceReference: return "id_distance_reference";
   }
   return "?";
 }
@@ -48,6 +49,7 @@ const char* MetricLabel(Metric m) {
     case Metric::kIdDistance: return "identity distance to own neutral render (lower = better)";
     case Metric::kIdDistanceGt: return "identity distance to ground truth (lower = better)";
     case Metric::kIdShareUnder06: return "share of renders under 0.6 from own neutral (higher = better)";
+    case Metric::kIdDistanceReference: return "ground truth's own distance to its neutral (reference)";
   }
   return "?";
 }
@@ -65,6 +67,7 @@ std::optional<double> TierValue(const TierMetrics& t, Metric m) {
     case Metric::kIdDistance: return t.id_distance;
     case Metric::kIdDistanceGt: return t.id_distance_gt;
     case Metric::kIdShareUnder06: return t.id_share_under_0_6;
+    case Metric::kIdDistanceReference: return t.id_distance_reference;
   }
   return std::nullopt;
 }
@@ -314,7 +317,9 @@ std::string ReportMarkdown(const Aggregate& a, const std::vector<RunRecord>& run
     << "NeRFFaceEditing proper are not available here and were not run.**\n"
     << "- Identity: dlib's ResNet face descriptor; `id_distance` / `id_cosine` compare a render with the model's "
     << "own neutral (expression zero) render of the same view (the paper's drift measure); `id_distance_gt` "
-    << "compares it with the ground-truth image. 0.6 is the network's same-person threshold. For scale: "
+    << "compares it with the ground-truth image; `id_distance_reference` is the same measure on the ground truth "
+    << "(ground-truth frame vs ground-truth neutral, same chips), i.e. the drift a perfect model would show. "
+    << "0.6 is the network's same-person threshold. For scale: "
     << "different real people have a median cosine of about 0.84 on this network, the same person 0.93-0.99.\n";
   bool lpips = false;
   for (const RunRecord& r : runs) lpips = lpips || r.metrics.lpips_available;
@@ -468,7 +473,7 @@ std::string PlotCommands(const Aggregate& a, Metric m, const std::string& dat) {
   s << "set multiplot layout 1," << a.ks.size() << " title \"" << MetricName(m) << " against delta (mean +- std over "
     << a.identities.size() << " identities)\"\n";
   s << "set xlabel \"delta (distance to the nearest training expression)\"\n";
-  s << "set ylabel \"" << MetricLabel(m) << "\"\nset grid\nset key bottom left\nset offsets 0.05, 0.05, 0, 0\n";
+  s << "set ylabel \"" << MetricLabel(m) << "\"\nset grid\nset key top left box opaque\nset offsets 0.05, 0.05, 0, 0\n";
   for (size_t ki = 0; ki < a.ks.size(); ++ki) {
     s << "set title \"K = " << a.ks[ki] << "\"\nplot ";
     for (size_t mi = 0; mi < a.methods.size(); ++mi) {
@@ -517,8 +522,8 @@ Result<std::vector<std::string>> WritePlots(const fs::path& dir, const Aggregate
     const std::string commands = PlotCommands(a, m, name + ".dat");
     std::ostringstream gp;
     gp << "# gnuplot " << name << ".gp (run in this directory) draws " << name << ".png and " << name << ".svg\n"
-       << "set terminal pngcairo size " << width << ",420 font \"sans,9\"\nset output \"" << name << ".png\"\n"
-       << commands << "set terminal svg size " << width << ",420 font \"sans,9\"\nset output \"" << name
+       << "set terminal pngcairo noenhanced size " << width << ",420 font \"sans,9\"\nset output \"" << name << ".png\"\n"
+       << commands << "set terminal svg noenhanced size " << width << ",420 font \"sans,9\"\nset output \"" << name
        << ".svg\"\n" << commands;
     ICEF_RETURN_IF_ERROR(WriteFileAtomic(plot_dir / (name + ".gp"), gp.str()));
     if (!have_gnuplot) continue;

@@ -38,8 +38,9 @@ struct RunRecord {
 };
 
 // The metrics a report aggregates, in table order.
-enum class Metric { kPsnr, kSsim, kLpips, kIdCosine, kIdDistance, kIdDistanceGt, kIdShareUnder06 };
-constexpr int kNumMetrics = 7;
+// kIdDistanceReference: the ground truth's own drift (GT vs GT neutral), the floor a perfect model shows.
+enum class Metric { kPsnr, kSsim, kLpips, kIdCosine, kIdDistance, kIdDistanceGt, kIdShareUnder06, kIdDistanceReference };
+constexpr int kNumMetrics = 8;
 const std::array<Metric, kNumMetrics>& AllMetrics();
 const char* MetricName(Metric metric);   // the metrics.json key, e.g. "id_distance"
 const char* MetricLabel(Metric metric);  // axis label, e.g. "identity distance to own neutral (lower = better)"
