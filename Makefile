@@ -69,7 +69,7 @@ fuzz: fuzz-deps
 	  ./$(FUZZ_BUILD_DIR)/fuzz/icef_fuzz_$$t -max_total_time=$(FUZZ_SECONDS) -print_final_stats=1 $$dict \
 	    -artifact_prefix=$(FUZZ_BUILD_DIR)/fuzz/crash-$$t- $(FUZZ_BUILD_DIR)/fuzz/corpus/$$t fuzz/corpus/$$t \
 	    > $(FUZZ_BUILD_DIR)/fuzz/$$t.log 2>&1; rc=$$?; \
-	  grep -E '^#[0-9]+ +(INITED|DONE)|stat::|ERROR|SUMMARY' $(FUZZ_BUILD_DIR)/fuzz/$$t.log; \
+	  grep -E '^#[0-9]+[[:space:]]+(INITED|DONE)|stat::|ERROR|SUMMARY' $(FUZZ_BUILD_DIR)/fuzz/$$t.log; \
 	  [ $$rc -eq 0 ] || { echo "fuzz: $$t FAILED (exit $$rc), see $(FUZZ_BUILD_DIR)/fuzz/$$t.log"; exit 1; }; \
 	done
 
