@@ -23,6 +23,7 @@ void ModelConfig::Bind(ConfigSchema& s) {
   s.Float("mask_softness", &mask_softness, "region mask: half-width of the soft edge (fraction of inter-ocular distance)");
   s.Bool("visual_hull", &visual_hull, "carve the occupancy grid to the visual hull of the training masks (images with alpha)");
   s.Int("hull_margin_px", &hull_margin_px, "visual hull: footprint dilation in pixels");
+  s.Int("hull_min_views", &hull_min_views, "visual hull: carve cells whose centre fewer training views see (0 = ceil(K/2))");
   s.Float("density_bias", &density_bias, "added to the log-density before exp (negative: space starts nearly empty)");
   s.Int("samples_per_ray", &samples_per_ray, "samples per ray over the ray/aabb interval");
   s.Int("occupancy_resolution", &occupancy_resolution, "occupancy grid cells per axis");
@@ -35,6 +36,7 @@ Status ModelConfig::Validate() const {
   ICEF_RETURN_IF_ERROR(ParseMethod(method).status().WithContext("method"));
   ICEF_RETURN_IF_ERROR(StaticOptions(1).Validate());
   if (hull_margin_px < 0) return Status::Error("hull_margin_px must be >= 0");
+  if (hull_min_views < 0) return Status::Error("hull_min_views must be >= 0");
   ICEF_RETURN_IF_ERROR(DeformationOptions().Validate());
   ICEF_RETURN_IF_ERROR(MaskOptions().Validate().WithContext("mask"));
   ICEF_RETURN_IF_ERROR(ConfidenceOpts().Validate().WithContext("kappa_lambda"));

@@ -39,7 +39,8 @@ struct ModelConfig {
   float mask_softness = 0.08f;        // half-width of the mask's soft edge (fraction of inter-ocular distance)
   bool visual_hull = true;            // carve the occupancy grid to the visual hull of the training masks (alpha only)
   int hull_margin_px = 2;             // visual hull footprint dilation, pixels
-  float density_bias = -1.f;          // added to the log-density before exp (negative: space starts nearly empty)
+  int hull_min_views = 0;             // visual hull: cells fewer training views see are carved (0 = ceil(K / 2))
+  float density_bias = -4.f;          // added to the log-density before exp (negative: space starts nearly empty)
   int samples_per_ray = 48;           // samples per ray over the ray/aabb interval
   int occupancy_resolution = 64;      // occupancy grid cells per axis
   float occupancy_threshold = 0.5f;   // density above which a cell is occupied

@@ -88,6 +88,7 @@ Result<std::unique_ptr<Trainer>> Trainer::Create(const Dataset& dataset, const f
     for (int k = 0; k < data.num_frames(); ++k) alphas.push_back(data.Alpha(k));
     VisualHullOptions hull;
     hull.margin_px = config.model.hull_margin_px;
+    hull.min_views = config.model.hull_min_views > 0 ? config.model.hull_min_views : (data.num_frames() + 1) / 2;
     ICEF_RETURN_IF_ERROR(model->occupancy().SetAllowed(VisualHullCells(
         setup.aabb, config.model.occupancy_resolution, data.cameras(), alphas, hull, executor)));
   }

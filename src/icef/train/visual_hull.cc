@@ -38,26 +38,22 @@ std::vector<uint8_t> VisualHullCells(const Aabb& aabb, int resolution, const std
     for (int64_t c = begin; c < end; ++c) {
       const int x = int(c % r), y = int((c / r) % r), z = int(c / (int64_t(r) * r));
       const Vec3d centre = aabb.min.cast<double>() + cell.cwiseProduct(Vec3d(x + 0.5, y + 0.5, z + 0.5));
-      bool seen = false;
+      int seen_by = 0;
       for (size_t k = 0; k < cameras.size() && allowed[c]; ++k) {
         const Camera& cam = cameras[k];
         const auto proj = cam.Project(centre);
-        if (!proj || proj->depth <= radius) {
-          seen |= proj.has_value();  // the camera is inside or next to the cell
-          continue;
-        }
+        if (!proj || proj->depth <= radius) continue;
         const double fl = std::max(cam.intrinsics().fl_x, cam.intrinsics().fl_y);
         const double rad = fl * radius / (proj->depth - radius) + options.margin_px;
         const double u = proj->uv.x(), v = proj->uv.y();
-        if (u + rad < 0 || v + rad < 0 || u - rad > cam.width() || v - rad > cam.height()) continue;  // unseen
-        seen = true;
-        if (u < 0 || v < 0 || u > cam.width() || v > cam.height()) continue;  // centre outside: partly seen
+        if (u < 0 || v < 0 || u > cam.width() || v > cam.height()) continue;  // centre not seen
+        ++seen_by;
         const ForegroundTable& t = tables[k];
         const int x0 = std::max(0, int(std::floor(u - rad))), y0 = std::max(0, int(std::floor(v - rad)));
         const int x1 = std::min(t.w, int(std::ceil(u + rad))), y1 = std::min(t.h, int(std::ceil(v + rad)));
         if (t.Count(x0, y0, x1, y1) == 0) allowed[c] = 0;
       }
-      if (!seen) allowed[c] = 0;
+      if (seen_by < options.min_views) allowed[c] = 0;
     }
   });
   return allowed;

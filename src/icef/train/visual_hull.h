@@ -3,8 +3,10 @@
 //  - some training view sees the cell's centre inside its image and no pixel of the cell's
 //    projected footprint (plus a margin, clipped to the image) is foreground (alpha >= threshold),
 //    or
-//  - no training view sees any of it (nothing there is ever supervised: novel views then render
-//    background there rather than whatever the initial field holds).
+//  - fewer than min_views training views see its centre: space that only one or two views
+//    constrain is where few-shot floaters live (a blob in front of one camera can paint that
+//    view's pixels without any other view objecting), and novel views render background there
+//    rather than whatever the field put in it.
 #pragma once
 
 #include <vector>
@@ -19,6 +21,7 @@ namespace icef {
 struct VisualHullOptions {
   int margin_px = 2;            // footprint dilation in pixels
   float alpha_threshold = 0.5f;  // alpha at or above this is foreground
+  int min_views = 1;             // cells whose centre fewer views see are carved
 };
 
 // alphas: one 1-channel image per camera (same size as the camera). Returns [R^3] flags, index

@@ -41,6 +41,17 @@ TEST(VisualHullTest, CarvesAroundADiscSilhouette) {
       }
   EXPECT_EQ(allowed[0], 0);  // a corner of the box is outside every silhouette
   EXPECT_LT(kept, r * r * r / 4);
+  // Requiring every view keeps the sphere (all three see it) and carves more of the rest.
+  VisualHullOptions all;
+  all.min_views = 3;
+  const auto strict = VisualHullCells(box, r, cams, alphas, all, Executor(2));
+  int kept_strict = 0;
+  for (int64_t c = 0; c < int64_t(strict.size()); ++c) {
+    kept_strict += strict[c];
+    EXPECT_LE(strict[c], allowed[c]);
+  }
+  EXPECT_EQ(strict[(size_t(r / 2) * r + r / 2) * r + r / 2], 1);
+  EXPECT_LE(kept_strict, kept);
   // Space no view sees is carved too.
   const auto none = VisualHullCells(box, r, {}, {}, VisualHullOptions{}, Executor(1));
   EXPECT_EQ(std::count(none.begin(), none.end(), 1), 0);
