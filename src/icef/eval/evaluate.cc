@@ -8,6 +8,7 @@
 #include "icef/eval/metrics.h"
 #include "icef/io/atomic_file.h"
 #include "icef/model/render_image.h"
+#include "icef/synth/synthesize.h"
 
 namespace fs = std::filesystem;
 
@@ -361,8 +362,11 @@ Result<EvalResult> EvaluateModel(const AvatarModel& model, const Dataset& datase
 
     FrameMetrics m;
     m.file_path = frame.file_path;
-    m.tier = frame.tier.value_or(Tier::kObserved);
     m.delta = frame.delta.value_or(render.nearest.delta);
+    // Frames without a tier get one from their delta and the dataset's thresholds (or synth's defaults).
+    const std::array<double, 2> thresholds = dataset.tier_thresholds.value_or(
+        std::array<double, 2>{synth::SynthOptions().near_threshold, synth::SynthOptions().far_threshold});
+    m.tier = frame.tier.value_or(synth::TierForDelta(m.delta, thresholds[0], thresholds[1]));
     m.nearest_index = render.nearest.index;
     m.model_delta = render.nearest.delta;
     m.kappa = render.nearest.kappa;

@@ -116,7 +116,9 @@ struct EvalNetworks {
   std::string identity_note;         // why `identity` is null (copied into the result)
 };
 
-// Evaluates `model` on the test frames of `dataset`. Errors: unreadable images, size mismatches.
+// Evaluates `model` on the test frames of `dataset`. A frame without a tier gets one from its
+// delta (the model's when the frame has none) and the dataset's tier thresholds. Errors:
+// unreadable images, size mismatches, an expression dimension other than the model's.
 // progress (may be null) counts frames.
 Result<EvalResult> EvaluateModel(const AvatarModel& model, const Dataset& dataset, const EvalOptions& options,
                                  const EvalNetworks& networks, const Executor& executor, ProgressBar* progress);

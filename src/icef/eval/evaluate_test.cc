@@ -202,6 +202,14 @@ TEST(EvaluateTest, EvaluatesTinyTrainedModel) {
   }
   EXPECT_TRUE(fs::exists(options.out_dir / "renders" / "neutral_000.png"));
 
+  // Frames without a stored tier get it from their delta and the dataset's thresholds.
+  Dataset untiered = *dataset;
+  for (Frame& f : untiered.test) f.tier.reset();
+  EvalOptions no_renders;
+  const Result<EvalResult> derived = EvaluateModel(model, untiered, no_renders, networks, executor, nullptr);
+  ASSERT_TRUE(derived.ok()) << derived.status().message();
+  for (size_t i = 0; i < derived->frames.size(); ++i) EXPECT_EQ(derived->frames[i].tier, *dataset->test[i].tier) << i;
+
   // With the face-identity network (when installed): identity metrics on every frame where a
   // face chip could be made (the dataset has landmarks, so all of them).
   Result<FaceIdentity> identity = FaceIdentity::Load({});
