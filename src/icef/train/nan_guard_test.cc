@@ -8,8 +8,10 @@
 #include <limits>
 #include <string>
 
+#include "icef/data/dataset.h"
 #include "icef/io/atomic_file.h"
 #include "icef/model/model_test_util.h"
+#include "icef/synth/synthesize.h"
 #include "icef/testing/tiny_dataset.h"
 #include "icef/train/trainer.h"
 
@@ -45,15 +47,28 @@ struct GuardRun {
   std::filesystem::path model_dir;
 };
 
+// A small synthetic head (16x16 images, 3 training frames) shared by the tests of this file.
+const Dataset& Subject() {
+  static const Dataset* dataset = [] {
+    synth::SynthOptions o;
+    o.out_dir = testing::MakeTempDir("nan_guard_subject");
+    o.num_train = 3;
+    o.resolution = 16;
+    o.test_views = 1;
+    o.novel_per_tier = 1;
+    ICEF_CHECK(synth::SynthesizeDataset(o, Executor(1)).ok());
+    Result<Dataset> loaded = LoadDataset(o.out_dir);
+    ICEF_CHECK(loaded.ok(), loaded.status().message());
+    return new Dataset(std::move(loaded).value());
+  }();
+  return *dataset;
+}
+
 // Trains the tiny config; after step `poison_step` completes, `poison` corrupts the model.
 GuardRun RunWithPoison(const std::string& name, int64_t poison_step,
                        const std::function<void(AvatarModel&)>& poison) {
   const std::filesystem::path dir = testing::MakeTempDir(name);
-  testing::TinyDatasetOptions data_options;
-  data_options.width = 16;
-  data_options.height = 12;
-  data_options.landmarks_3d = true;
-  const Dataset dataset = testing::WriteTinyDataset(dir / "data", data_options);
+  const Dataset& dataset = Subject();
   GuardRun run;
   run.model_dir = dir / "model";
   Result<std::unique_ptr<Trainer>> trainer = Trainer::Create(dataset, run.model_dir, TinyRunConfig());
