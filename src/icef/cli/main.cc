@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
       {"import", {"Convert a NerFace / instant-ngp dataset into our format", icef::cli::RegisterImport}},
       {"train", {"Train a model (icef or a baseline) on a dataset", icef::cli::RegisterTrain}},
       {"render", {"Render a trained model: views, expressions, sweeps, turntables", icef::cli::RegisterRender}},
+      {"config", {"Print the resolved run config, or document every key (--markdown)", icef::cli::RegisterConfig}},
       {"mask", {"Show the expression-region mask (overlay + volume slices)", icef::cli::RegisterMask}},
       {"landmarks", {"Detect 68 face landmarks (dlib) and write them into a dataset", icef::cli::RegisterLandmarks}},
       {"faceid", {"Face-identity descriptors of photos and their pairwise distances", icef::cli::RegisterFaceId}},
