@@ -25,6 +25,8 @@ fi
 "$ICEF" synth --out "$WORK/data" --k 3 --res 16 --test-views 1 --novel-per-tier 1 --threads 2 > /dev/null 2>&1 ||
   fail "icef synth failed"
 train() { "$ICEF" train "$WORK/data" --config "$CONFIG" --threads 2 --quiet "$@"; }
+# Background runs start icef directly (not through the function) so that $! is icef's own pid.
+TRAIN=("$ICEF" train "$WORK/data" --config "$CONFIG" --threads 2 --quiet)
 render() {  # render MODEL OUT: the model's image at the default camera
   "$ICEF" render "$1" --out "$2" --res 16 --threads 2 > "$2.log" 2>&1
 }
@@ -44,11 +46,13 @@ RANDOM=7
 for round in $(seq 1 "$ROUNDS"); do
   model=$WORK/kill_$round
   delay=$(awk -v t="$ref_seconds" -v r=$((RANDOM % 1000)) 'BEGIN { printf "%.3f", t * r / 1000 }')
-  train --out "$model" > "$WORK/kill_$round.log" 2>&1 &
+  "${TRAIN[@]}" --out "$model" > "$WORK/kill_$round.log" 2>&1 &
   pid=$!
   sleep "$delay"
-  kill -9 "$pid" 2>/dev/null || true
+  hit="killed while running"
+  kill -9 "$pid" 2>/dev/null || hit="had already finished"
   wait "$pid" 2>/dev/null || true
+  kill -0 "$pid" 2>/dev/null && fail "round $round: the training process survived kill -9"
   state="no checkpoint yet"
   if [ -f "$model/checkpoint.icef" ]; then
     render "$model" "$WORK/kill_${round}_render" ||
@@ -67,12 +71,12 @@ for round in $(seq 1 "$ROUNDS"); do
   cmp -s "$ref_png" "$(first_png "$WORK/resumed_${round}_render")" ||
     fail "round $round: resumed model renders differently from the uninterrupted run"
   leftovers=$(find "$model" -name '*.tmp*' | wc -l)
-  echo "round $round: kill -9 after ${delay}s: $state; resumed run matches the reference ($leftovers stale temporaries)"
+  echo "round $round: kill -9 after ${delay}s ($hit): $state; resumed run matches the reference ($leftovers stale temporaries)"
 done
 
 # 3. SIGINT: clean stop with a final checkpoint, then resume.
 model=$WORK/sigint
-train --out "$model" > "$WORK/sigint.log" 2>&1 &
+"${TRAIN[@]}" --out "$model" > "$WORK/sigint.log" 2>&1 &
 pid=$!
 for _ in $(seq 1 200); do [ -f "$model/checkpoint.icef" ] && break; sleep 0.05; done
 kill -INT "$pid" 2>/dev/null || fail "SIGINT: training ended before the signal (make the run longer)"
