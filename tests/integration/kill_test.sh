@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Crash safety of training. On a tiny synthetic dataset and config (tests/reliability/tiny_config.json,
-# a checkpoint every 4 steps):
+# 120 steps, a checkpoint every 4 steps):
 #  1. an uninterrupted reference run;
-#  2. runs killed with SIGKILL at random moments (seeded, reproducible): whatever is on disk must
+#  2. runs killed with SIGKILL at random moments of the reference duration: whatever is on disk must
 #     be a checkpoint that loads (`icef render` of it succeeds) or no checkpoint at all, and
 #     `--resume` must finish the run and give exactly the reference run's image;
 #  3. a run stopped with SIGINT: it must exit cleanly with a final checkpoint, and `--resume` must
@@ -24,9 +24,10 @@ fi
 
 "$ICEF" synth --out "$WORK/data" --k 3 --res 16 --test-views 1 --novel-per-tier 1 --threads 2 > /dev/null 2>&1 ||
   fail "icef synth failed"
-train() { "$ICEF" train "$WORK/data" --config "$CONFIG" --threads 2 --quiet "$@"; }
+# 120 steps (30 checkpoints): long enough that kills and the SIGINT land mid-run on an idle machine.
+train() { "$ICEF" train "$WORK/data" --config "$CONFIG" --steps 120 --threads 2 --quiet "$@"; }
 # Background runs start icef directly (not through the function) so that $! is icef's own pid.
-TRAIN=("$ICEF" train "$WORK/data" --config "$CONFIG" --threads 2 --quiet)
+TRAIN=("$ICEF" train "$WORK/data" --config "$CONFIG" --steps 120 --threads 2 --quiet)
 render() {  # render MODEL OUT: the model's image at the default camera
   "$ICEF" render "$1" --out "$2" --res 16 --threads 2 > "$2.log" 2>&1
 }
@@ -78,7 +79,7 @@ done
 model=$WORK/sigint
 "${TRAIN[@]}" --out "$model" > "$WORK/sigint.log" 2>&1 &
 pid=$!
-for _ in $(seq 1 200); do [ -f "$model/checkpoint.icef" ] && break; sleep 0.05; done
+for _ in $(seq 1 3000); do [ -f "$model/checkpoint.icef" ] && break; sleep 0.01; done
 kill -INT "$pid" 2>/dev/null || fail "SIGINT: training ended before the signal (make the run longer)"
 rc=0
 wait "$pid" || rc=$?
