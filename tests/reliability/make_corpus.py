@@ -169,11 +169,9 @@ def define_cases():
          {"config.json": '{"optimizer": {"lr": 1}}\n'}, needs="train")
     case("train_malformed_dataset", "icef train on a dataset with a zero-size image", "train {data} --out {out}",
          ["train_000.png"], {"images/train_000.png": b""}, needs="train")
-    # Known gap (reported): Trainer::Create makes the model directory before it decodes the images,
-    # so an undecodable image leaves an empty {out} behind. Remove `leaves` once that is fixed.
-    case("train_truncated_png", "icef train on a dataset whose train_000.png is cut to 40 bytes (KNOWN GAP: empty out/ left)",
+    case("train_truncated_png", "icef train on a dataset whose train_000.png is cut to 40 bytes",
          "train {data} --out {out}", ["train_000.png"], {"images/train_000.png": png(W, H, 3, seed=1)[:40]},
-         needs="train", leaves="created: out")
+         needs="train")
     # --- checkpoints (a tiny model trained once per run, then damaged) ------------------------
     render = "render {model} --out {out}"
     case("ckpt_truncated", "checkpoint.icef cut to half its size", render, ["checkpoint.icef", "truncated"],

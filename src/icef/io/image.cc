@@ -47,7 +47,8 @@ Result<Image> ReadImage(const fs::path& path) {
   int w = 0, h = 0, c = 0;
   if (!stbi_info_from_memory(data, size, &w, &h, &c))
     return Status::Error(path.string() + ": not a readable PNG/JPEG image (" + stbi_failure_reason() + ")");
-  if (w <= 0 || h <= 0 || int64_t(w) * h > (int64_t(1) << 28))
+  // Bounded before anything is allocated: a corrupt header must not ask for gigabytes.
+  if (w <= 0 || h <= 0 || w > 16384 || h > 16384 || int64_t(w) * h > (int64_t(1) << 26))
     return Status::Error(path.string() + ": unsupported image size " + std::to_string(w) + "x" + std::to_string(h));
   const int out_c = (c == 2) ? 4 : c;  // grey+alpha -> RGBA
   Image img(w, h, out_c);

@@ -76,9 +76,6 @@ Result<std::unique_ptr<Trainer>> Trainer::Create(const Dataset& dataset, const f
                                                  const RunConfig& config) {
   ICEF_RETURN_IF_ERROR(config.Validate());
   const Executor executor(config.train.threads);
-  std::error_code ec;
-  fs::create_directories(model_dir, ec);
-  if (!fs::is_directory(model_dir)) return Status::Error(model_dir.string() + ": cannot create the model directory");
   ICEF_ASSIGN_OR_RETURN(TrainingData data, TrainingData::Load(dataset));
   ICEF_ASSIGN_OR_RETURN(const ModelSetup setup, ModelSetup::FromDataset(dataset, executor));
   ICEF_ASSIGN_OR_RETURN(std::unique_ptr<AvatarModel> model, AvatarModel::Create(config.model, setup, executor));
@@ -92,6 +89,10 @@ Result<std::unique_ptr<Trainer>> Trainer::Create(const Dataset& dataset, const f
     ICEF_RETURN_IF_ERROR(model->occupancy().SetAllowed(VisualHullCells(
         setup.aabb, config.model.occupancy_resolution, data.cameras(), alphas, hull, executor)));
   }
+  // Only now that the data and the model are good is anything written.
+  std::error_code ec;
+  fs::create_directories(model_dir, ec);
+  if (!fs::is_directory(model_dir)) return Status::Error(model_dir.string() + ": cannot create the model directory");
   ICEF_RETURN_IF_ERROR(WriteFileAtomic(model_dir / "config.json", FormatJson(config.ToJson())));
   return std::unique_ptr<Trainer>(new Trainer(dataset, model_dir, config, std::move(data), std::move(model)));
 }
