@@ -8,21 +8,10 @@
 #include <cmath>
 
 #include "icef/eval/face_descriptor.h"
+#include "icef/landmarks/dlib_image.h"
 
 namespace icef::eval {
 namespace {
-
-dlib::matrix<dlib::rgb_pixel> ToDlib(const Image& image) {
-  dlib::matrix<dlib::rgb_pixel> out(image.height, image.width);
-  auto q = [](float v) { return static_cast<unsigned char>(std::lround(std::clamp(v, 0.f, 1.f) * 255.f)); };
-  for (int y = 0; y < image.height; ++y) {
-    for (int x = 0; x < image.width; ++x) {
-      const Vec3f rgb = image.Rgb(x, y);
-      out(y, x) = dlib::rgb_pixel(q(rgb.x()), q(rgb.y()), q(rgb.z()));
-    }
-  }
-  return out;
-}
 
 Image FromDlib(const dlib::matrix<dlib::rgb_pixel>& chip) {
   Image out(int(chip.nc()), int(chip.nr()), 3);
@@ -56,7 +45,7 @@ Result<Image> ExtractFaceChip(const Image& image, const std::vector<Vec2f>& land
   const dlib::full_object_detection shape(box, parts);
   const dlib::chip_details details = dlib::get_face_chip_details(shape, kFaceChipSize, 0.25);
   dlib::matrix<dlib::rgb_pixel> chip;
-  dlib::extract_image_chip(ToDlib(image), details, chip);
+  dlib::extract_image_chip(ToDlibRgb(image), details, chip);
   return FromDlib(chip);
 }
 

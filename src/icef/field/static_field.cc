@@ -68,6 +68,21 @@ void StaticField::Initialize(uint64_t seed) {
   color_mlp_.Initialize(Mix64(seed ^ 3));
 }
 
+void StaticField::SetLevelWeights(std::vector<float> weights) {
+  ICEF_CHECK(weights.empty() || int(weights.size()) == options_.grid.num_levels, "one weight per grid level");
+  bool all_one = true;
+  for (float w : weights) all_one &= (w == 1.f);
+  level_weights_ = all_one ? std::vector<float>() : std::move(weights);
+}
+
+void StaticField::ScaleLevels(int64_t n, float* features) const {
+  if (level_weights_.empty()) return;
+  const int levels = options_.grid.num_levels, f = options_.grid.features_per_level, g = levels * f;
+  for (int64_t i = 0; i < n; ++i)
+    for (int l = 0; l < levels; ++l)
+      for (int k = 0; k < f; ++k) features[i * g + l * f + k] *= level_weights_[l];
+}
+
 void StaticField::DensityForward(const Executor& executor, int64_t n, const float* positions, const float* condition,
                                  StaticFieldContext* ctx, bool keep_for_backward, bool need_position_grad) const {
   const int g = grid_.output_dims(), c = options_.condition_dims, di = g + c;
@@ -87,6 +102,7 @@ void StaticField::DensityForward(const Executor& executor, int64_t n, const floa
   if (c != 0) Grow(ctx->grid_features, n * g);
   float* features = c == 0 ? ctx->density_input.data() : ctx->grid_features.data();
   grid_.Forward(executor, n, unit, features, need_position_grad ? ctx->grid_jacobian.data() : nullptr);
+  ScaleLevels(n, features);  // the Jacobian stays unscaled: Backward scales the incoming gradient
   if (c != 0) {
     float* in = ctx->density_input.data();
     ParallelFor(executor, n, [&](int64_t b, int64_t e, int) {
@@ -147,6 +163,7 @@ void StaticField::Backward(const Executor& executor, int64_t n, const float* sig
   if (c != 0) {
     for (int64_t i = 0; i < n; ++i) std::copy(d_features + i * di, d_features + i * di + g, d_features + i * g);
   }
+  ScaleLevels(n, d_features);  // d(w f)/d(theta, x) = w df/d(theta, x)
   grid_.BackwardParams(executor, n, ctx->unit_positions.data(), d_features);
   if (d_positions) {
     Grow(ctx->d_unit_positions, n * 3);

@@ -88,6 +88,12 @@ class StaticField {
   void Density(const Executor& executor, int64_t n, const float* positions, const float* condition, float* sigma,
                StaticFieldContext* ctx) const;
 
+  // Coarse-to-fine: level l's features are multiplied by weights[l] in [0, 1] (size L; empty =
+  // all ones). Gradients are scaled alike, so a level at weight 0 is neither used nor trained.
+  void SetLevelWeights(std::vector<float> weights);
+  const std::vector<float>& level_weights() const { return level_weights_; }
+  int num_levels() const { return options_.grid.num_levels; }
+
   const StaticFieldOptions& options() const { return options_; }
   const Aabb& aabb() const { return aabb_; }
   std::string ToString() const;
@@ -96,8 +102,11 @@ class StaticField {
   void DensityForward(const Executor& executor, int64_t n, const float* positions, const float* condition,
                       StaticFieldContext* ctx, bool keep_for_backward, bool need_position_grad) const;
 
+  void ScaleLevels(int64_t n, float* features) const;
+
   StaticFieldOptions options_;
   Aabb aabb_;
+  std::vector<float> level_weights_;  // [L] or empty
   nn::HashGridEncoding grid_;
   nn::Mlp density_mlp_;
   nn::Mlp color_mlp_;

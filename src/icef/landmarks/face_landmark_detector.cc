@@ -1,4 +1,5 @@
 #include "icef/landmarks/face_landmark_detector.h"
+#include "icef/landmarks/dlib_image.h"
 
 #include <dlib/image_processing.h>
 #include <dlib/image_processing/frontal_face_detector.h>
@@ -11,18 +12,6 @@
 
 namespace icef {
 namespace {
-
-dlib::matrix<dlib::rgb_pixel> ToDlib(const Image& image) {
-  dlib::matrix<dlib::rgb_pixel> out(image.height, image.width);
-  auto q = [](float v) { return static_cast<unsigned char>(std::lround(std::clamp(v, 0.f, 1.f) * 255.f)); };
-  for (int y = 0; y < image.height; ++y) {
-    for (int x = 0; x < image.width; ++x) {
-      const Vec3f rgb = image.Rgb(x, y);
-      out(y, x) = dlib::rgb_pixel(q(rgb.x()), q(rgb.y()), q(rgb.z()));
-    }
-  }
-  return out;
-}
 
 // dlib coordinates (pixel centres at integers) of the image that was searched -> ours.
 Vec2f FromDlib(dlib::dpoint p, bool upsampled) {
@@ -77,7 +66,7 @@ FaceLandmarkDetector FaceLandmarkDetector::Clone() const {
 Result<FaceDetection> FaceLandmarkDetector::DetectFace(const Image& image) const {
   ICEF_CHECK(impl_ != nullptr, "DetectFace() on a detector that was not loaded");
   if (image.empty()) return Status::Error("face detector: empty image");
-  dlib::matrix<dlib::rgb_pixel> img = ToDlib(image);
+  dlib::matrix<dlib::rgb_pixel> img = ToDlibRgb(image);
   FaceDetection out;
   std::vector<dlib::rectangle> faces = impl_->detector(img);
   if (faces.empty()) {

@@ -123,6 +123,7 @@ class AvatarModel {
   const OccupancyGrid& occupancy() const { return occupancy_; }
   const RegionMask& mask() const { return mask_; }
   const ExpressionConfidence& confidence() const { return confidence_; }
+  StaticField& static_field() { return *static_field_; }
   DeformationField* deformation() { return deformation_.get(); }
   const DeformationField* deformation() const { return deformation_.get(); }
   std::string ToString() const;

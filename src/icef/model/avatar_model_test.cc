@@ -183,6 +183,7 @@ TEST(IdentityLossTest, GradientsMatchFiniteDifferences) {
 TEST(AvatarModelTest, TrainLossGradientMatchesFiniteDifferences) {
   for (const char* method : {"icef", "nerface"}) {
     auto model = MakeModel(method, 0.05f);
+    model->static_field().SetLevelWeights({1.f, 0.8f, 0.4f, 0.1f});  // coarse-to-fine scaling too
     TrainRays batch;
     Rng rng(5, StreamId("batch"));
     for (int r = 0; r < 24; ++r) {
@@ -217,7 +218,7 @@ TEST(AvatarModelTest, TrainLossGradientMatchesFiniteDifferences) {
       const double lm = model->TrainForwardBackward(batch, w, 3, 0, ex).total;
       store.params()[i] = saved;
       const double fd = (lp - lm) / (2.0 * (double(saved + h) - double(saved)));
-      EXPECT_NEAR(grads[i], fd, 2e-2 * std::abs(fd) + 1e-6) << method << " parameter " << i;
+      EXPECT_NEAR(grads[i], fd, 3e-2 * std::abs(fd) + 1e-6) << method << " parameter " << i;
     }
     store.ZeroGrads();
   }

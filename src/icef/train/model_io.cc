@@ -74,6 +74,7 @@ Result<LoadedModel> LoadModel(const fs::path& given, const Executor& executor) {
   ICEF_ASSIGN_OR_RETURN(out.state.elapsed_seconds, tv.Number("elapsed_seconds"));
   out.state.step = static_cast<int64_t>(step);
   if (DeformationField* d = out.model->deformation()) d->SetAnnealing(DeformationAnnealing(out.config, out.state.step));
+  out.model->static_field().SetLevelWeights(GridLevelWeights(out.config, out.state.step));
   if (ckpt.Has("log")) {
     ICEF_ASSIGN_OR_RETURN(const std::string log, ckpt.Section("log"));
     std::istringstream in(log);

@@ -1,6 +1,7 @@
 #include "icef/train/train_config.h"
 
 #include <algorithm>
+#include <cmath>
 #include <set>
 
 #include "icef/io/checkpoint.h"
@@ -23,6 +24,8 @@ void TrainConfig::Bind(ConfigSchema& s) {
   s.Int("smooth_max_samples", &smooth_max_samples, "boundary samples per step used by L_smooth");
   s.Bool("random_background", &random_background,
          "composite targets over a random colour per ray, rendered over the same (images with alpha only)");
+  s.Int("grid_anneal_steps", &grid_anneal_steps,
+        "coarse-to-fine hash grid: levels beyond the 4 coarsest switch on over these steps (0 = off)");
   s.Int("anneal_steps", &anneal_steps, "coarse-to-fine: deformation frequencies switch on over these steps (0 = off)");
   s.Int("occupancy_warmup", &occupancy_warmup, "steps before the occupancy grid starts skipping empty space");
   s.Int("occupancy_every", &occupancy_every, "steps between occupancy grid updates");
@@ -48,7 +51,7 @@ Status TrainConfig::Validate() const {
   if (!non_negative(lambda_distortion)) return Status::Error("train.lambda_distortion must be a finite number >= 0");
   if (!positive(smooth_epsilon)) return Status::Error("train.smooth_epsilon must be positive");
   if (smooth_max_samples < 1) return Status::Error("train.smooth_max_samples must be >= 1");
-  if (anneal_steps < 0 || occupancy_warmup < 0 || occupancy_every < 1 || checkpoint_every < 0 || log_every < 1 ||
+  if (anneal_steps < 0 || grid_anneal_steps < 0 || occupancy_warmup < 0 || occupancy_every < 1 || checkpoint_every < 0 || log_every < 1 ||
       eval_every < 0)
     return Status::Error("train: anneal_steps, occupancy_warmup, checkpoint_every, eval_every must be >= 0 and "
                          "occupancy_every, log_every >= 1");
@@ -136,6 +139,19 @@ double DeformationAnnealing(const RunConfig& config, int64_t step) {
   const double n = config.model.deform_frequencies;
   const int anneal = config.train.anneal_steps;
   return anneal > 0 ? std::min(n, n * double(step) / anneal) : n;
+}
+
+std::vector<float> GridLevelWeights(const RunConfig& config, int64_t step) {
+  const int levels = config.model.grid_levels, anneal = config.train.grid_anneal_steps;
+  std::vector<float> w(levels, 1.f);
+  if (anneal <= 0 || step >= anneal) return w;
+  constexpr double kFirst = 4;  // levels on from the start
+  const double alpha = kFirst + (levels - kFirst) * double(step) / anneal;
+  for (int l = 0; l < levels; ++l) {
+    const double x = std::clamp(alpha - l, 0.0, 1.0);
+    w[l] = static_cast<float>(0.5 * (1.0 - std::cos(M_PI * x)));
+  }
+  return w;
 }
 
 std::string ConfigDocumentation() {

@@ -28,6 +28,7 @@ struct TrainConfig {
   double smooth_epsilon = 0.01;      // finite-difference offset of L_smooth (half-extent units)
   int smooth_max_samples = 4096;     // boundary samples per step used by L_smooth
   bool random_background = true;     // train over random background colours (images with alpha only)
+  int grid_anneal_steps = 0;         // coarse-to-fine hash grid: levels beyond the 4 coarsest switch on over these steps (0 = off)
   int anneal_steps = 500;            // coarse-to-fine: deformation frequencies are switched on over these steps (0 = off)
   int occupancy_warmup = 256;        // steps before the occupancy grid starts skipping empty space
   int occupancy_every = 16;          // steps between occupancy grid updates
@@ -60,6 +61,10 @@ struct RunConfig {
 // The deformation encoding's coarse-to-fine parameter alpha after `step` steps (all frequencies
 // on once step >= train.anneal_steps). Training and every later render use the same value.
 double DeformationAnnealing(const RunConfig& config, int64_t step);
+
+// Per-level weights of the static field's hash grid after `step` steps (coarse-to-fine; all ones
+// once step >= train.grid_anneal_steps, or when it is 0).
+std::vector<float> GridLevelWeights(const RunConfig& config, int64_t step);
 
 // Markdown for docs/config.md: one table per section.
 std::string ConfigDocumentation();
