@@ -14,7 +14,7 @@ namespace icef {
 
 namespace fs = std::filesystem;
 
-Result<std::vector<float>> ParseVector(const std::string& text, int expected_dim) {
+Result<std::vector<float>> ParseVector(const std::string& text) {
   std::vector<float> v;
   std::stringstream ss(text);
   for (std::string item; std::getline(ss, item, ',');) {
@@ -24,9 +24,6 @@ Result<std::vector<float>> ParseVector(const std::string& text, int expected_dim
       return Status::Error("--beta: '" + item + "' is not a finite number");
     v.push_back(x);
   }
-  if (static_cast<int>(v.size()) != expected_dim)
-    return Status::Error("--beta: expected " + std::to_string(expected_dim) + " comma-separated values (the model's "
-                         "expression_dim), got " + std::to_string(v.size()));
   return v;
 }
 

@@ -50,7 +50,8 @@ struct RenderedFrameInfo {
 Result<std::vector<RenderedFrameInfo>> RunRender(const RenderAppOptions& options, std::ostream& out);
 
 // Parsing helpers (exposed for tests). Errors name the option and the value.
-Result<std::vector<float>> ParseVector(const std::string& text, int expected_dim);
+// "0.1,0.2,..." -> values; RunRender checks the length against the model's expression_dim.
+Result<std::vector<float>> ParseVector(const std::string& text);
 Status ApplyNamedValue(const ModelSetup& setup, const std::string& assignment, std::vector<float>* beta);
 // A turntable around the mean training view (looking at the aabb centre), `count` views with
 // yaw in [-yaw, +yaw] degrees.

@@ -1,6 +1,4 @@
-#include <cmath>
 #include <iostream>
-#include <sstream>
 #include <memory>
 
 #include "icef/app/render_app.h"
@@ -43,16 +41,7 @@ CommandFn RegisterRender(CLI::App& app) {
     if (!sweep->empty()) opts.sweep = *sweep;
     if (*res > 0) opts.resolution = *res;
     if (!beta->empty()) {
-      std::vector<float> v;
-      std::stringstream ss(*beta);
-      for (std::string item; std::getline(ss, item, ',');) {
-        char* end = nullptr;
-        const float x = std::strtof(item.c_str(), &end);
-        if (item.empty() || *end != '\0' || !std::isfinite(x))
-          return Status::Error("--beta: '" + item + "' is not a finite number");
-        v.push_back(x);
-      }
-      opts.beta = v;
+      ICEF_ASSIGN_OR_RETURN(opts.beta, ParseVector(*beta));
     }
     return RunRender(opts, std::cout).status();
   };

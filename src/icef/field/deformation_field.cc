@@ -20,10 +20,6 @@ nn::FrequencyMlpOptions MlpOptionsFor(const DeformationFieldOptions& o, int expr
   m.output_init_scale = o.output_init_scale;
   return m;
 }
-template <typename V>
-void Grow(V& v, int64_t size) {
-  if (int64_t(v.size()) < size) v.resize(size);
-}
 }  // namespace
 
 Status DeformationFieldOptions::Validate() const {
@@ -61,8 +57,8 @@ void DeformationField::SetAnnealing(double alpha) { mlp_.encoding().SetAlpha(alp
 void DeformationField::ToUnit(const Executor& executor, int64_t n, const float* positions,
                               DeformationContext* ctx) const {
   ctx->n = n;
-  Grow(ctx->unit_positions, n * 3);
-  Grow(ctx->raw, n * 3);
+  nn::GrowTo(ctx->unit_positions, n * 3);
+  nn::GrowTo(ctx->raw, n * 3);
   float* u = ctx->unit_positions.data();
   const Vec3f lo = aabb_.min, inv = half_extent_.cwiseInverse();
   ParallelFor(executor, n, [&](int64_t b, int64_t e, int) {
@@ -83,7 +79,7 @@ void DeformationField::Forward(const Executor& executor, int64_t n, const float*
 void DeformationField::Backward(const Executor& executor, int64_t n, const float* d_offsets,
                                 DeformationContext* ctx) {
   ICEF_CHECK(ctx->n == n, "Backward batch size differs from Forward");
-  Grow(ctx->d_raw, n * 3);
+  nn::GrowTo(ctx->d_raw, n * 3);
   float* d_raw = ctx->d_raw.data();
   for (int64_t i = 0; i < n; ++i)
     for (int a = 0; a < 3; ++a) d_raw[3 * i + a] = d_offsets[3 * i + a] * half_extent_[a];
@@ -94,7 +90,7 @@ void DeformationField::LinearizedForward(const Executor& executor, int64_t n, co
                                          const float* anchors, const float* directions, float* offsets,
                                          DeformationContext* ctx) const {
   ToUnit(executor, n, positions, ctx);
-  Grow(ctx->tangent, n * 3);
+  nn::GrowTo(ctx->tangent, n * 3);
   mlp_.Jvp(executor, n, ctx->unit_positions.data(), anchors, nullptr, directions, ctx->raw.data(),
            ctx->tangent.data(), &ctx->mlp);
   const float* raw = ctx->raw.data();

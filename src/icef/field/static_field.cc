@@ -24,10 +24,6 @@ nn::MlpOptions ColorMlpOptions(const StaticFieldOptions& o) {
   m.output_activation = nn::Activation::kSigmoid;
   return m;
 }
-template <typename V>
-void Grow(V& v, int64_t size) {
-  if (int64_t(v.size()) < size) v.resize(size);
-}
 }  // namespace
 
 Status StaticFieldOptions::Validate() const {
@@ -88,10 +84,10 @@ void StaticField::DensityForward(const Executor& executor, int64_t n, const floa
   const int g = grid_.output_dims(), c = options_.condition_dims, di = g + c;
   ctx->n = n;
   ctx->has_position_jacobian = need_position_grad;
-  Grow(ctx->unit_positions, n * 3);
-  Grow(ctx->density_input, n * di);
-  Grow(ctx->density_output, n * options_.geo_features);
-  if (need_position_grad) Grow(ctx->grid_jacobian, n * g * 3);
+  nn::GrowTo(ctx->unit_positions, n * 3);
+  nn::GrowTo(ctx->density_input, n * di);
+  nn::GrowTo(ctx->density_output, n * options_.geo_features);
+  if (need_position_grad) nn::GrowTo(ctx->grid_jacobian, n * g * 3);
   const Vec3f lo = aabb_.min, inv = aabb_.Extent().cwiseInverse();
   float* unit = ctx->unit_positions.data();
   ParallelFor(executor, n, [&](int64_t b, int64_t e, int) {
@@ -99,7 +95,7 @@ void StaticField::DensityForward(const Executor& executor, int64_t n, const floa
       for (int a = 0; a < 3; ++a) unit[3 * i + a] = (positions[3 * i + a] - lo[a]) * inv[a];
   });
   // The grid writes [n, g]; with a condition the rows are widened to [n, g + c] afterwards.
-  if (c != 0) Grow(ctx->grid_features, n * g);
+  if (c != 0) nn::GrowTo(ctx->grid_features, n * g);
   float* features = c == 0 ? ctx->density_input.data() : ctx->grid_features.data();
   grid_.Forward(executor, n, unit, features, need_position_grad ? ctx->grid_jacobian.data() : nullptr);
   ScaleLevels(n, features);  // the Jacobian stays unscaled: Backward scales the incoming gradient
@@ -121,7 +117,7 @@ void StaticField::Forward(const Executor& executor, int64_t n, const float* posi
                           bool keep_for_backward, bool need_position_grad) const {
   DensityForward(executor, n, positions, condition, ctx, keep_for_backward, need_position_grad);
   const int geo = options_.geo_features, sh = options_.sh_degree * options_.sh_degree, ci = geo + sh;
-  Grow(ctx->color_input, n * ci);
+  nn::GrowTo(ctx->color_input, n * ci);
   float* cin = ctx->color_input.data();
   const float* h = ctx->density_output.data();
   ParallelFor(executor, n, [&](int64_t b, int64_t e, int) {
@@ -141,9 +137,9 @@ void StaticField::Backward(const Executor& executor, int64_t n, const float* sig
   ICEF_CHECK(d_positions == nullptr || ctx->has_position_jacobian, "Forward was run without need_position_grad");
   const int g = grid_.output_dims(), c = options_.condition_dims, di = g + c;
   const int geo = options_.geo_features, sh = options_.sh_degree * options_.sh_degree, ci = geo + sh;
-  Grow(ctx->d_color_input, n * ci);
-  Grow(ctx->d_density_output, n * geo);
-  Grow(ctx->d_density_input, n * di);
+  nn::GrowTo(ctx->d_color_input, n * ci);
+  nn::GrowTo(ctx->d_density_output, n * geo);
+  nn::GrowTo(ctx->d_density_input, n * di);
   color_mlp_.Backward(executor, n, ctx->color_input.data(), rgb, d_rgb, &ctx->color_mlp,
                       ctx->d_color_input.data());
   const float* dci = ctx->d_color_input.data();
@@ -166,7 +162,7 @@ void StaticField::Backward(const Executor& executor, int64_t n, const float* sig
   ScaleLevels(n, d_features);  // d(w f)/d(theta, x) = w df/d(theta, x)
   grid_.BackwardParams(executor, n, ctx->unit_positions.data(), d_features);
   if (d_positions) {
-    Grow(ctx->d_unit_positions, n * 3);
+    nn::GrowTo(ctx->d_unit_positions, n * 3);
     grid_.BackwardInput(executor, n, ctx->grid_jacobian.data(), d_features, ctx->d_unit_positions.data());
     const Vec3f inv = aabb_.Extent().cwiseInverse();
     const float* du = ctx->d_unit_positions.data();

@@ -27,6 +27,12 @@ struct AlignedAllocator {
 template <typename T>
 using AlignedVector = std::vector<T, AlignedAllocator<T>>;
 
+// Grows a buffer to at least `size` elements, never shrinking it (per-batch workspaces).
+template <typename V>
+void GrowTo(V& v, long long size) {
+  if (static_cast<long long>(v.size()) < size) v.resize(size);
+}
+
 // Rounds n up to a multiple of 16 floats (one cache line), the granularity of slab blocks.
 constexpr long long RoundUpToLine(long long n) { return (n + 15) / 16 * 16; }
 

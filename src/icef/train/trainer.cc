@@ -193,7 +193,6 @@ Result<TrainSummary> Trainer::Run(const ProgressFn& progress, const std::atomic<
   const TrainConfig& t = config_.train;
   const auto start = Clock::now();
   const double elapsed_before = state_.elapsed_seconds;
-  const int64_t start_step = state_.step;
   int64_t samples = 0;
   TrainSummary summary;
   summary.method = config_.model.method;
@@ -242,7 +241,6 @@ Result<TrainSummary> Trainer::Run(const ProgressFn& progress, const std::atomic<
   summary.final_loss = last_terms_.total;
   summary.final_batch_psnr = last_terms_.psnr();
   summary.samples_per_second = run_seconds > 0 ? samples / run_seconds : 0;
-  (void)start_step;
   if (!summary.interrupted)
     summary.psnr_observed = MeanTierPsnr(*model_, dataset_, Tier::kObserved, executor_, &summary.observed_frames);
   ICEF_RETURN_IF_ERROR(WriteFileAtomic(model_dir_ / "summary.json", FormatJson(summary.ToJson())));
