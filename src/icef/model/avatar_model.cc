@@ -7,6 +7,7 @@
 #include "icef/core/rng.h"
 #include "icef/model/identity_losses.h"
 #include "icef/render/distortion_loss.h"
+#include "icef/render/occlusion_loss.h"
 
 namespace icef {
 
@@ -35,14 +36,14 @@ double LossTerms::psnr() const { return photo > 0 ? -10.0 * std::log10(photo) : 
 
 bool LossTerms::AllFinite() const {
   return std::isfinite(photo) && std::isfinite(mask) && std::isfinite(id) && std::isfinite(smooth) &&
-         std::isfinite(distortion) && std::isfinite(total);
+         std::isfinite(distortion) && std::isfinite(occlusion) && std::isfinite(total);
 }
 
 std::string LossTerms::ToString() const {
   std::ostringstream os;
   os.precision(4);
   os << "loss " << total << " (photo " << photo << ", mask " << mask << ", id " << id << ", smooth " << smooth
-     << ", dist " << distortion << ") psnr " << psnr();
+     << ", dist " << distortion << ", occ " << occlusion << ") psnr " << psnr();
   return os.str();
 }
 
@@ -210,6 +211,8 @@ LossTerms AvatarModel::TrainForwardBackward(const TrainRays& batch, const LossWe
   terms.mask = mask_loss * inv_r;
   std::span<const float> d_weights;
   if (weights.lambda_distortion > 0) {
+    // Distances in units of the aabb diagonal, so the weight does not depend on the scene's scale.
+    const double inv_diag = 1.0 / setup_.aabb.Extent().norm();
     Fit(ws.d_weights, n);
     double dist = 0;
     for (int64_t r = 0; r < num_rays; ++r) {
@@ -217,13 +220,24 @@ LossTerms AvatarModel::TrainForwardBackward(const TrainRays& batch, const LossWe
       if (cnt == 0) continue;
       dist += DistortionLossRay<float>(cnt, &ws.composite.weights[off], &ws.samples.t[off], &ws.samples.dt[off]);
       DistortionLossRayBackward<float>(cnt, &ws.composite.weights[off], &ws.samples.t[off], &ws.samples.dt[off],
-                                       static_cast<float>(weights.lambda_distortion * inv_r), &ws.d_weights[off]);
+                                       static_cast<float>(weights.lambda_distortion * inv_r * inv_diag),
+                                       &ws.d_weights[off]);
     }
-    terms.distortion = dist * inv_r;
+    terms.distortion = dist * inv_r * inv_diag;
     d_weights = ws.d_weights;
   }
   CompositeOutputGradients<float> grads{ws.d_color, ws.d_opacity, {}, d_weights};
   CompositeBackward(in, ws.composite, grads, executor, &ws.d_sigma, &ws.d_rgb);
+  if (weights.lambda_occlusion > 0) {
+    double occ = 0;
+    const float scale = static_cast<float>(weights.lambda_occlusion * inv_r);
+    for (int64_t r = 0; r < num_rays; ++r) {
+      const int64_t off = ws.samples.ray_offset[r], cnt = ws.samples.ray_count[r];
+      occ += OcclusionLossRay<float>(static_cast<int>(cnt), &ws.composite.weights[off], &ws.sigma[off],
+                                     &ws.samples.dt[off], scale, &ws.d_sigma[off]);
+    }
+    terms.occlusion = occ * inv_r;
+  }
 
   if (deformation_) Fit(ws.d_canonical, 3 * n);
   static_field_->Backward(executor, n, ws.sigma.data(), ws.rgb.data(), ws.d_sigma.data(), ws.d_rgb.data(),
@@ -285,7 +299,7 @@ LossTerms AvatarModel::TrainForwardBackward(const TrainRays& batch, const LossWe
   const double lid = traits_.identity_losses ? weights.lambda_id : 0.0;
   const double lsm = traits_.identity_losses ? weights.lambda_smooth : 0.0;
   terms.total = terms.photo + weights.lambda_mask * terms.mask + lid * terms.id + lsm * terms.smooth +
-                weights.lambda_distortion * terms.distortion;
+                weights.lambda_distortion * terms.distortion + weights.lambda_occlusion * terms.occlusion;
   return terms;
 }
 

@@ -32,13 +32,14 @@ inline constexpr int kMlpGroup = 1;
 inline constexpr int kDeformGroup = 2;
 
 // Loss weights of L = L_photo + lambda_mask L_mask + lambda_id L_id + lambda_smooth L_smooth
-// + lambda_distortion L_dist (the trainer fills them from TrainConfig; the method's traits zero
+// + lambda_distortion L_dist + lambda_occlusion L_occ (the trainer fills them from TrainConfig; the method's traits zero
 // L_id and L_smooth where the method has none).
 struct LossWeights {
   double lambda_id = 0.0;
   double lambda_smooth = 0.0;
   double lambda_mask = 0.0;
   double lambda_distortion = 0.0;
+  double lambda_occlusion = 0.0;
   double smooth_epsilon = 0.01;  // finite-difference offset of L_smooth, in half-extent units of the aabb
   int smooth_max_samples = 8192;  // cap on boundary samples used by L_smooth per batch
 };
@@ -58,7 +59,8 @@ struct LossTerms {
   double mask = 0;        // mean squared error of opacity against alpha
   double id = 0;          // L_id (mean over samples, half-extent units squared)
   double smooth = 0;      // L_smooth estimate
-  double distortion = 0;  // mean distortion loss per ray
+  double distortion = 0;  // mean distortion loss per ray (distances in aabb diagonals)
+  double occlusion = 0;   // mean occlusion sparsity loss per ray (render/occlusion_loss.h)
   double total = 0;       // weighted sum
   int64_t samples = 0;    // samples evaluated
   double psnr() const;    // from `photo`

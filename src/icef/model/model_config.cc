@@ -30,6 +30,8 @@ void ModelConfig::Bind(ConfigSchema& s) {
   s.Float("occupancy_threshold", &occupancy_threshold, "density above which an occupancy cell is occupied");
   s.Float("occupancy_decay", &occupancy_decay, "occupancy EMA-of-max decay per update");
   s.Number("transmittance_eps", &transmittance_eps, "stop compositing a ray once its transmittance is below this");
+  s.Int("render_supersample", &render_supersample,
+        "image renders average s x s rays per pixel (anti-aliasing; photos and the synthetic data integrate over the pixel)");
 }
 
 Status ModelConfig::Validate() const {
@@ -37,6 +39,7 @@ Status ModelConfig::Validate() const {
   ICEF_RETURN_IF_ERROR(StaticOptions(1).Validate());
   if (hull_margin_px < 0) return Status::Error("hull_margin_px must be >= 0");
   if (hull_min_views < 0) return Status::Error("hull_min_views must be >= 0");
+  if (render_supersample < 1 || render_supersample > 8) return Status::Error("render_supersample must be in 1..8");
   ICEF_RETURN_IF_ERROR(DeformationOptions().Validate());
   ICEF_RETURN_IF_ERROR(MaskOptions().Validate().WithContext("mask"));
   ICEF_RETURN_IF_ERROR(ConfidenceOpts().Validate().WithContext("kappa_lambda"));

@@ -28,7 +28,7 @@ struct ModelConfig {
   int density_hidden = 64;            // density MLP hidden width
   int geo_features = 16;              // density MLP outputs (log-density + colour features)
   std::vector<int> color_hidden = {64, 64};  // colour MLP hidden widths
-  int sh_degree = 4;                  // view-direction SH degree
+  int sh_degree = 2;                  // view-direction SH degree (few-shot: low, view-dependence overfits)
   int deform_frequencies = 6;         // deformation positional-encoding frequencies
   std::vector<int> deform_hidden = {64, 64, 64};  // deformation MLP hidden widths
   float deform_init_scale = 0.01f;    // initial output-layer scale of the deformation MLP
@@ -42,6 +42,7 @@ struct ModelConfig {
   int hull_min_views = 0;             // visual hull: cells fewer training views see are carved (0 = ceil(K / 2))
   float density_bias = -4.f;          // added to the log-density before exp (negative: space starts nearly empty)
   int samples_per_ray = 48;           // samples per ray over the ray/aabb interval
+  int render_supersample = 2;         // image renders: s x s rays per pixel, averaged
   int occupancy_resolution = 64;      // occupancy grid cells per axis
   float occupancy_threshold = 0.5f;   // density above which a cell is occupied
   float occupancy_decay = 0.9f;       // EMA-of-max decay of stored cell densities per update

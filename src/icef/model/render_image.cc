@@ -8,11 +8,33 @@ namespace icef {
 RenderedImage RenderImage(const AvatarModel& model, const Camera& camera, std::span<const float> beta,
                           const Vec3f& background, const Executor& executor) {
   const int w = camera.width(), h = camera.height();
-  std::vector<Ray> rays(size_t(w) * h);
+  const int s = model.config().render_supersample, s2 = s * s;
+  // s x s rays per pixel on a regular sub-pixel grid, consecutive per pixel.
+  std::vector<Ray> rays(size_t(w) * h * s2);
   for (int j = 0; j < h; ++j)
-    for (int i = 0; i < w; ++i) rays[size_t(j) * w + i] = camera.PixelRay(i, j);
+    for (int i = 0; i < w; ++i)
+      for (int q = 0; q < s2; ++q)
+        rays[(size_t(j) * w + i) * s2 + q] = camera.RayThrough(i + (q % s + 0.5) / s, j + (q / s + 0.5) / s);
   RenderOutput out;
   model.Render(rays, beta, background, executor, &out);
+  if (s2 > 1) {
+    const float inv = 1.f / float(s2);
+    auto average = [&](std::vector<float>& v, int channels) {
+      const size_t pixels = size_t(w) * h;
+      for (size_t p = 0; p < pixels; ++p)
+        for (int c = 0; c < channels; ++c) {
+          float sum = 0.f;
+          for (int q = 0; q < s2; ++q) sum += v[(p * s2 + q) * channels + c];
+          v[p * channels + c] = sum * inv;
+        }
+      v.resize(pixels * channels);
+    };
+    average(out.color, 3);
+    average(out.depth, 1);
+    average(out.opacity, 1);
+    average(out.mask, 1);
+    average(out.deformation, 1);
+  }
   RenderedImage img;
   img.color = Image(w, h, 3);
   img.color.pixels.assign(out.color.begin(), out.color.end());

@@ -1,4 +1,5 @@
-// Renders whole images from a AvatarModel: one ray per pixel centre of a camera, at one expression.
+// Renders whole images from an AvatarModel at one expression: s x s rays per pixel on a regular
+// sub-pixel grid (s = the model config's render_supersample; 1 = the pixel centre), averaged.
 #pragma once
 
 #include <span>

@@ -19,11 +19,15 @@ void TrainConfig::Bind(ConfigSchema& s) {
   s.Number("lambda_id", &lambda_id, "weight of L_id, identity preservation outside the expression regions");
   s.Number("lambda_smooth", &lambda_smooth, "weight of L_smooth, deformation smoothness at the region boundary");
   s.Number("lambda_mask", &lambda_mask, "weight of the alpha-mask loss (auxiliary; datasets with alpha only)");
-  s.Number("lambda_distortion", &lambda_distortion, "weight of the mip-NeRF 360 distortion loss (auxiliary; 0 = off)");
+  s.Number("lambda_distortion", &lambda_distortion, "weight of the mip-NeRF 360 distortion loss, distances in aabb diagonals (few-shot prior; 0 = off)");
+  s.Number("lambda_occlusion", &lambda_occlusion,
+           "weight of the occlusion sparsity prior: density behind what the training rays already hit (0 = off)");
   s.Number("smooth_epsilon", &smooth_epsilon, "finite-difference offset of L_smooth (half-extent units of the aabb)");
   s.Int("smooth_max_samples", &smooth_max_samples, "boundary samples per step used by L_smooth");
   s.Bool("random_background", &random_background,
          "composite targets over a random colour per ray, rendered over the same (images with alpha only)");
+  s.Bool("pixel_jitter", &pixel_jitter,
+         "cast each training ray through a random point of its pixel (the targets are pixel averages)");
   s.Int("grid_anneal_steps", &grid_anneal_steps,
         "coarse-to-fine hash grid: levels beyond the 4 coarsest switch on over these steps (0 = off)");
   s.Int("anneal_steps", &anneal_steps, "coarse-to-fine: deformation frequencies switch on over these steps (0 = off)");
@@ -49,6 +53,7 @@ Status TrainConfig::Validate() const {
   if (!non_negative(lambda_smooth)) return Status::Error("train.lambda_smooth must be a finite number >= 0");
   if (!non_negative(lambda_mask)) return Status::Error("train.lambda_mask must be a finite number >= 0");
   if (!non_negative(lambda_distortion)) return Status::Error("train.lambda_distortion must be a finite number >= 0");
+  if (!non_negative(lambda_occlusion)) return Status::Error("train.lambda_occlusion must be a finite number >= 0");
   if (!positive(smooth_epsilon)) return Status::Error("train.smooth_epsilon must be positive");
   if (smooth_max_samples < 1) return Status::Error("train.smooth_max_samples must be >= 1");
   if (anneal_steps < 0 || grid_anneal_steps < 0 || occupancy_warmup < 0 || occupancy_every < 1 || checkpoint_every < 0 || log_every < 1 ||

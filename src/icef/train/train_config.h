@@ -21,12 +21,14 @@ struct TrainConfig {
   double lr_mlp = 1e-3;              // Adam learning rate of the static field's MLPs
   double lr_deform = 1e-3;           // Adam learning rate of the deformation MLP
   double lr_final_factor = 0.1;      // learning rates decay exponentially to this factor at the last step
-  double lambda_id = 0.1;            // weight of L_id (identity preservation outside the expression regions)
+  double lambda_id = 1.0;            // weight of L_id (identity preservation outside the expression regions)
   double lambda_smooth = 1e-4;       // weight of L_smooth (deformation smoothness at the region boundary)
   double lambda_mask = 0.1;          // weight of the alpha-mask loss (images with alpha only)
-  double lambda_distortion = 1e-3;   // weight of the mip-NeRF 360 distortion loss (0 = off)
+  double lambda_distortion = 0.35;   // weight of the mip-NeRF 360 distortion loss (0 = off)
   double smooth_epsilon = 0.01;      // finite-difference offset of L_smooth (half-extent units)
   int smooth_max_samples = 4096;     // boundary samples per step used by L_smooth
+  double lambda_occlusion = 1e-4;    // weight of the occlusion sparsity prior (0 = off)
+  bool pixel_jitter = true;          // training rays through random points of their pixels
   bool random_background = true;     // train over random background colours (images with alpha only)
   int grid_anneal_steps = 0;         // coarse-to-fine hash grid: levels beyond the 4 coarsest switch on over these steps (0 = off)
   int anneal_steps = 500;            // coarse-to-fine: deformation frequencies are switched on over these steps (0 = off)

@@ -131,12 +131,13 @@ Result<LossTerms> Trainer::Step() {
   ApplySchedules();
   if (state_.step >= t.occupancy_warmup && state_.step % t.occupancy_every == 0)
     model_->UpdateOccupancy(seed, state_.step, executor_);
-  data_.SampleBatch(t.batch_rays, seed, state_.step, t.random_background, &batch_);
+  data_.SampleBatch(t.batch_rays, seed, state_.step, t.random_background, t.pixel_jitter, &batch_);
   LossWeights w;
   w.lambda_id = t.lambda_id;
   w.lambda_smooth = t.lambda_smooth;
   w.lambda_mask = data_.has_alpha() ? t.lambda_mask : 0.0;
   w.lambda_distortion = t.lambda_distortion;
+  w.lambda_occlusion = t.lambda_occlusion;
   w.smooth_epsilon = t.smooth_epsilon;
   w.smooth_max_samples = t.smooth_max_samples;
   const LossTerms terms = model_->TrainForwardBackward(batch_, w, seed, state_.step, executor_);

@@ -55,6 +55,33 @@ std::string ParamBytes(const AvatarModel& model) {
   return std::string(reinterpret_cast<const char*>(s.params()), s.size() * sizeof(float));
 }
 
+TEST(TrainingDataTest, JitteredRaysStayInsideTheirPixelAndAreDeterministic) {
+  auto data = TrainingData::Load(TinySubject());
+  ASSERT_TRUE(data.ok()) << data.status().message();
+  TrainRays centre, jittered, again;
+  data->SampleBatch(256, 9, 4, false, false, &centre);
+  data->SampleBatch(256, 9, 4, false, true, &jittered);
+  data->SampleBatch(256, 9, 4, false, true, &again);
+  int off_centre = 0;
+  for (int r = 0; r < 256; ++r) {
+    ASSERT_EQ(centre.frame[r], jittered.frame[r]);  // same pixels and targets, only the ray moves
+    EXPECT_EQ(centre.target_rgb[3 * r], jittered.target_rgb[3 * r]);
+    const Camera& cam = data->camera(centre.frame[r]);
+    const auto c = cam.Project((centre.rays[r].origin + 3.f * centre.rays[r].direction).cast<double>());
+    const auto j = cam.Project((jittered.rays[r].origin + 3.f * jittered.rays[r].direction).cast<double>());
+    ASSERT_TRUE(c && j);
+    const double px = std::floor(c->uv.x()), py = std::floor(c->uv.y());
+    EXPECT_NEAR(c->uv.x() - px, 0.5, 1e-3);  // without jitter: the pixel centre
+    EXPECT_GE(j->uv.x(), px - 1e-3);
+    EXPECT_LE(j->uv.x(), px + 1 + 1e-3);
+    EXPECT_GE(j->uv.y(), py - 1e-3);
+    EXPECT_LE(j->uv.y(), py + 1 + 1e-3);
+    off_centre += std::abs(j->uv.x() - c->uv.x()) > 0.05;
+    EXPECT_EQ(jittered.rays[r].direction, again.rays[r].direction);
+  }
+  EXPECT_GT(off_centre, 128);
+}
+
 TEST(TrainerTest, TrainingLowersLossAndRaisesPsnr) {
   const Dataset& dataset = TinySubject();
   RunConfig config = SmallConfig("icef");
@@ -192,7 +219,7 @@ TEST(RunConfigTest, ParentsOverridesAndStrictKeys) {
   auto back = RunConfig::FromJson(c->ToJson(), "mem");
   ASSERT_TRUE(back.ok());
   EXPECT_EQ(back->Hash(), c->Hash());
-  EXPECT_NE(ConfigDocumentation().find("| `lambda_id` | `0.1` |"), std::string::npos);
+  EXPECT_NE(ConfigDocumentation().find("| `lambda_id` | `1.0` |"), std::string::npos);
 }
 
 }  // namespace

@@ -49,7 +49,7 @@ Image TrainingData::Alpha(int k) const {
   return out;
 }
 
-void TrainingData::SampleBatch(int num_rays, uint64_t seed, int64_t step, bool random_background,
+void TrainingData::SampleBatch(int num_rays, uint64_t seed, int64_t step, bool random_background, bool jitter,
                                TrainRays* batch) const {
   batch->rays.resize(num_rays);
   batch->frame.resize(num_rays);
@@ -59,12 +59,15 @@ void TrainingData::SampleBatch(int num_rays, uint64_t seed, int64_t step, bool r
   const bool random = random_background && has_alpha_;
   Rng rng(seed, StreamId("ray_batch"), uint64_t(step));
   Rng bg_rng(seed, StreamId("random_background"), uint64_t(step));
+  Rng jitter_rng(seed, StreamId("pixel_jitter"), uint64_t(step));
   const uint64_t total = frame_of_pixel_.size();
   for (int r = 0; r < num_rays; ++r) {
     const uint64_t p = rng.Below(total);
     const int k = frame_of_pixel_[p];
     batch->frame[r] = k;
-    batch->rays[r] = cameras_[k].PixelRay(pixel_x_[p], pixel_y_[p]);
+    // The target is the pixel's average colour, so the ray goes through a random point of the pixel.
+    const double ju = jitter ? jitter_rng.Uniform() : 0.5, jv = jitter ? jitter_rng.Uniform() : 0.5;
+    batch->rays[r] = cameras_[k].RayThrough(pixel_x_[p] + ju, pixel_y_[p] + jv);
     const float alpha = has_alpha_ ? alpha_[p] : 1.f;
     for (int a = 0; a < 3; ++a) {
       const float bg = random ? bg_rng.Uniform() : background_[3 * p + a];

@@ -27,7 +27,10 @@ class TrainingData {
   // Rng(seed, "ray_batch", step): deterministic for (seed, step). With random_background (and
   // alpha), each ray's target is its foreground composited over a random colour that the model
   // also renders over, so the field cannot fake the background with haze (instant-ngp's trick).
-  void SampleBatch(int num_rays, uint64_t seed, int64_t step, bool random_background, TrainRays* batch) const;
+  // With jitter, each ray passes through a uniformly random point of its pixel (the target is the
+  // pixel's average), else through the pixel centre.
+  void SampleBatch(int num_rays, uint64_t seed, int64_t step, bool random_background, bool jitter,
+                   TrainRays* batch) const;
 
  private:
   std::vector<Camera> cameras_;
