@@ -222,6 +222,7 @@ Result<TrainSummary> Trainer::Run(const ProgressFn& progress, const std::atomic<
       line["id"] = terms.id;
       line["smooth"] = terms.smooth;
       line["distortion"] = terms.distortion;
+      line["occlusion"] = terms.occlusion;
       line["batch_psnr"] = terms.psnr();
       line["occupied"] = model_->occupancy().OccupiedFraction();
       if (t.eval_every > 0 && state_.step % t.eval_every == 0) {
