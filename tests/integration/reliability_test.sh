@@ -156,6 +156,14 @@ EOF
   cat "$ROWS"
   cat <<'EOF'
 
+`icef info` (and every dataset load) checks each image's header and file structure (PNG: every
+chunk complete, critical chunks' CRCs, IEND; JPEG: every segment complete up to the end-of-image
+marker) but does not decode pixels, for speed (2021 PNGs of 128x128: 0.027 s for the checks,
+0.48 s to decode; decoding grows with the pixel count, about 3.6 ms per 512x512 PNG). Damage that
+leaves the structure intact, such as corrupt JPEG scan data, is found when `icef train` (or `eval`)
+decodes the image (libpng and libjpeg-turbo; every decoder error and every corrupt-data warning is
+an error naming the file).
+
 Related guarantees tested elsewhere: checkpoints are written to a temporary file, flushed and
 renamed (`io/atomic_file`), carry a format version, the config hash and an FNV-1a checksum, and a
 truncated or bit-flipped file is refused (`io/checkpoint_test`, rows above);
@@ -163,7 +171,7 @@ truncated or bit-flipped file is refused (`io/checkpoint_test`, rows above);
 checkpoint always loads and `--resume` continues; `src/icef/train/nan_guard_test.cc` checks that a
 non-finite loss stops training with the step and the term named and the previous checkpoint intact.
 The fuzzers in `fuzz/` (`make fuzz`) cover the dataset loader, the checkpoint reader and the image
-reader.
+reader; their former findings are regression seeds in `fuzz/corpus/` (`io/image_test` reads them).
 EOF
 } > "$GENERATED"
 

@@ -133,12 +133,27 @@ def define_cases():
     good = png(W, H, 3, seed=1)
     case("png_zero_size", "train_000.png is a zero-size file", info, [t, "frames[0]", "train_000.png"],
          {"images/train_000.png": b""})
-    # LoadDataset validates image headers only (sizes), so `icef info` accepts a PNG whose pixel
-    # data is cut off; training decodes every image and refuses it (train_truncated_png below).
-    case("png_truncated", "train_000.png cut to its first 40 bytes (header only): info reads headers only", info,
-         [], {"images/train_000.png": good[:40]}, exit_code=0)
-    case("png_truncated_data", "train_000.png missing its last 30 bytes (IDAT cut): info reads headers only",
-         info, [], {"images/train_000.png": good[:-30]}, exit_code=0)
+    # LoadDataset reads image headers and checks each file's structure (chunks, CRCs, end marker)
+    # without decoding pixels, so `icef info` refuses truncated and bit-flipped PNGs.
+    case("png_truncated", "train_000.png cut to its first 40 bytes (header only)", info,
+         [t, "frames[0]", "train_000.png", "truncated"], {"images/train_000.png": good[:40]})
+    case("png_truncated_data", "train_000.png missing its last 30 bytes (IDAT cut)", info,
+         [t, "frames[0]", "train_000.png", "truncated"], {"images/train_000.png": good[:-30]})
+    flipped = bytearray(good)
+    flipped[good.index(b"IDAT") + 10] ^= 0x10
+    case("png_bit_flip", "one bit flipped inside train_000.png's pixel data (IDAT)", info,
+         [t, "frames[0]", "train_000.png", "CRC"], {"images/train_000.png": bytes(flipped)})
+    # JPEG: the committed 8x8 seed of the image fuzzer, named in the JSON as train_000.jpg.
+    with open(os.path.join(HERE, "..", "..", "fuzz", "corpus", "image", "rgb_8x8.jpg"), "rb") as f:
+        jpeg = f.read()
+    jpeg_json = edited("train", lambda d: d["frames"][0].update(file_path="images/train_000.jpg"))
+    case("jpeg_truncated", "train_000.jpg cut in half", info, [t, "frames[0]", "train_000.jpg", "truncated"],
+         {t: jpeg_json, "images/train_000.jpg": jpeg[:len(jpeg) // 2]})
+    dht = bytearray(jpeg)
+    at = jpeg.index(b"\xff\xc4") + 5  # the 16 code counts of the first Huffman table
+    dht[at:at + 16] = bytes([17] * 16)  # 272 codes: stb_image wrote past its table here
+    case("jpeg_huffman_overflow", "train_000.jpg with a Huffman table of 272 codes (at most 256)", info,
+         [t, "frames[0]", "train_000.jpg", "Huffman"], {t: jpeg_json, "images/train_000.jpg": bytes(dht)})
     case("png_not_an_image", "train_000.png holds text", info, [t, "frames[0]", "train_000.png"],
          {"images/train_000.png": b"this is not a PNG\n"})
     case("png_16bit", "train_000.png is a 16-bit RGB PNG (supported: read as [0, 1] floats)", info, [],
