@@ -182,6 +182,9 @@ def define_cases():
          {"config.json": '{"train": {"steps": "ten"}}\n'}, needs="train")
     case("config_unknown_section", "run config with a section \"optimizer\"", cfg, ["config.json", "optimizer"],
          {"config.json": '{"optimizer": {"lr": 1}}\n'}, needs="train")
+    case("config_bad_nonfinite_policy", "run config with train.on_nonfinite = \"ignore\"", cfg,
+         ["config.json", "on_nonfinite"], {"config.json": '{"train": {"steps": 2, "on_nonfinite": "ignore"}}\n'},
+         needs="train")
     case("train_malformed_dataset", "icef train on a dataset with a zero-size image", "train {data} --out {out}",
          ["train_000.png"], {"images/train_000.png": b""}, needs="train")
     case("train_truncated_png", "icef train on a dataset whose train_000.png is cut to 40 bytes",
@@ -199,6 +202,26 @@ def define_cases():
          needs="render", mutate="png")
     case("ckpt_missing", "model directory without checkpoint.icef", render, ["checkpoint.icef"],
          needs="render", mutate="delete")
+    # Resealed checkpoints (edit_checkpoint.py): the container checksum passes, the content is wrong.
+    case("ckpt_step_negative", "checkpoint.icef with trainer.step = -1 (resealed)", render,
+         ["checkpoint.icef", "trainer.step", "-1"], needs="render", mutate="set-json trainer step -1")
+    case("ckpt_step_fraction", "checkpoint.icef with trainer.step = 2.5 (resealed)", render,
+         ["checkpoint.icef", "trainer.step", "2.5"], needs="render", mutate="set-json trainer step 2.5")
+    case("ckpt_step_huge", "checkpoint.icef with trainer.step = 1e300 (resealed)", render,
+         ["checkpoint.icef", "trainer.step"], needs="render", mutate="set-json trainer step 1e300")
+    case("ckpt_config_edited", "checkpoint.icef whose config says train.lambda_id = 0.5 (resealed; hash kept)",
+         render, ["checkpoint.icef", "config_hash"], needs="render",
+         mutate="set-json config train.lambda_id 0.5")
+    case("ckpt_config_hash_wrong", "checkpoint.icef with trainer.config_hash = 12345 (resealed)", render,
+         ["checkpoint.icef", "config_hash"], needs="render", mutate="set-json trainer config_hash 12345")
+    resume = "train {synth} --out {model} --resume"
+    tiny = json.load(open(os.path.join(HERE, "tiny_config.json")))
+    tiny["train"]["lambda_id"] = 0.5
+    case("resume_other_config", "icef train --resume with a --config whose train.lambda_id differs", resume +
+         " --config {data}/config.json", ["checkpoint.icef", "config.json", "train.lambda_id"],
+         {"config.json": json.dumps(tiny) + "\n"}, needs="train")
+    case("resume_set_method", "icef train --resume --set model.method=warp", resume + " --set model.method=warp",
+         ["checkpoint.icef", "model.method"], needs="train")
     case("render_unknown_expression", "icef render --set-expression grin=1 (no such expression)",
          "render {model} --out {out} --set-expression grin=1", ["grin"], needs="render")
     case("render_wrong_expression_length", "icef render --beta with 2 values for expression_dim 11",
