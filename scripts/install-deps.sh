@@ -6,6 +6,7 @@ set -euo pipefail
 PACKAGES=(
   build-essential cmake ninja-build pkg-config git
   libeigen3-dev nlohmann-json3-dev libcli11-dev libstb-dev libgif-dev
+  libpng-dev libjpeg62-turbo-dev zlib1g-dev  # image reading (libpng, libjpeg-turbo)
   libgtest-dev libgmock-dev libbenchmark-dev
   libdlib-dev libdlib-data opencv-doc python3-skimage python-matplotlib-data  # eval: face alignment, test photos
   gnuplot-nox  # bench: report plots (PNG + SVG)

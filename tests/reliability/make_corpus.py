@@ -133,12 +133,27 @@ def define_cases():
     good = png(W, H, 3, seed=1)
     case("png_zero_size", "train_000.png is a zero-size file", info, [t, "frames[0]", "train_000.png"],
          {"images/train_000.png": b""})
-    # LoadDataset validates image headers only (sizes), so `icef info` accepts a PNG whose pixel
-    # data is cut off; training decodes every image and refuses it (train_truncated_png below).
-    case("png_truncated", "train_000.png cut to its first 40 bytes (header only): info reads headers only", info,
-         [], {"images/train_000.png": good[:40]}, exit_code=0)
-    case("png_truncated_data", "train_000.png missing its last 30 bytes (IDAT cut): info reads headers only",
-         info, [], {"images/train_000.png": good[:-30]}, exit_code=0)
+    # LoadDataset reads image headers and checks each file's structure (chunks, CRCs, end marker)
+    # without decoding pixels, so `icef info` refuses truncated and bit-flipped PNGs.
+    case("png_truncated", "train_000.png cut to its first 40 bytes (header only)", info,
+         [t, "frames[0]", "train_000.png", "truncated"], {"images/train_000.png": good[:40]})
+    case("png_truncated_data", "train_000.png missing its last 30 bytes (IDAT cut)", info,
+         [t, "frames[0]", "train_000.png", "truncated"], {"images/train_000.png": good[:-30]})
+    flipped = bytearray(good)
+    flipped[good.index(b"IDAT") + 10] ^= 0x10
+    case("png_bit_flip", "one bit flipped inside train_000.png's pixel data (IDAT)", info,
+         [t, "frames[0]", "train_000.png", "CRC"], {"images/train_000.png": bytes(flipped)})
+    # JPEG: the committed 8x8 seed of the image fuzzer, named in the JSON as train_000.jpg.
+    with open(os.path.join(HERE, "..", "..", "fuzz", "corpus", "image", "rgb_8x8.jpg"), "rb") as f:
+        jpeg = f.read()
+    jpeg_json = edited("train", lambda d: d["frames"][0].update(file_path="images/train_000.jpg"))
+    case("jpeg_truncated", "train_000.jpg cut in half", info, [t, "frames[0]", "train_000.jpg", "truncated"],
+         {t: jpeg_json, "images/train_000.jpg": jpeg[:len(jpeg) // 2]})
+    dht = bytearray(jpeg)
+    at = jpeg.index(b"\xff\xc4") + 5  # the 16 code counts of the first Huffman table
+    dht[at:at + 16] = bytes([17] * 16)  # 272 codes: stb_image wrote past its table here
+    case("jpeg_huffman_overflow", "train_000.jpg with a Huffman table of 272 codes (at most 256)", info,
+         [t, "frames[0]", "train_000.jpg", "Huffman"], {t: jpeg_json, "images/train_000.jpg": bytes(dht)})
     case("png_not_an_image", "train_000.png holds text", info, [t, "frames[0]", "train_000.png"],
          {"images/train_000.png": b"this is not a PNG\n"})
     case("png_16bit", "train_000.png is a 16-bit RGB PNG (supported: read as [0, 1] floats)", info, [],
@@ -167,6 +182,9 @@ def define_cases():
          {"config.json": '{"train": {"steps": "ten"}}\n'}, needs="train")
     case("config_unknown_section", "run config with a section \"optimizer\"", cfg, ["config.json", "optimizer"],
          {"config.json": '{"optimizer": {"lr": 1}}\n'}, needs="train")
+    case("config_bad_nonfinite_policy", "run config with train.on_nonfinite = \"ignore\"", cfg,
+         ["config.json", "on_nonfinite"], {"config.json": '{"train": {"steps": 2, "on_nonfinite": "ignore"}}\n'},
+         needs="train")
     case("train_malformed_dataset", "icef train on a dataset with a zero-size image", "train {data} --out {out}",
          ["train_000.png"], {"images/train_000.png": b""}, needs="train")
     case("train_truncated_png", "icef train on a dataset whose train_000.png is cut to 40 bytes",
@@ -184,6 +202,26 @@ def define_cases():
          needs="render", mutate="png")
     case("ckpt_missing", "model directory without checkpoint.icef", render, ["checkpoint.icef"],
          needs="render", mutate="delete")
+    # Resealed checkpoints (edit_checkpoint.py): the container checksum passes, the content is wrong.
+    case("ckpt_step_negative", "checkpoint.icef with trainer.step = -1 (resealed)", render,
+         ["checkpoint.icef", "trainer.step", "-1"], needs="render", mutate="set-json trainer step -1")
+    case("ckpt_step_fraction", "checkpoint.icef with trainer.step = 2.5 (resealed)", render,
+         ["checkpoint.icef", "trainer.step", "2.5"], needs="render", mutate="set-json trainer step 2.5")
+    case("ckpt_step_huge", "checkpoint.icef with trainer.step = 1e300 (resealed)", render,
+         ["checkpoint.icef", "trainer.step"], needs="render", mutate="set-json trainer step 1e300")
+    case("ckpt_config_edited", "checkpoint.icef whose config says train.lambda_id = 0.5 (resealed; hash kept)",
+         render, ["checkpoint.icef", "config_hash"], needs="render",
+         mutate="set-json config train.lambda_id 0.5")
+    case("ckpt_config_hash_wrong", "checkpoint.icef with trainer.config_hash = 12345 (resealed)", render,
+         ["checkpoint.icef", "config_hash"], needs="render", mutate="set-json trainer config_hash 12345")
+    resume = "train {synth} --out {model} --resume"
+    tiny = json.load(open(os.path.join(HERE, "tiny_config.json")))
+    tiny["train"]["lambda_id"] = 0.5
+    case("resume_other_config", "icef train --resume with a --config whose train.lambda_id differs", resume +
+         " --config {data}/config.json", ["checkpoint.icef", "config.json", "train.lambda_id"],
+         {"config.json": json.dumps(tiny) + "\n"}, needs="train")
+    case("resume_set_method", "icef train --resume --set model.method=warp", resume + " --set model.method=warp",
+         ["checkpoint.icef", "model.method"], needs="train")
     case("render_unknown_expression", "icef render --set-expression grin=1 (no such expression)",
          "render {model} --out {out} --set-expression grin=1", ["grin"], needs="render")
     case("render_wrong_expression_length", "icef render --beta with 2 values for expression_dim 11",

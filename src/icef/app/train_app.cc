@@ -1,5 +1,6 @@
 #include "icef/app/train_app.h"
 
+#include <algorithm>
 #include <iomanip>
 #include <sstream>
 
@@ -10,8 +11,9 @@ namespace icef {
 
 namespace fs = std::filesystem;
 
-Result<RunConfig> ResolveRunConfig(const TrainAppOptions& o) {
-  RunConfig config;
+namespace {
+// `base` (the defaults, or a resumed checkpoint's config), then --config, --set and the flags.
+Result<RunConfig> ResolveFrom(RunConfig config, const TrainAppOptions& o) {
   if (o.config_file) {
     ICEF_ASSIGN_OR_RETURN(config, RunConfig::FromFile(*o.config_file));
   }
@@ -27,6 +29,36 @@ Result<RunConfig> ResolveRunConfig(const TrainAppOptions& o) {
   ICEF_RETURN_IF_ERROR(config.Validate().WithContext("run config"));
   return config;
 }
+}  // namespace
+
+Result<RunConfig> ResolveRunConfig(const TrainAppOptions& o) { return ResolveFrom(RunConfig(), o); }
+
+const std::vector<std::string>& ResumableConfigKeys() {
+  static const std::vector<std::string> keys = {"train.steps", "train.time_budget_seconds", "train.threads",
+                                                "train.on_nonfinite"};
+  return keys;
+}
+
+Result<RunConfig> ResolveResumeConfig(const TrainAppOptions& o, const RunConfig& saved, const std::string& checkpoint) {
+  ICEF_ASSIGN_OR_RETURN(const RunConfig config, ResolveFrom(saved, o));
+  const Json before = saved.ToJson(), after = config.ToJson();
+  std::string differ;
+  for (const std::string& key : JsonDifferences(before, after)) {
+    const auto& allowed = ResumableConfigKeys();
+    if (std::find(allowed.begin(), allowed.end(), key) != allowed.end()) continue;
+    std::string pointer = "/" + key;
+    std::replace(pointer.begin(), pointer.end(), '.', '/');
+    const Json::json_pointer at(pointer);
+    differ += (differ.empty() ? "" : ", ") + key + " (checkpoint " + (before.contains(at) ? before.at(at).dump() : "-") +
+              ", given " + (after.contains(at) ? after.at(at).dump() : "-") + ")";
+  }
+  if (differ.empty()) return config;
+  std::string source = o.config_file ? o.config_file->string() : "--set/--method/--seed";
+  std::string allowed;
+  for (const std::string& key : ResumableConfigKeys()) allowed += (allowed.empty() ? "" : ", ") + key;
+  return Status::Error(checkpoint + ": cannot resume with a different run config (" + source + "): " + differ +
+                       "; only " + allowed + " may change when resuming (start afresh with --overwrite)");
+}
 
 Result<TrainSummary> RunTrain(const TrainAppOptions& o, std::ostream& out) {
   ICEF_ASSIGN_OR_RETURN(const Dataset dataset, LoadDataset(o.dataset));
@@ -35,8 +67,9 @@ Result<TrainSummary> RunTrain(const TrainAppOptions& o, std::ostream& out) {
   std::unique_ptr<Trainer> trainer;
   if (o.resume) {
     if (!has_model) return Status::Error(o.out.string() + ": --resume given but there is no checkpoint to resume");
-    ICEF_ASSIGN_OR_RETURN(trainer,
-                          Trainer::Resume(dataset, o.out, o.steps, o.time_budget, o.threads));
+    const std::string checkpoint = (o.out / kCheckpointFile).string();
+    auto configure = [&](const RunConfig& saved) { return ResolveResumeConfig(o, saved, checkpoint); };
+    ICEF_ASSIGN_OR_RETURN(trainer, Trainer::Resume(dataset, o.out, configure, o.threads.value_or(0)));
   } else {
     if (has_model && !o.overwrite)
       return Status::Error(o.out.string() + ": already holds a trained model; use --resume to continue it, "

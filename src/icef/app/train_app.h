@@ -31,6 +31,17 @@ struct TrainAppOptions {
 // Resolves the run config the options describe (without training).
 Result<RunConfig> ResolveRunConfig(const TrainAppOptions& options);
 
+// The keys a resumed run may change: the step count, time budget, thread count and what to do on
+// a non-finite step.
+const std::vector<std::string>& ResumableConfigKeys();
+
+// The config of a resumed run: the checkpoint's config `saved`, then (as for a fresh run) --config
+// (a whole run config: defaults < file), --set and the flags. A result that differs from `saved`
+// in any key but ResumableConfigKeys() is refused with an error naming `checkpoint` and each key
+// with both values.
+Result<RunConfig> ResolveResumeConfig(const TrainAppOptions& options, const RunConfig& saved,
+                                      const std::string& checkpoint);
+
 Result<TrainSummary> RunTrain(const TrainAppOptions& options, std::ostream& out);
 
 }  // namespace icef

@@ -11,7 +11,9 @@ CommandFn RegisterTrain(CLI::App& app) {
       "Train a model on a dataset. The run config is the defaults (docs/config.md), then --config FILE, then "
       "--set overrides, then the dedicated flags. Writes MODEL/checkpoint.icef (periodically, atomically), "
       "config.json, train_log.jsonl and summary.json. Ctrl-C stops after the current step with a checkpoint; "
-      "--resume continues it.");
+      "--resume continues it with the checkpoint's run config: --config, --set and the flags may then change only "
+      "train.steps, train.time_budget_seconds, train.threads and train.on_nonfinite (anything else is refused, "
+      "naming the keys).");
   auto o = std::make_shared<TrainAppOptions>();
   auto method = std::make_shared<std::string>();
   auto steps = std::make_shared<int64_t>(0);
@@ -28,7 +30,9 @@ CommandFn RegisterTrain(CLI::App& app) {
   app.add_option("--seed", *seed, "Root random seed")->check(CLI::NonNegativeNumber);
   app.add_option("--threads", *threads, "Worker threads (0 = all cores)")->check(CLI::NonNegativeNumber);
   app.add_option("--set", o->overrides, "Config override SECTION.KEY=VALUE, e.g. train.lambda_id=0.2 (repeatable)");
-  app.add_flag("--resume", o->resume, "Continue from MODEL/checkpoint.icef");
+  app.add_flag("--resume", o->resume,
+               "Continue from MODEL/checkpoint.icef (its run config; only the step count, time budget, threads and "
+               "train.on_nonfinite may change)");
   app.add_flag("--overwrite", o->overwrite, "Start afresh even if MODEL already holds a model");
   app.add_flag("--quiet", o->quiet, "No progress bar");
   return [=]() -> Status {

@@ -2,15 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <sstream>
 
 #include "icef/io/atomic_file.h"
+#include "icef/io/image_decode.h"
 
-#define STB_IMAGE_IMPLEMENTATION
-#define STBI_ONLY_PNG
-#define STBI_ONLY_JPEG
-#define STBI_FAILURE_USERMSG
-#include <stb_image.h>
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #include <stb_image_write.h>
 
@@ -30,30 +27,28 @@ std::string Image::ToString() const {
   return os.str();
 }
 
-Result<ImageInfo> ReadImageInfo(const fs::path& path) {
+namespace {
+// Reads and checks the file (io/image_decode.h); errors name the file.
+Result<DecodedImage> ReadAndDecode(const fs::path& path, bool decode) {
   ICEF_ASSIGN_OR_RETURN(const std::string bytes, ReadFile(path));
-  ImageInfo info;
-  if (!stbi_info_from_memory(reinterpret_cast<const stbi_uc*>(bytes.data()), static_cast<int>(bytes.size()),
-                             &info.width, &info.height, &info.channels))
-    return Status::Error(path.string() + ": not a readable PNG/JPEG image (" + stbi_failure_reason() + ")");
-  return info;
+  Result<DecodedImage> decoded = DecodeImage(bytes, decode);
+  if (!decoded.ok()) return Status::Error(path.string() + ": " + decoded.status().message());
+  return decoded;
+}
+}  // namespace
+
+Result<ImageInfo> ReadImageInfo(const fs::path& path) {
+  ICEF_ASSIGN_OR_RETURN(const DecodedImage d, ReadAndDecode(path, /*decode=*/false));
+  return ImageInfo{d.width, d.height, d.channels};
 }
 
 Result<Image> ReadImage(const fs::path& path) {
-  ICEF_ASSIGN_OR_RETURN(const std::string bytes, ReadFile(path));
-  if (bytes.empty()) return Status::Error(path.string() + ": empty file, not an image");
-  const auto* data = reinterpret_cast<const stbi_uc*>(bytes.data());
-  const int size = static_cast<int>(bytes.size());
-  int w = 0, h = 0, c = 0;
-  if (!stbi_info_from_memory(data, size, &w, &h, &c))
-    return Status::Error(path.string() + ": not a readable PNG/JPEG image (" + stbi_failure_reason() + ")");
-  // Bounded before anything is allocated: a corrupt header must not ask for gigabytes.
-  if (w <= 0 || h <= 0 || w > 16384 || h > 16384 || int64_t(w) * h > (int64_t(1) << 26))
-    return Status::Error(path.string() + ": unsupported image size " + std::to_string(w) + "x" + std::to_string(h));
+  ICEF_ASSIGN_OR_RETURN(const DecodedImage d, ReadAndDecode(path, /*decode=*/true));
+  const int c = d.channels;
   const int out_c = (c == 2) ? 4 : c;  // grey+alpha -> RGBA
-  Image img(w, h, out_c);
-  const size_t n = size_t(w) * h;
-  auto expand = [&](auto* src, float scale) {
+  Image img(d.width, d.height, out_c);
+  const size_t n = size_t(d.width) * d.height;
+  auto expand = [&](const auto* src, float scale) {
     for (size_t i = 0; i < n; ++i) {
       float* dst = &img.pixels[i * out_c];
       if (c == 2) {
@@ -64,16 +59,12 @@ Result<Image> ReadImage(const fs::path& path) {
       }
     }
   };
-  if (stbi_is_16_bit_from_memory(data, size)) {
-    stbi_us* px = stbi_load_16_from_memory(data, size, &w, &h, &c, 0);
-    if (!px) return Status::Error(path.string() + ": cannot decode image (" + stbi_failure_reason() + ")");
-    expand(px, 1.f / 65535.f);
-    stbi_image_free(px);
+  if (d.bit_depth == 16) {
+    std::vector<uint16_t> samples(d.samples.size() / 2);
+    std::memcpy(samples.data(), d.samples.data(), samples.size() * 2);
+    expand(samples.data(), 1.f / 65535.f);
   } else {
-    stbi_uc* px = stbi_load_from_memory(data, size, &w, &h, &c, 0);
-    if (!px) return Status::Error(path.string() + ": cannot decode image (" + stbi_failure_reason() + ")");
-    expand(px, 1.f / 255.f);
-    stbi_image_free(px);
+    expand(d.samples.data(), 1.f / 255.f);
   }
   return img;
 }

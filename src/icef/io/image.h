@@ -1,7 +1,8 @@
 // Float images: values in [0, 1] as stored in the file (no colour-space conversion: NeRF-family
 // datasets are trained directly on the stored values). Interleaved channels, row-major, row 0 at
-// the top. Reading via stb_image (PNG, JPEG; 8- or 16-bit; grey, grey+alpha, RGB, RGBA); writing
-// PNG (8-bit) atomically.
+// the top. Reading via libpng and libjpeg-turbo (PNG, JPEG; 8- or 16-bit; grey, grey+alpha, RGB,
+// RGBA; palette PNGs and CMYK JPEGs as RGB(A)), with a corrupt file an error naming it, never a
+// crash (io/image_decode.h); writing PNG (8-bit, stb_image_write) atomically.
 #pragma once
 
 #include <filesystem>
@@ -30,11 +31,14 @@ struct Image {
   std::string ToString() const;
 };
 
-// Size and channel count from the file header, without decoding the pixels.
+// Size and channel count from the file header, without decoding the pixels. The file's structure
+// is checked too (complete PNG chunks with valid CRCs up to IEND; complete JPEG segments up to the
+// end-of-image marker), so a truncated or bit-flipped PNG and a truncated JPEG are refused here;
+// damage inside compressed data that leaves the structure intact shows only in ReadImage.
 struct ImageInfo {
   int width = 0;
   int height = 0;
-  int channels = 0;
+  int channels = 0;  // as stored: 1 grey, 2 grey+alpha (read as RGBA), 3 RGB, 4 RGBA
 };
 Result<ImageInfo> ReadImageInfo(const std::filesystem::path& path);
 

@@ -204,6 +204,36 @@ Result<int> JsonObjectView::Int(std::string_view key) const {
   return static_cast<int>(x);
 }
 
+Result<int64_t> JsonObjectView::Int64(std::string_view key, int64_t min, int64_t max) const {
+  ICEF_ASSIGN_OR_RETURN(const Json* v, Get(key));
+  if (IsNonFinite(*v)) return Error(key, "expected a finite number, got " + NonFiniteName(*v));
+  if (!v->is_number()) return Error(key, "expected a number, got " + JsonTypeDescription(*v));
+  const std::string range = "[" + std::to_string(min) + ", " + std::to_string(max) + "]";
+  auto bad = [&] { return Error(key, "expected an integer in " + range + ", got " + v->dump()); };
+  if (v->is_number_unsigned()) {
+    const uint64_t x = v->get<uint64_t>();
+    if (max < 0 || x > uint64_t(max) || (min > 0 && x < uint64_t(min))) return bad();
+    return static_cast<int64_t>(x);
+  }
+  if (v->is_number_integer()) {
+    const int64_t x = v->get<int64_t>();
+    if (x < min || x > max) return bad();
+    return x;
+  }
+  const double x = v->get<double>();
+  // The double comparisons are exact for the bounds used in practice (|bound| <= 2^53).
+  if (!std::isfinite(x) || x != std::floor(x) || x < double(min) || x > double(max)) return bad();
+  return static_cast<int64_t>(x);
+}
+
+Result<uint64_t> JsonObjectView::Uint64(std::string_view key) const {
+  ICEF_ASSIGN_OR_RETURN(const Json* v, Get(key));
+  if (v->is_number_unsigned()) return v->get<uint64_t>();
+  if (v->is_number_integer() && v->get<int64_t>() >= 0) return static_cast<uint64_t>(v->get<int64_t>());
+  return Error(key, "expected a non-negative integer, got " +
+                        (v->is_number() ? v->dump() : JsonTypeDescription(*v)));
+}
+
 Result<bool> JsonObjectView::Bool(std::string_view key) const {
   ICEF_ASSIGN_OR_RETURN(const Json* v, Get(key));
   if (!v->is_boolean()) return Error(key, "expected true or false, got " + JsonTypeDescription(*v));
@@ -320,6 +350,32 @@ Result<std::vector<JsonObjectView>> JsonObjectView::ObjectArray(std::string_view
       return Status::Error(file_ + ": " + element + ": expected an object, got " + JsonTypeDescription((*v)[i]));
     out.push_back(JsonObjectView(&(*v)[i], file_, element));
   }
+  return out;
+}
+
+namespace {
+void CollectDifferences(const Json& a, const Json& b, const std::string& prefix, std::vector<std::string>* out) {
+  if (!a.is_object() || !b.is_object()) {
+    if (a != b) out->push_back(prefix);
+    return;
+  }
+  auto path = [&](const std::string& key) { return prefix.empty() ? key : prefix + "." + key; };
+  for (auto it = a.begin(); it != a.end(); ++it) {
+    const auto other = b.find(it.key());
+    if (other == b.end()) {
+      out->push_back(path(it.key()));
+    } else {
+      CollectDifferences(it.value(), *other, path(it.key()), out);
+    }
+  }
+  for (auto it = b.begin(); it != b.end(); ++it)
+    if (!a.contains(it.key())) out->push_back(path(it.key()));
+}
+}  // namespace
+
+std::vector<std::string> JsonDifferences(const Json& a, const Json& b) {
+  std::vector<std::string> out;
+  CollectDifferences(a, b, "", &out);
   return out;
 }
 

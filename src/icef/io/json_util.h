@@ -57,6 +57,11 @@ class JsonObjectView {
   // non-finite number an error naming the field.
   Result<double> Number(std::string_view key) const;
   Result<int> Int(std::string_view key) const;  // an integer-valued number within int range
+  // An integer-valued number in [min, max]; JSON integers are read exactly over the whole int64
+  // range, numbers written with a fraction or exponent must be whole.
+  Result<int64_t> Int64(std::string_view key, int64_t min, int64_t max) const;
+  // A non-negative JSON integer, read exactly over the whole uint64 range (hashes).
+  Result<uint64_t> Uint64(std::string_view key) const;
   Result<bool> Bool(std::string_view key) const;
   Result<std::string> String(std::string_view key) const;
   // Arrays; expected_size < 0 accepts any length.
@@ -77,6 +82,11 @@ class JsonObjectView {
   std::string file_;
   std::string path_;
 };
+
+// Dotted paths ("train.lambda_id") of the values that differ between two JSON objects: nested
+// objects are compared key by key, anything else as a whole; keys present on one side only count
+// as differences. In the order of `a`'s keys, then those only in `b`.
+std::vector<std::string> JsonDifferences(const Json& a, const Json& b);
 
 // Describes a JSON value's type for error messages ("a string", "null", "a non-finite number").
 std::string JsonTypeDescription(const Json& value);

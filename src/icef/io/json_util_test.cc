@@ -91,5 +91,29 @@ TEST(JsonUtil, FormatJsonKeepsScalarArraysOnOneLineAndReparses) {
   EXPECT_EQ(Json::parse(text), doc);
 }
 
+TEST(JsonUtil, Int64AndUint64AreExactAndRangeChecked) {
+  const Json doc = Parse(R"({"step": 120, "neg": -1, "half": 1.5, "big": 1e300, "whole": 3.0,
+                             "hash": 18446744073709551615, "s": "7"})");
+  const JsonObjectView t = JsonObjectView::Make(doc, "ckpt", "trainer").value();
+  EXPECT_EQ(t.Int64("step", 0, 1000).value(), 120);
+  EXPECT_EQ(t.Int64("whole", 0, 1000).value(), 3);
+  EXPECT_EQ(t.Int64("neg", 0, 1000).status().message(), "ckpt: trainer.neg: expected an integer in [0, 1000], got -1");
+  EXPECT_EQ(t.Int64("half", 0, 1000).status().message(), "ckpt: trainer.half: expected an integer in [0, 1000], got 1.5");
+  EXPECT_FALSE(t.Int64("big", 0, int64_t(1) << 53).ok());
+  EXPECT_FALSE(t.Int64("hash", 0, int64_t(1) << 53).ok());
+  EXPECT_FALSE(t.Int64("s", 0, 10).ok());
+  EXPECT_EQ(t.Uint64("hash").value(), 18446744073709551615ULL);
+  EXPECT_EQ(t.Uint64("step").value(), 120u);
+  EXPECT_EQ(t.Uint64("neg").status().message(), "ckpt: trainer.neg: expected a non-negative integer, got -1");
+  EXPECT_FALSE(t.Uint64("whole").ok());
+}
+
+TEST(JsonUtil, DifferencesNameNestedKeys) {
+  const Json a = Parse(R"({"model": {"method": "icef", "hidden": [16]}, "train": {"steps": 10, "lr": 0.1}})");
+  const Json b = Parse(R"({"model": {"method": "warp", "hidden": [16]}, "train": {"steps": 20, "seed": 1}})");
+  EXPECT_EQ(JsonDifferences(a, a), std::vector<std::string>{});
+  EXPECT_EQ(JsonDifferences(a, b), (std::vector<std::string>{"model.method", "train.steps", "train.lr", "train.seed"}));
+}
+
 }  // namespace
 }  // namespace icef

@@ -12,7 +12,8 @@ namespace fs = std::filesystem;
 Status SaveCheckpoint(const fs::path& path, const RunConfig& config, const AvatarModel& model, const nn::Adam* adam,
                       const TrainerState& state) {
   CheckpointWriter w;
-  w.Add("config", config.ToJson().dump());
+  const std::string config_text = config.ToJson().dump();
+  w.Add("config", config_text);
   w.Add("setup", model.setup().ToJson().dump());
   std::ostringstream params;
   ICEF_RETURN_IF_ERROR(model.store().Write(params));
@@ -29,12 +30,33 @@ Status SaveCheckpoint(const fs::path& path, const RunConfig& config, const Avata
   Json trainer;
   trainer["step"] = state.step;
   trainer["elapsed_seconds"] = state.elapsed_seconds;
-  trainer["config_hash"] = config.Hash();
+  trainer["skipped_steps"] = state.skipped_steps;
+  trainer["config_hash"] = Fnv1a64(config_text);  // = config.Hash()
   w.Add("trainer", trainer.dump());
   std::string log;
   for (const auto& line : state.log) log += line + "\n";
   w.Add("log", log);
   return w.WriteAtomic(path);
+}
+
+Result<TrainerState> ParseTrainerSection(const std::string& trainer_text, const std::string& config_text,
+                                         const std::string& origin) {
+  ICEF_ASSIGN_OR_RETURN(const Json json, ParseJson(trainer_text, origin + " [trainer]"));
+  ICEF_ASSIGN_OR_RETURN(const JsonObjectView tv, JsonObjectView::Make(json, origin, "trainer"));
+  TrainerState state;
+  ICEF_ASSIGN_OR_RETURN(state.step, tv.Int64("step", 0, kMaxCheckpointStep));
+  ICEF_ASSIGN_OR_RETURN(state.elapsed_seconds, tv.Number("elapsed_seconds"));
+  if (state.elapsed_seconds < 0) return tv.Error("elapsed_seconds", "must be >= 0, got " + json["elapsed_seconds"].dump());
+  if (tv.Has("skipped_steps")) {
+    ICEF_ASSIGN_OR_RETURN(state.skipped_steps, tv.Int64("skipped_steps", 0, state.step));
+  }
+  // The hash covers the config section exactly as written, so a checkpoint whose config was
+  // edited (or whose sections come from different runs) is refused.
+  ICEF_ASSIGN_OR_RETURN(const uint64_t stored_hash, tv.Uint64("config_hash"));
+  if (stored_hash != Fnv1a64(config_text))
+    return tv.Error("config_hash", "does not match the checkpoint's config section (the config or the trainer state "
+                                   "was altered after the checkpoint was written)");
+  return state;
 }
 
 Result<LoadedModel> LoadModel(const fs::path& given, const Executor& executor) {
@@ -46,6 +68,8 @@ Result<LoadedModel> LoadModel(const fs::path& given, const Executor& executor) {
   const std::string origin = path.string();
   LoadedModel out;
   ICEF_ASSIGN_OR_RETURN(const std::string config_text, ckpt.Section("config"));
+  ICEF_ASSIGN_OR_RETURN(const std::string trainer_text, ckpt.Section("trainer"));
+  ICEF_ASSIGN_OR_RETURN(out.state, ParseTrainerSection(trainer_text, config_text, origin));
   ICEF_ASSIGN_OR_RETURN(const Json config_json, ParseJson(config_text, origin + " [config]"));
   ICEF_ASSIGN_OR_RETURN(out.config, RunConfig::FromJson(config_json, origin + " [config]"));
   ICEF_ASSIGN_OR_RETURN(const std::string setup_text, ckpt.Section("setup"));
@@ -58,7 +82,7 @@ Result<LoadedModel> LoadModel(const fs::path& given, const Executor& executor) {
   ICEF_ASSIGN_OR_RETURN(std::string occ, ckpt.Section("occupancy"));
   if (occ.size() % sizeof(float) != 0) return Status::Error(origin + " [occupancy]: size is not a whole number of floats");
   std::vector<float> densities(occ.size() / sizeof(float));
-  std::memcpy(densities.data(), occ.data(), occ.size());
+  if (!occ.empty()) std::memcpy(densities.data(), occ.data(), occ.size());  // never memcpy(nullptr, ...)
   ICEF_RETURN_IF_ERROR(out.model->occupancy().SetDensities(std::move(densities)).WithContext(origin + " [occupancy]"));
   ICEF_ASSIGN_OR_RETURN(const std::string allowed, ckpt.Section("occupancy_allowed"));
   ICEF_RETURN_IF_ERROR(out.model->occupancy()
@@ -67,12 +91,6 @@ Result<LoadedModel> LoadModel(const fs::path& given, const Executor& executor) {
   if (ckpt.Has("adam")) {
     ICEF_ASSIGN_OR_RETURN(out.adam_state, ckpt.Section("adam"));
   }
-  ICEF_ASSIGN_OR_RETURN(const std::string trainer_text, ckpt.Section("trainer"));
-  ICEF_ASSIGN_OR_RETURN(const Json trainer_json, ParseJson(trainer_text, origin + " [trainer]"));
-  ICEF_ASSIGN_OR_RETURN(const JsonObjectView tv, JsonObjectView::Make(trainer_json, origin, "trainer"));
-  ICEF_ASSIGN_OR_RETURN(const double step, tv.Number("step"));
-  ICEF_ASSIGN_OR_RETURN(out.state.elapsed_seconds, tv.Number("elapsed_seconds"));
-  out.state.step = static_cast<int64_t>(step);
   if (DeformationField* d = out.model->deformation()) d->SetAnnealing(DeformationAnnealing(out.config, out.state.step));
   out.model->static_field().SetLevelWeights(GridLevelWeights(out.config, out.state.step));
   if (ckpt.Has("log")) {

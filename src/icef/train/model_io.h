@@ -24,8 +24,12 @@ inline constexpr const char* kCheckpointFile = "checkpoint.icef";
 struct TrainerState {
   int64_t step = 0;              // completed optimiser steps
   double elapsed_seconds = 0;    // training wall time so far (over all resumed runs)
+  int64_t skipped_steps = 0;     // steps skipped for a non-finite loss or gradient (train.on_nonfinite = skip)
   std::vector<std::string> log;  // train_log.jsonl lines so far
 };
+
+// Largest step count a checkpoint may hold (exact in a double, far beyond any real run).
+inline constexpr int64_t kMaxCheckpointStep = int64_t(1) << 53;
 
 Status SaveCheckpoint(const std::filesystem::path& path, const RunConfig& config, const AvatarModel& model,
                       const nn::Adam* adam, const TrainerState& state);
@@ -36,6 +40,13 @@ struct LoadedModel {
   std::string adam_state;  // serialised Adam state (empty when the checkpoint has none)
   TrainerState state;
 };
+
+// The checkpoint's "trainer" section: step (an integer in [0, kMaxCheckpointStep]), elapsed_seconds
+// (finite, >= 0), skipped_steps (optional, in [0, step]) and config_hash, which must equal the hash
+// of `config_text`, the checkpoint's "config" section, byte for byte as stored. Errors name
+// `origin` and the field ("model/checkpoint.icef: trainer.step: ...").
+Result<TrainerState> ParseTrainerSection(const std::string& trainer_text, const std::string& config_text,
+                                         const std::string& origin);
 
 // Reads a checkpoint file, or MODEL_DIR/checkpoint.icef when given a directory. Errors name the
 // file and what is wrong (corrupt, truncated, from another version, missing section).

@@ -38,6 +38,10 @@ void TrainConfig::Bind(ConfigSchema& s) {
   s.Int("eval_every", &eval_every, "steps between held-out PSNR evaluations on observed-tier test frames (0 = off)");
   s.Int64("seed", &seed, "root seed of every random draw");
   s.Int("threads", &threads, "worker threads (0 = all cores)");
+  s.String("on_nonfinite", &on_nonfinite,
+           "a non-finite loss term or gradient: \"stop\" training with an error naming the step and term, or "
+           "\"skip\" the optimiser step (counted as skipped_steps in summary.json; the 11th non-finite step in a "
+           "row still stops training)");
 }
 
 Status TrainConfig::Validate() const {
@@ -61,6 +65,8 @@ Status TrainConfig::Validate() const {
     return Status::Error("train: anneal_steps, occupancy_warmup, checkpoint_every, eval_every must be >= 0 and "
                          "occupancy_every, log_every >= 1");
   if (threads < 0) return Status::Error("train.threads must be >= 0");
+  if (on_nonfinite != "stop" && on_nonfinite != "skip")
+    return Status::Error("train.on_nonfinite must be \"stop\" or \"skip\", got \"" + on_nonfinite + "\"");
   return Status::Ok();
 }
 

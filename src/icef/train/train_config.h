@@ -39,6 +39,7 @@ struct TrainConfig {
   int eval_every = 0;                // steps between held-out PSNR evaluations on observed-tier test frames (0 = off)
   int64_t seed = 0;                  // root seed of every random draw
   int threads = 0;                   // worker threads (0 = all cores)
+  std::string on_nonfinite = "stop"; // a non-finite loss term or gradient: "stop" training, or "skip" the step
 
   void Bind(ConfigSchema& s);
   Status Validate() const;

@@ -22,6 +22,7 @@ Json TrainSummary::ToJson() const {
   j["psnr_observed"] = psnr_observed ? Json(*psnr_observed) : Json(nullptr);
   j["observed_frames"] = observed_frames;
   j["samples_per_second"] = samples_per_second;
+  j["skipped_steps"] = skipped_steps;
   j["interrupted"] = interrupted;
   j["stop_reason"] = stop_reason;
   return j;
@@ -32,6 +33,7 @@ std::string TrainSummary::BriefReport() const {
   os.precision(4);
   os << method << ": " << steps << " steps in " << wall_seconds << " s (" << stop_reason << "), final loss "
      << final_loss << ", batch PSNR " << final_batch_psnr << " dB";
+  if (skipped_steps > 0) os << ", steps skipped for a non-finite loss or gradient: " << skipped_steps;
   if (psnr_observed) os << ", held-out PSNR (observed tier, " << observed_frames << " frames) " << *psnr_observed << " dB";
   return os.str();
 }
@@ -101,13 +103,24 @@ Result<std::unique_ptr<Trainer>> Trainer::Resume(const Dataset& dataset, const f
                                                  std::optional<int64_t> steps_override,
                                                  std::optional<double> time_budget_override,
                                                  std::optional<int> threads_override) {
-  ICEF_ASSIGN_OR_RETURN(LoadedModel loaded, LoadModel(model_dir, Executor(threads_override.value_or(0))));
+  auto configure = [&](const RunConfig& saved) -> Result<RunConfig> {
+    RunConfig config = saved;
+    if (steps_override) config.train.steps = *steps_override;
+    if (time_budget_override) config.train.time_budget_seconds = *time_budget_override;
+    if (threads_override) config.train.threads = *threads_override;
+    return config;
+  };
+  return Resume(dataset, model_dir, configure, threads_override.value_or(0));
+}
+
+Result<std::unique_ptr<Trainer>> Trainer::Resume(const Dataset& dataset, const fs::path& model_dir,
+                                                 const ConfigureResumeFn& configure, int load_threads) {
+  ICEF_ASSIGN_OR_RETURN(LoadedModel loaded, LoadModel(model_dir, Executor(load_threads)));
   ICEF_RETURN_IF_ERROR(CheckDatasetMatches(dataset, loaded.model->setup(), dataset.root.string()));
-  RunConfig config = loaded.config;
-  if (steps_override) config.train.steps = *steps_override;
-  if (time_budget_override) config.train.time_budget_seconds = *time_budget_override;
-  if (threads_override) config.train.threads = *threads_override;
+  ICEF_ASSIGN_OR_RETURN(const RunConfig config, configure(loaded.config));
   ICEF_RETURN_IF_ERROR(config.Validate());
+  if (WriteConfig(config.model) != WriteConfig(loaded.config.model))
+    return Status::Error((model_dir / kCheckpointFile).string() + ": resuming cannot change the model config");
   ICEF_ASSIGN_OR_RETURN(TrainingData data, TrainingData::Load(dataset));
   std::unique_ptr<Trainer> trainer(
       new Trainer(dataset, model_dir, config, std::move(data), std::move(loaded.model)));
@@ -141,22 +154,42 @@ Result<LossTerms> Trainer::Step() {
   w.smooth_epsilon = t.smooth_epsilon;
   w.smooth_max_samples = t.smooth_max_samples;
   const LossTerms terms = model_->TrainForwardBackward(batch_, w, seed, state_.step, executor_);
-  auto bad = [&](const char* name, double v) -> Status {
-    if (std::isfinite(v)) return Status::Ok();
-    return Status::Error("step " + std::to_string(state_.step) + ": loss term '" + name +
-                         "' is not finite; training stopped, the last checkpoint is kept");
-  };
-  ICEF_RETURN_IF_ERROR(bad("photo", terms.photo));
-  ICEF_RETURN_IF_ERROR(bad("mask", terms.mask));
-  ICEF_RETURN_IF_ERROR(bad("id", terms.id));
-  ICEF_RETURN_IF_ERROR(bad("smooth", terms.smooth));
-  ICEF_RETURN_IF_ERROR(bad("distortion", terms.distortion));
-  const float* g = model_->store().grads();
-  float sum = 0;
-  for (int64_t i = 0, n = model_->store().size(); i < n; ++i) sum += g[i] * 0.f;  // NaN/Inf propagate through * 0
-  if (!std::isfinite(sum))
-    return Status::Error("step " + std::to_string(state_.step) +
-                         ": a parameter gradient is not finite; training stopped, the last checkpoint is kept");
+  // What is non-finite this step ("" when nothing is).
+  std::string nonfinite;
+  for (const auto& [name, v] : {std::pair{"photo", terms.photo}, std::pair{"mask", terms.mask},
+                                std::pair{"id", terms.id}, std::pair{"smooth", terms.smooth},
+                                std::pair{"distortion", terms.distortion}, std::pair{"total", terms.total}}) {
+    if (!std::isfinite(v)) {
+      nonfinite = std::string("loss term '") + name + "' is not finite";
+      break;
+    }
+  }
+  if (nonfinite.empty()) {
+    const float* g = model_->store().grads();
+    float sum = 0;
+    for (int64_t i = 0, n = model_->store().size(); i < n; ++i) sum += g[i] * 0.f;  // NaN/Inf propagate through * 0
+    if (!std::isfinite(sum)) nonfinite = "a parameter gradient is not finite";
+  }
+  const std::string step_name = "step " + std::to_string(state_.step);
+  if (!nonfinite.empty() && t.on_nonfinite != "skip")
+    return Status::Error(step_name + ": " + nonfinite + "; training stopped, the last checkpoint is kept");
+  if (!nonfinite.empty()) {
+    // Skip: drop the gradients, leave the parameters and the optimiser state as they are, and
+    // advance the step counter so that the next step draws a different batch.
+    if (++consecutive_skipped_ > kMaxConsecutiveSkippedSteps)
+      return Status::Error(step_name + ": " + nonfinite + ", the " + std::to_string(consecutive_skipped_) +
+                           "th non-finite step in a row (train.on_nonfinite = \"skip\" skips at most " +
+                           std::to_string(kMaxConsecutiveSkippedSteps) +
+                           " in a row); training stopped, the last checkpoint is kept");
+    model_->store().ZeroGrads();
+    ++state_.skipped_steps;
+    ++state_.step;
+    ApplySchedules();
+    last_step_skipped_ = true;
+    return terms;
+  }
+  consecutive_skipped_ = 0;
+  last_step_skipped_ = false;
   adam_->Step(executor_);
   ++state_.step;
   ApplySchedules();  // the model between steps is the model of `state_.step` completed steps
@@ -225,6 +258,7 @@ Result<TrainSummary> Trainer::Run(const ProgressFn& progress, const std::atomic<
       line["occlusion"] = terms.occlusion;
       line["batch_psnr"] = terms.psnr();
       line["occupied"] = model_->occupancy().OccupiedFraction();
+      if (last_step_skipped_) line["skipped"] = true;
       if (t.eval_every > 0 && state_.step % t.eval_every == 0) {
         int count = 0;
         const auto psnr = MeanTierPsnr(*model_, dataset_, Tier::kObserved, executor_, &count);
@@ -233,12 +267,16 @@ Result<TrainSummary> Trainer::Run(const ProgressFn& progress, const std::atomic<
       state_.log.push_back(line.dump());
     }
     if (progress) progress({state_.step, t.steps, state_.elapsed_seconds, terms});
-    if (t.checkpoint_every > 0 && state_.step % t.checkpoint_every == 0) ICEF_RETURN_IF_ERROR(SaveCheckpoint());
+    // Not after a skipped step: should the non-finite values persist until training stops, the
+    // last checkpoint is still the one of the last good step.
+    if (t.checkpoint_every > 0 && state_.step % t.checkpoint_every == 0 && !last_step_skipped_)
+      ICEF_RETURN_IF_ERROR(SaveCheckpoint());
   }
   state_.elapsed_seconds = elapsed();
   const double run_seconds = state_.elapsed_seconds - elapsed_before;
   ICEF_RETURN_IF_ERROR(SaveCheckpoint());
   summary.steps = state_.step;
+  summary.skipped_steps = state_.skipped_steps;
   summary.wall_seconds = state_.elapsed_seconds;
   summary.final_loss = last_terms_.total;
   summary.final_batch_psnr = last_terms_.psnr();

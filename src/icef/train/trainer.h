@@ -28,6 +28,7 @@ struct TrainSummary {
   std::optional<double> psnr_observed;  // mean PSNR over test frames of tier `observed`
   int observed_frames = 0;
   double samples_per_second = 0;      // field samples per second of training time (this run)
+  int64_t skipped_steps = 0;          // steps skipped for a non-finite loss or gradient (all resumed runs)
   bool interrupted = false;           // stopped by a signal before the end
   std::string stop_reason;            // "steps", "time budget" or "interrupted"
 
@@ -42,9 +43,16 @@ struct TrainProgress {
   LossTerms terms;
 };
 
+// With train.on_nonfinite = "skip", at most this many non-finite steps in a row are skipped; the
+// next one stops training.
+inline constexpr int kMaxConsecutiveSkippedSteps = 10;
+
 class Trainer {
  public:
   using ProgressFn = std::function<void(const TrainProgress&)>;
+  // Turns the checkpoint's config into the config of the continued run (the caller decides what
+  // may change; the model config may not).
+  using ConfigureResumeFn = std::function<Result<RunConfig>(const RunConfig& checkpoint_config)>;
 
   // Fresh run: creates model_dir, writes config.json; runs on config.train.threads threads. The
   // dataset must outlive the trainer.
@@ -57,13 +65,20 @@ class Trainer {
                                                  std::optional<int64_t> steps_override,
                                                  std::optional<double> time_budget_override,
                                                  std::optional<int> threads_override);
+  // Continues from model_dir/checkpoint.icef with the config `configure` returns; the checkpoint
+  // is loaded on `load_threads` threads (0 = all cores). Nothing is written here.
+  static Result<std::unique_ptr<Trainer>> Resume(const Dataset& dataset, const std::filesystem::path& model_dir,
+                                                 const ConfigureResumeFn& configure, int load_threads);
 
   // Runs to the configured step count or time budget, or until *stop becomes true (then a
   // checkpoint is written and summary.interrupted is set). A non-finite loss or gradient stops
-  // training with an error naming the step and the term; the last checkpoint stays intact.
+  // training with an error naming the step and the term, the last checkpoint intact; with
+  // train.on_nonfinite = "skip" the step is skipped instead (no optimiser update, its gradients
+  // dropped, the step counter advanced so the next batch differs) unless more than
+  // kMaxConsecutiveSkippedSteps steps in a row were non-finite (counted within one run).
   Result<TrainSummary> Run(const ProgressFn& progress, const std::atomic<bool>* stop);
 
-  // One optimiser step (exposed for tests); returns its loss terms.
+  // One optimiser step (exposed for tests); returns its loss terms (non-finite ones when skipped).
   Result<LossTerms> Step();
   Status SaveCheckpoint() const;
 
@@ -91,6 +106,8 @@ class Trainer {
   TrainerState state_;
   TrainRays batch_;
   LossTerms last_terms_;
+  int consecutive_skipped_ = 0;     // non-finite steps in a row (on_nonfinite = "skip")
+  bool last_step_skipped_ = false;  // the latest Step() was skipped
 };
 
 }  // namespace icef
