@@ -158,7 +158,8 @@ Result<LossTerms> Trainer::Step() {
   std::string nonfinite;
   for (const auto& [name, v] : {std::pair{"photo", terms.photo}, std::pair{"mask", terms.mask},
                                 std::pair{"id", terms.id}, std::pair{"smooth", terms.smooth},
-                                std::pair{"distortion", terms.distortion}, std::pair{"total", terms.total}}) {
+                                std::pair{"distortion", terms.distortion}, std::pair{"occlusion", terms.occlusion},
+                                std::pair{"total", terms.total}}) {
     if (!std::isfinite(v)) {
       nonfinite = std::string("loss term '") + name + "' is not finite";
       break;
