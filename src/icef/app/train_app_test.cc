@@ -77,7 +77,7 @@ TEST(ResumeConfig, ConfigFileIsAWholeRunConfig) {
   const Status s = ResolveResumeConfig(other, Saved(), "m/checkpoint.icef").status();
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.message().find("other.json"), std::string::npos) << s.message();
-  EXPECT_NE(s.message().find("train.lambda_id (checkpoint 0.2, given 0.1)"), std::string::npos) << s.message();
+  EXPECT_NE(s.message().find("train.lambda_id (checkpoint 0.2, given 1.0)"), std::string::npos) << s.message();
   fs::remove_all(other.config_file->parent_path());
 }
 
