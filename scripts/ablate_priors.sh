@@ -35,6 +35,7 @@ done
 # name | what changes | --set overrides (empty: the defaults)
 variants=(
   "default|all defaults (docs/config.md)|"
+  "no-symmetry|left-right symmetry prior off|train.lambda_symmetry=0"
   "no-occlusion|occlusion sparsity prior off|train.lambda_occlusion=0"
   "distortion-1e-3|distortion loss weight 1e-3 instead of the default|train.lambda_distortion=0.001"
   "no-distortion|distortion loss off|train.lambda_distortion=0"

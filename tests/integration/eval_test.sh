@@ -13,8 +13,11 @@ fail() { echo "FAIL: $*" >&2; exit 1; }
 TINY=(--set model.grid_levels=4 --set model.grid_log2_table_size=10 --set model.grid_finest_resolution=32
       --set model.density_hidden=16 --set "model.color_hidden=[16]" --set "model.deform_hidden=[16,16]"
       --set model.samples_per_ray=16 --set model.occupancy_resolution=16 --set train.batch_rays=256)
-"$ICEF" train "$WORK/data" --out "$WORK/model" --steps 10 --threads 2 --quiet "${TINY[@]}" > /dev/null \
+"$ICEF" train "$WORK/data" --out "$WORK/model" --steps 10 --threads 2 --quiet "${TINY[@]}" > "$WORK/train.txt" \
   || fail "icef train exited $?"
+# The symmetry prior (on by default) reports how well the synthetic face's landmarks mirror.
+grep -Eq "^symmetry prior: landmark pairs mirror onto each other within 0\.0[0-9]* inter-ocular distances$" \
+  "$WORK/train.txt" || fail "no symmetry-plane line: $(cat "$WORK/train.txt")"
 
 "$ICEF" eval "$WORK/model" "$WORK/data" --out "$WORK/eval" --threads 2 > "$WORK/out.txt" 2> "$WORK/err.txt" \
   || fail "icef eval exited $?: $(cat "$WORK/err.txt")"

@@ -8,6 +8,10 @@
 #include "icef/core/progress.h"
 
 namespace icef {
+namespace {
+// Landmark mirror error (inter-ocular distances) above which the symmetry prior gets a warning.
+constexpr float kAsymmetricFace = 0.1f;
+}  // namespace
 
 namespace fs = std::filesystem;
 
@@ -81,7 +85,20 @@ Result<TrainSummary> RunTrain(const TrainAppOptions& o, std::ostream& out) {
   out << "icef train: " << config.model.method << " on " << o.dataset.string() << " (" << dataset.train.size()
       << " training frames), " << config.train.steps << " steps";
   if (config.train.time_budget_seconds > 0) out << " or " << config.train.time_budget_seconds << " s";
-  out << (o.resume ? ", resuming at step " + std::to_string(trainer->step()) : "") << "\n" << std::flush;
+  out << (o.resume ? ", resuming at step " + std::to_string(trainer->step()) : "") << "\n";
+  if (config.train.lambda_symmetry > 0) {
+    const std::optional<SymmetryPlane>& plane = trainer->model().symmetry_plane();
+    if (!plane) {
+      out << "symmetry prior: off, the landmarks give no left-right symmetry plane\n";
+    } else {
+      std::ostringstream line;
+      line << "symmetry prior: landmark pairs mirror onto each other within " << std::setprecision(2)
+           << plane->residual() << " inter-ocular distances";
+      if (plane->residual() > kAsymmetricFace) line << " (a clearly asymmetric face: consider train.lambda_symmetry=0)";
+      out << line.str() << "\n";
+    }
+  }
+  out << std::flush;
   ProgressBar bar("train", config.train.steps, out, !o.quiet && StdoutIsTerminal());
   bar.Update(trainer->step());
   auto progress = [&](const TrainProgress& p) {

@@ -6,6 +6,7 @@
 
 #include "icef/core/rng.h"
 #include "icef/model/identity_losses.h"
+#include "icef/model/symmetry_loss.h"
 #include "icef/render/distortion_loss.h"
 #include "icef/render/occlusion_loss.h"
 
@@ -23,6 +24,11 @@ struct ModelWorkspace {
   std::vector<float> smooth_positions, smooth_betas, smooth_offsets, smooth_d_offsets, smooth_weight;
   std::vector<int64_t> smooth_index;
   DeformationContext smooth_ctx;
+  // L_sym: m samples (gathered) and their mirror images.
+  std::vector<int64_t> sym_index;
+  std::vector<float> sym_positions, sym_dirs, sym_betas, sym_sigma_a, sym_rgb_a, sym_sigma_b, sym_rgb_b, sym_dt;
+  std::vector<float> sym_d_sigma_a, sym_d_rgb_a, sym_d_sigma_b, sym_d_rgb_b, sym_d_positions;
+  StaticFieldContext sym_ctx;
 };
 
 namespace {
@@ -36,14 +42,14 @@ double LossTerms::psnr() const { return photo > 0 ? -10.0 * std::log10(photo) : 
 
 bool LossTerms::AllFinite() const {
   return std::isfinite(photo) && std::isfinite(mask) && std::isfinite(id) && std::isfinite(smooth) &&
-         std::isfinite(distortion) && std::isfinite(occlusion) && std::isfinite(total);
+         std::isfinite(distortion) && std::isfinite(occlusion) && std::isfinite(symmetry) && std::isfinite(total);
 }
 
 std::string LossTerms::ToString() const {
   std::ostringstream os;
   os.precision(4);
   os << "loss " << total << " (photo " << photo << ", mask " << mask << ", id " << id << ", smooth " << smooth
-     << ", dist " << distortion << ", occ " << occlusion << ") psnr " << psnr();
+     << ", dist " << distortion << ", occ " << occlusion << ", sym " << symmetry << ") psnr " << psnr();
   return os.str();
 }
 
@@ -72,6 +78,8 @@ Result<std::unique_ptr<AvatarModel>> AvatarModel::Create(const ModelConfig& conf
   if (confidence.expression_dim() != setup.expression_dim)
     return Status::Error("model setup: training expressions do not have expression_dim values");
   std::unique_ptr<AvatarModel> model(new AvatarModel(config, setup, std::move(mask), std::move(confidence)));
+  if (Result<SymmetryPlane> plane = SymmetryPlane::FromLandmarks(setup.mask_landmarks); plane.ok())
+    model->symmetry_ = *plane;
   model->static_field_ = std::make_unique<StaticField>(config.StaticOptions(setup.expression_dim), setup.aabb,
                                                        &model->store_, "static", kGridGroup, kMlpGroup);
   if (model->traits_.deformation) {
@@ -239,9 +247,21 @@ LossTerms AvatarModel::TrainForwardBackward(const TrainRays& batch, const LossWe
     terms.occlusion = occ * inv_r;
   }
 
+  const bool symmetry = weights.lambda_symmetry > 0 && symmetry_;
+  if (symmetry) terms.symmetry = SymmetryTerm(ws, n, canonical, weights, executor);
+
   if (deformation_) Fit(ws.d_canonical, 3 * n);
   static_field_->Backward(executor, n, ws.sigma.data(), ws.rgb.data(), ws.d_sigma.data(), ws.d_rgb.data(),
                           &ws.static_ctx, deformation_ ? ws.d_canonical.data() : nullptr);
+  if (symmetry && deformation_) {
+    // The mirror images P x_c move with the warp too: d/dx_c = H d/d(P x_c), H = I - 2 n n^T.
+    for (size_t j = 0; j < ws.sym_index.size(); ++j) {
+      const int64_t i = ws.sym_index[j];
+      const Vec3f g = symmetry_->ReflectDirection(
+          Vec3f(ws.sym_d_positions[3 * j], ws.sym_d_positions[3 * j + 1], ws.sym_d_positions[3 * j + 2]));
+      for (int a = 0; a < 3; ++a) ws.d_canonical[3 * i + a] += g[a];
+    }
+  }
 
   if (deformation_) {
     const bool id_terms = traits_.identity_losses && (weights.lambda_id > 0 || weights.lambda_smooth > 0);
@@ -299,8 +319,63 @@ LossTerms AvatarModel::TrainForwardBackward(const TrainRays& batch, const LossWe
   const double lid = traits_.identity_losses ? weights.lambda_id : 0.0;
   const double lsm = traits_.identity_losses ? weights.lambda_smooth : 0.0;
   terms.total = terms.photo + weights.lambda_mask * terms.mask + lid * terms.id + lsm * terms.smooth +
-                weights.lambda_distortion * terms.distortion + weights.lambda_occlusion * terms.occlusion;
+                weights.lambda_distortion * terms.distortion + weights.lambda_occlusion * terms.occlusion +
+                weights.lambda_symmetry * terms.symmetry;
   return terms;
+}
+
+double AvatarModel::SymmetryTerm(ModelWorkspace& ws, int64_t n, const float* canonical, const LossWeights& weights,
+                                 const Executor& executor) {
+  // An even stride over the batch's samples; their canonical positions and directions mirrored.
+  const int64_t m = std::min<int64_t>(n, weights.symmetry_max_samples);
+  ws.sym_index.clear();
+  if (m <= 0) return 0.0;
+  const int b = setup_.expression_dim;
+  const bool cond = traits_.entangled_beta;
+  Fit(ws.sym_index, m);
+  Fit(ws.sym_positions, 3 * m);
+  Fit(ws.sym_dirs, 3 * m);
+  Fit(ws.sym_sigma_a, m);
+  Fit(ws.sym_rgb_a, 3 * m);
+  Fit(ws.sym_sigma_b, m);
+  Fit(ws.sym_rgb_b, 3 * m);
+  Fit(ws.sym_dt, m);
+  Fit(ws.sym_d_sigma_a, m);
+  Fit(ws.sym_d_rgb_a, 3 * m);
+  Fit(ws.sym_d_sigma_b, m);
+  Fit(ws.sym_d_rgb_b, 3 * m);
+  if (cond) Fit(ws.sym_betas, m * b);
+  for (int64_t j = 0; j < m; ++j) {
+    const int64_t i = j * n / m;
+    ws.sym_index[j] = i;
+    const Vec3f x = symmetry_->ReflectPoint(Vec3f(canonical[3 * i], canonical[3 * i + 1], canonical[3 * i + 2]));
+    const Vec3f d = symmetry_->ReflectDirection(Vec3f(ws.dirs[3 * i], ws.dirs[3 * i + 1], ws.dirs[3 * i + 2]));
+    for (int a = 0; a < 3; ++a) {
+      ws.sym_positions[3 * j + a] = x[a];
+      ws.sym_dirs[3 * j + a] = d[a];
+      ws.sym_rgb_a[3 * j + a] = ws.rgb[3 * i + a];
+    }
+    ws.sym_sigma_a[j] = ws.sigma[i];
+    ws.sym_dt[j] = ws.samples.dt[i];
+    if (cond) std::copy(ws.betas.begin() + i * b, ws.betas.begin() + (i + 1) * b, ws.sym_betas.begin() + j * b);
+  }
+  static_field_->Forward(executor, m, ws.sym_positions.data(), ws.sym_dirs.data(), cond ? ws.sym_betas.data() : nullptr,
+                         ws.sym_sigma_b.data(), ws.sym_rgb_b.data(), &ws.sym_ctx, true, deformation_ != nullptr);
+  const float scale = static_cast<float>(weights.lambda_symmetry);
+  const double loss = SymmetryLoss<float>(m, ws.sym_sigma_a.data(), ws.sym_rgb_a.data(), ws.sym_sigma_b.data(),
+                                          ws.sym_rgb_b.data(), ws.sym_dt.data(),
+                                          static_cast<float>(weights.symmetry_colour), scale, ws.sym_d_sigma_a.data(),
+                                          ws.sym_d_rgb_a.data(), ws.sym_d_sigma_b.data(), ws.sym_d_rgb_b.data());
+  // The original samples' share joins the main backward pass; the mirror images get their own.
+  for (int64_t j = 0; j < m; ++j) {
+    const int64_t i = ws.sym_index[j];
+    ws.d_sigma[i] += ws.sym_d_sigma_a[j];
+    for (int a = 0; a < 3; ++a) ws.d_rgb[3 * i + a] += ws.sym_d_rgb_a[3 * j + a];
+  }
+  if (deformation_) Fit(ws.sym_d_positions, 3 * m);
+  static_field_->Backward(executor, m, ws.sym_sigma_b.data(), ws.sym_rgb_b.data(), ws.sym_d_sigma_b.data(),
+                          ws.sym_d_rgb_b.data(), &ws.sym_ctx, deformation_ ? ws.sym_d_positions.data() : nullptr);
+  return loss;
 }
 
 void AvatarModel::Render(std::span<const Ray> rays, std::span<const float> beta, const Vec3f& background,

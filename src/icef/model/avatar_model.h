@@ -8,6 +8,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -17,6 +18,7 @@
 #include "icef/field/deformation_field.h"
 #include "icef/field/region_mask.h"
 #include "icef/field/static_field.h"
+#include "icef/field/symmetry_plane.h"
 #include "icef/model/model_config.h"
 #include "icef/model/model_setup.h"
 #include "icef/nn/parameter_store.h"
@@ -32,7 +34,7 @@ inline constexpr int kMlpGroup = 1;
 inline constexpr int kDeformGroup = 2;
 
 // Loss weights of L = L_photo + lambda_mask L_mask + lambda_id L_id + lambda_smooth L_smooth
-// + lambda_distortion L_dist + lambda_occlusion L_occ (the trainer fills them from TrainConfig; the method's traits zero
+// + lambda_distortion L_dist + lambda_occlusion L_occ + lambda_symmetry L_sym (the trainer fills them from TrainConfig; the method's traits zero
 // L_id and L_smooth where the method has none).
 struct LossWeights {
   double lambda_id = 0.0;
@@ -40,6 +42,9 @@ struct LossWeights {
   double lambda_mask = 0.0;
   double lambda_distortion = 0.0;
   double lambda_occlusion = 0.0;
+  double lambda_symmetry = 0.0;
+  double symmetry_colour = 0.0;  // weight of the colour part of L_sym (model/symmetry_loss.h)
+  int symmetry_max_samples = 16384;  // cap on the samples mirrored by L_sym per batch
   double smooth_epsilon = 0.01;  // finite-difference offset of L_smooth, in half-extent units of the aabb
   int smooth_max_samples = 8192;  // cap on boundary samples used by L_smooth per batch
 };
@@ -61,6 +66,7 @@ struct LossTerms {
   double smooth = 0;      // L_smooth estimate
   double distortion = 0;  // mean distortion loss per ray (distances in aabb diagonals)
   double occlusion = 0;   // mean occlusion sparsity loss per ray (render/occlusion_loss.h)
+  double symmetry = 0;    // L_sym (model/symmetry_loss.h)
   double total = 0;       // weighted sum
   int64_t samples = 0;    // samples evaluated
   double psnr() const;    // from `photo`
@@ -125,6 +131,8 @@ class AvatarModel {
   const OccupancyGrid& occupancy() const { return occupancy_; }
   const RegionMask& mask() const { return mask_; }
   const ExpressionConfidence& confidence() const { return confidence_; }
+  // The face's symmetry plane (from the mask landmarks), or nullopt when they do not give one.
+  const std::optional<SymmetryPlane>& symmetry_plane() const { return symmetry_; }
   StaticField& static_field() { return *static_field_; }
   DeformationField* deformation() { return deformation_.get(); }
   const DeformationField* deformation() const { return deformation_.get(); }
@@ -132,6 +140,10 @@ class AvatarModel {
 
  private:
   AvatarModel(const ModelConfig& config, const ModelSetup& setup, RegionMask mask, ExpressionConfidence confidence);
+  // L_sym of the batch in `ws` (canonical sample positions given): adds its gradient w.r.t. the
+  // batch's sigma and rgb to ws.d_sigma / ws.d_rgb and back-propagates the mirror images' share.
+  double SymmetryTerm(ModelWorkspace& ws, int64_t n, const float* canonical, const LossWeights& weights,
+                      const Executor& executor);
 
   ModelConfig config_;
   ModelSetup setup_;
@@ -143,6 +155,7 @@ class AvatarModel {
   RegionMask mask_;
   ExpressionConfidence confidence_;
   OccupancyGrid occupancy_;
+  std::optional<SymmetryPlane> symmetry_;
   std::unique_ptr<ModelWorkspace> train_ws_;
   mutable std::unique_ptr<ModelWorkspace> render_ws_;
 };

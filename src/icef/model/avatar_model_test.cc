@@ -233,6 +233,9 @@ TEST(AvatarModelTest, TrainLossGradientMatchesFiniteDifferences) {
     w.lambda_id = 0.5;
     w.lambda_mask = 0.2;
     w.lambda_distortion = 0.01 * std::sqrt(3.0);  // distances in aabb diagonals (sqrt 3 here)
+    w.lambda_symmetry = 0.3;  // mirrored samples through the warp and both fields
+    w.symmetry_colour = 0.0;  // its colour weight is a stop-gradient (symmetry_loss_test checks that part)
+    w.symmetry_max_samples = 64;
     const Executor ex(1);
     // Raise densities so the compositing weights are non-trivial.
     nn::ParameterStore& store = model->store();

@@ -22,6 +22,12 @@ void TrainConfig::Bind(ConfigSchema& s) {
   s.Number("lambda_distortion", &lambda_distortion, "weight of the mip-NeRF 360 distortion loss, distances in aabb diagonals (few-shot prior; 0 = off)");
   s.Number("lambda_occlusion", &lambda_occlusion,
            "weight of the occlusion sparsity prior: density behind what the training rays already hit (0 = off)");
+  s.Number("lambda_symmetry", &lambda_symmetry,
+           "weight of the left-right symmetry prior: opacity (and colour) of canonical samples against their "
+           "mirror images across the face's landmark symmetry plane (few-shot prior; 0 = off)");
+  s.Number("symmetry_colour", &symmetry_colour,
+           "weight of the symmetry prior's colour part relative to its opacity part (0 = geometry only)");
+  s.Int("symmetry_max_samples", &symmetry_max_samples, "samples per step mirrored by the symmetry prior");
   s.Number("smooth_epsilon", &smooth_epsilon, "finite-difference offset of L_smooth (half-extent units of the aabb)");
   s.Int("smooth_max_samples", &smooth_max_samples, "boundary samples per step used by L_smooth");
   s.Bool("random_background", &random_background,
@@ -58,6 +64,9 @@ Status TrainConfig::Validate() const {
   if (!non_negative(lambda_mask)) return Status::Error("train.lambda_mask must be a finite number >= 0");
   if (!non_negative(lambda_distortion)) return Status::Error("train.lambda_distortion must be a finite number >= 0");
   if (!non_negative(lambda_occlusion)) return Status::Error("train.lambda_occlusion must be a finite number >= 0");
+  if (!non_negative(lambda_symmetry)) return Status::Error("train.lambda_symmetry must be a finite number >= 0");
+  if (!non_negative(symmetry_colour)) return Status::Error("train.symmetry_colour must be a finite number >= 0");
+  if (symmetry_max_samples < 1) return Status::Error("train.symmetry_max_samples must be >= 1");
   if (!positive(smooth_epsilon)) return Status::Error("train.smooth_epsilon must be positive");
   if (smooth_max_samples < 1) return Status::Error("train.smooth_max_samples must be >= 1");
   if (anneal_steps < 0 || grid_anneal_steps < 0 || occupancy_warmup < 0 || occupancy_every < 1 || checkpoint_every < 0 || log_every < 1 ||

@@ -28,6 +28,9 @@ struct TrainConfig {
   double smooth_epsilon = 0.01;      // finite-difference offset of L_smooth (half-extent units)
   int smooth_max_samples = 4096;     // boundary samples per step used by L_smooth
   double lambda_occlusion = 1e-4;    // weight of the occlusion sparsity prior (0 = off)
+  double lambda_symmetry = 0.1;      // weight of the left-right symmetry prior L_sym (0 = off)
+  double symmetry_colour = 0.0;      // weight of L_sym's colour part relative to its opacity part
+  int symmetry_max_samples = 16384;  // samples per step mirrored by L_sym
   bool pixel_jitter = true;          // training rays through random points of their pixels
   bool random_background = true;     // train over random background colours (images with alpha only)
   int grid_anneal_steps = 0;         // coarse-to-fine hash grid: levels beyond the 4 coarsest switch on over these steps (0 = off)

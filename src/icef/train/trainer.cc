@@ -151,6 +151,9 @@ Result<LossTerms> Trainer::Step() {
   w.lambda_mask = data_.has_alpha() ? t.lambda_mask : 0.0;
   w.lambda_distortion = t.lambda_distortion;
   w.lambda_occlusion = t.lambda_occlusion;
+  w.lambda_symmetry = t.lambda_symmetry;
+  w.symmetry_colour = t.symmetry_colour;
+  w.symmetry_max_samples = t.symmetry_max_samples;
   w.smooth_epsilon = t.smooth_epsilon;
   w.smooth_max_samples = t.smooth_max_samples;
   const LossTerms terms = model_->TrainForwardBackward(batch_, w, seed, state_.step, executor_);
@@ -159,6 +162,7 @@ Result<LossTerms> Trainer::Step() {
   for (const auto& [name, v] : {std::pair{"photo", terms.photo}, std::pair{"mask", terms.mask},
                                 std::pair{"id", terms.id}, std::pair{"smooth", terms.smooth},
                                 std::pair{"distortion", terms.distortion}, std::pair{"occlusion", terms.occlusion},
+                                std::pair{"symmetry", terms.symmetry},
                                 std::pair{"total", terms.total}}) {
     if (!std::isfinite(v)) {
       nonfinite = std::string("loss term '") + name + "' is not finite";
@@ -257,6 +261,7 @@ Result<TrainSummary> Trainer::Run(const ProgressFn& progress, const std::atomic<
       line["smooth"] = terms.smooth;
       line["distortion"] = terms.distortion;
       line["occlusion"] = terms.occlusion;
+      line["symmetry"] = terms.symmetry;
       line["batch_psnr"] = terms.psnr();
       line["occupied"] = model_->occupancy().OccupiedFraction();
       if (last_step_skipped_) line["skipped"] = true;
