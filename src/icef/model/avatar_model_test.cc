@@ -216,6 +216,35 @@ TEST(RenderImageTest, SupersamplingAveragesSubpixelRays) {
   EXPECT_GT(max_spread, 1e-3);  // the sub-pixel rays really saw different things
 }
 
+// Large images render in bands of rows; every pixel must match a render of its own rays.
+TEST(RenderImageTest, BandedRenderMatchesPerPixelRays) {
+  ModelConfig config = TinyModelConfig("icef");
+  config.render_supersample = 1;
+  config.density_bias = 2.f;
+  auto created = AvatarModel::Create(config, TinySetup(), Executor(2));
+  ASSERT_TRUE(created.ok()) << created.status().message();
+  AvatarModel& model = **created;
+  model.Initialize(4);
+  Intrinsics in;
+  in.width = 300, in.height = 260, in.fl_x = in.fl_y = 300, in.cx = 150, in.cy = 130;  // 78 000 rays: 2 bands
+  Mat4d pose = Mat4d::Identity();
+  pose(2, 3) = 2.0;
+  const Camera cam(in, pose);
+  const std::vector<float> beta = {0.1f, 0.f, 0.2f};
+  const RenderedImage img = RenderImage(model, cam, beta, Vec3f(1, 1, 1), Executor(2));
+  ASSERT_EQ(img.color.width, 300);
+  ASSERT_EQ(img.depth.height, 260);
+  for (int j : {0, 100, 217, 218, 259})  // rows of both bands, either side of the band edge (218)
+    for (int i : {0, 150, 299}) {
+      const Ray ray = cam.RayThrough(i + 0.5, j + 0.5);
+      RenderOutput out;
+      model.Render(std::span<const Ray>(&ray, 1), beta, Vec3f(1, 1, 1), Executor(1), &out);
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(img.color.At(i, j, c), out.color[c], 1e-6) << i << "," << j;
+      EXPECT_NEAR(img.depth.At(i, j, 0), out.depth[0], 1e-6) << i << "," << j;
+      EXPECT_NEAR(img.mask.At(i, j, 0), out.mask[0], 1e-6) << i << "," << j;
+    }
+}
+
 TEST(AvatarModelTest, TrainLossGradientMatchesFiniteDifferences) {
   for (const char* method : {"icef", "nerface"}) {
     auto model = MakeModel(method, 0.05f);

@@ -9,43 +9,43 @@ RenderedImage RenderImage(const AvatarModel& model, const Camera& camera, std::s
                           const Vec3f& background, const Executor& executor) {
   const int w = camera.width(), h = camera.height();
   const int s = model.config().render_supersample, s2 = s * s;
-  // s x s rays per pixel on a regular sub-pixel grid, consecutive per pixel.
-  std::vector<Ray> rays(size_t(w) * h * s2);
-  for (int j = 0; j < h; ++j)
-    for (int i = 0; i < w; ++i)
-      for (int q = 0; q < s2; ++q)
-        rays[(size_t(j) * w + i) * s2 + q] = camera.RayThrough(i + (q % s + 0.5) / s, j + (q / s + 0.5) / s);
+  RenderedImage img;
+  img.color = Image(w, h, 3);
+  img.depth = Image(w, h, 1);
+  img.opacity = Image(w, h, 1);
+  img.mask = Image(w, h, 1);
+  img.deformation = Image(w, h, 1);
+  // Bands of rows of at most kBandRays rays, so memory does not grow with the image (rendering
+  // rays is independent per ray: the bands give the same pixels as one call for the whole image).
+  constexpr int64_t kBandRays = 1 << 16;
+  const int rows = static_cast<int>(std::max<int64_t>(1, kBandRays / (int64_t(w) * s2)));
+  std::vector<Ray> rays;
   RenderOutput out;
-  model.Render(rays, beta, background, executor, &out);
-  if (s2 > 1) {
-    const float inv = 1.f / float(s2);
-    auto average = [&](std::vector<float>& v, int channels) {
-      const size_t pixels = size_t(w) * h;
+  const float inv = 1.f / float(s2);
+  for (int j0 = 0; j0 < h; j0 += rows) {
+    const int j1 = std::min(h, j0 + rows);
+    // s x s rays per pixel on a regular sub-pixel grid, consecutive per pixel.
+    rays.resize(size_t(j1 - j0) * w * s2);
+    for (int j = j0; j < j1; ++j)
+      for (int i = 0; i < w; ++i)
+        for (int q = 0; q < s2; ++q)
+          rays[(size_t(j - j0) * w + i) * s2 + q] = camera.RayThrough(i + (q % s + 0.5) / s, j + (q / s + 0.5) / s);
+    model.Render(rays, beta, background, executor, &out);
+    const size_t first = size_t(j0) * w, pixels = size_t(j1 - j0) * w;
+    auto average = [&](const std::vector<float>& v, int channels, Image& dst) {
       for (size_t p = 0; p < pixels; ++p)
         for (int c = 0; c < channels; ++c) {
           float sum = 0.f;
           for (int q = 0; q < s2; ++q) sum += v[(p * s2 + q) * channels + c];
-          v[p * channels + c] = sum * inv;
+          dst.pixels[(first + p) * channels + c] = s2 > 1 ? sum * inv : sum;
         }
-      v.resize(pixels * channels);
     };
-    average(out.color, 3);
-    average(out.depth, 1);
-    average(out.opacity, 1);
-    average(out.mask, 1);
-    average(out.deformation, 1);
+    average(out.color, 3, img.color);
+    average(out.depth, 1, img.depth);
+    average(out.opacity, 1, img.opacity);
+    average(out.mask, 1, img.mask);
+    average(out.deformation, 1, img.deformation);
   }
-  RenderedImage img;
-  img.color = Image(w, h, 3);
-  img.color.pixels.assign(out.color.begin(), out.color.end());
-  img.depth = Image(w, h, 1);
-  img.depth.pixels = out.depth;
-  img.opacity = Image(w, h, 1);
-  img.opacity.pixels = out.opacity;
-  img.mask = Image(w, h, 1);
-  img.mask.pixels = out.mask;
-  img.deformation = Image(w, h, 1);
-  img.deformation.pixels = out.deformation;
   img.nearest = model.Nearest(beta);
   return img;
 }
