@@ -21,4 +21,24 @@ for n in $(grep -o -E '[0-9]+\.[0-9]+' <<<"$section" | sort -u); do
   fi
 done
 [ $missing -eq 0 ] && echo "readme_numbers_test: every number of the README's bench summary is in the report"
+
+# The README's training curve: every row "| step | seconds | PSNR |" between the train-curve markers
+# must be a line of docs/results/train_k5_128_icef.jsonl (seconds to 0 and PSNR to 2 decimals).
+log="$root/docs/results/train_k5_128_icef.jsonl"
+rows=$(sed -n '/<!-- train-curve:begin -->/,/<!-- train-curve:end -->/p' "$readme" | grep -E '^ *\| [0-9]+ \|' || true)
+if [ -z "$rows" ]; then
+  echo "readme_numbers_test: README.md has no train-curve rows" >&2
+  missing=1
+fi
+while read -r step secs psnr; do
+  line=$(grep -E "^\{\"step\":$step," "$log" || true)
+  got_secs=$(sed -E 's/.*"seconds":([0-9.eE+-]+).*/\1/' <<<"$line")
+  got_psnr=$(sed -nE 's/.*"psnr_observed":([0-9.eE+-]+).*/\1/p' <<<"$line")
+  if [ -z "$line" ] || [ -z "$got_psnr" ] || [ "$(printf '%.0f' "$got_secs")" != "$secs" ] ||
+     [ "$(printf '%.2f' "$got_psnr")" != "$psnr" ]; then
+    echo "readme_numbers_test: README curve row step $step ($secs s, $psnr dB) is not in $log" >&2
+    missing=1
+  fi
+done < <(awk -F'|' '{gsub(/ /, "", $2); gsub(/ /, "", $3); gsub(/ /, "", $4); print $2, $3, $4}' <<<"$rows")
+[ $missing -eq 0 ] && echo "readme_numbers_test: the README's training curve matches the committed log"
 exit $missing
