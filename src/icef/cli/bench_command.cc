@@ -1,5 +1,5 @@
 // icef bench --out DIR [--identities N] [--k 3,5,10] [--methods a,b] [--res R] [--steps S |
-//   --time-budget T] [--quick] [--shard i/n] [--threads N] [--set section.key=value ...]
+//   --time-budget T] [--quick] [--validation] [--shard i/n] [--threads N] [--set section.key=value ...]
 // icef bench merge DIR... --out DIR   (or icef bench --merge DIR... --out DIR)
 // The whole evaluation protocol (eval/bench_protocol.h): synthesise, train, evaluate every
 // identity x K x method, then report.md + report.json + plots.
@@ -23,6 +23,7 @@ CommandFn RegisterBench(CLI::App& app) {
     std::vector<std::string> methods;
     std::string shard;
     bool quick = false;
+    bool validation = false;
     std::vector<std::string> merge;
     std::vector<std::string> merge_inputs;
     std::string merge_out;
@@ -35,7 +36,8 @@ CommandFn RegisterBench(CLI::App& app) {
       "report.json and plots/. Re-running skips finished runs. `icef bench merge A B --out C` builds one "
       "report from shard directories.");
   app.add_option("--out,-o", args->out, "Output directory (created)");
-  app.add_option("--identities", o.identities, "Number of identities (seeds 1..N)")->capture_default_str();
+  app.add_option("--identities", o.identities, "Number of identities (test seeds 1..N; with --validation 6, seeds 101..106)")
+      ->capture_default_str();
   app.add_option("--first-seed", o.first_identity_seed, "Seed of the first identity")->capture_default_str();
   app.add_option("--k", args->ks, "Training-frame counts K, comma-separated (default 3,5,10)");
   app.add_option("--methods", args->methods, "Methods (default: all five)")->delimiter(',');
@@ -48,6 +50,10 @@ CommandFn RegisterBench(CLI::App& app) {
   app.add_option("--config", o.config_path, "Base run config file (default: built-in defaults)");
   app.add_option("--set", o.overrides, "Config override for every run, e.g. train.batch_rays=2048 (repeatable)");
   app.add_flag("--quick", args->quick, "Tiny settings for CI: 1 identity, K=3, 32x32, 20 steps of a tiny model");
+  app.add_flag("--validation", args->validation,
+               "Validation bench: validation identities (seeds 101 and up, 6 by default) at K=5, for tuning and "
+               "prior experiments. Without it the identities are test seeds (below 101), which are only reported, "
+               "never tuned on");
   app.add_option("--shard", args->shard, "Run only shard i of n (i/n, 0-based): runs i, i+n, ... of the stable order");
   app.add_option("--threads", o.threads, "Worker threads (0 = all cores)")->capture_default_str();
   app.add_option("--faceid-model", o.faceid_model_dir, "Face-identity model directory");
@@ -68,6 +74,12 @@ CommandFn RegisterBench(CLI::App& app) {
       return eval::MergeBench(inputs, out, std::cout);
     }
     eval::BenchOptions options = args->options;
+    if (args->validation) {
+      options.ApplyValidation();
+      // Options given explicitly win over the validation settings.
+      if (self->count("--identities")) options.identities = args->options.identities;
+      if (self->count("--first-seed")) options.first_identity_seed = args->options.first_identity_seed;
+    }
     if (args->quick) {
       const std::vector<std::string> user = options.overrides;
       options.overrides.clear();

@@ -34,6 +34,9 @@ struct Frame {
   std::optional<double> delta;      // test frames: min_k ||beta - beta_k|| over training frames
   std::optional<Tier> tier;         // test frames
   std::optional<std::string> neutral_file_path;  // test frames: same view at expression zero
+  // Test frames: the 68 landmarks of that neutral image (2D pixels, 3D world frame; optional).
+  std::optional<std::vector<Vec2f>> neutral_landmarks_2d;
+  std::optional<std::vector<Vec3f>> neutral_landmarks_3d;
   // NerFace: the face's box [y0, y1, x0, x1] as fractions of the image height/width (optional).
   std::optional<std::array<float, 4>> bbox;
   std::string ToString() const;

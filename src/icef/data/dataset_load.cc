@@ -164,6 +164,17 @@ Result<ParsedFrame> ParseFrame(const JsonObjectView& f, int expression_dim) {
     frame.landmarks_3d.emplace();
     for (const auto& xyz : l) frame.landmarks_3d->push_back(Vec3f(float(xyz[0]), float(xyz[1]), float(xyz[2])));
   }
+  if (f.Has("neutral_landmarks_2d")) {
+    ICEF_ASSIGN_OR_RETURN(const auto l, f.NumberMatrix("neutral_landmarks_2d", kNumLandmarks, 2));
+    frame.neutral_landmarks_2d.emplace();
+    for (const auto& xy : l) frame.neutral_landmarks_2d->push_back(Vec2f(float(xy[0]), float(xy[1])));
+  }
+  if (f.Has("neutral_landmarks_3d")) {
+    ICEF_ASSIGN_OR_RETURN(const auto l, f.NumberMatrix("neutral_landmarks_3d", kNumLandmarks, 3));
+    frame.neutral_landmarks_3d.emplace();
+    for (const auto& xyz : l)
+      frame.neutral_landmarks_3d->push_back(Vec3f(float(xyz[0]), float(xyz[1]), float(xyz[2])));
+  }
   if (f.Has("delta")) {
     ICEF_ASSIGN_OR_RETURN(const double delta, f.Number("delta"));
     if (delta < 0) return f.Error("delta", "must be >= 0");

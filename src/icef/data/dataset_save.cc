@@ -41,6 +41,10 @@ Status CheckFrame(const Dataset& d, const Frame& f, const std::string& where) {
     return Status::Error(where + ".landmarks_2d_visible: expected 68 flags alongside landmarks_2d");
   if (f.landmarks_3d && f.landmarks_3d->size() != size_t(kNumLandmarks))
     return Status::Error(where + ".landmarks_3d: expected 68 points");
+  if (f.neutral_landmarks_2d && f.neutral_landmarks_2d->size() != size_t(kNumLandmarks))
+    return Status::Error(where + ".neutral_landmarks_2d: expected 68 points");
+  if (f.neutral_landmarks_3d && f.neutral_landmarks_3d->size() != size_t(kNumLandmarks))
+    return Status::Error(where + ".neutral_landmarks_3d: expected 68 points");
   if (Status s = ValidateRigid(f.camera.world_from_cam()); !s.ok())
     return Status::Error(where + ".transform_matrix: " + s.message());
   if (Status s = f.camera.intrinsics().Validate(); !s.ok()) return Status::Error(where + ": intrinsics: " + s.message());
@@ -77,6 +81,16 @@ Json FrameToJson(const Frame& f, const std::optional<Intrinsics>& global) {
   if (f.delta) j["delta"] = *f.delta;
   if (f.tier) j["tier"] = TierName(*f.tier);
   if (f.neutral_file_path) j["neutral_file_path"] = *f.neutral_file_path;
+  if (f.neutral_landmarks_2d) {
+    Json l = Json::array();
+    for (const Vec2f& p : *f.neutral_landmarks_2d) l.push_back(FloatArray(p.data(), 2));
+    j["neutral_landmarks_2d"] = l;
+  }
+  if (f.neutral_landmarks_3d) {
+    Json l = Json::array();
+    for (const Vec3f& p : *f.neutral_landmarks_3d) l.push_back(FloatArray(p.data(), 3));
+    j["neutral_landmarks_3d"] = l;
+  }
   if (f.bbox) j["bbox"] = FloatArray(f.bbox->data(), 4);
   return j;
 }

@@ -70,6 +70,8 @@ void ExpectSameFrames(const std::vector<Frame>& a, const std::vector<Frame>& b) 
     EXPECT_EQ(a[i].delta, b[i].delta);
     EXPECT_EQ(a[i].tier, b[i].tier);
     EXPECT_EQ(a[i].neutral_file_path, b[i].neutral_file_path);
+    EXPECT_EQ(a[i].neutral_landmarks_2d, b[i].neutral_landmarks_2d);
+    EXPECT_EQ(a[i].neutral_landmarks_3d, b[i].neutral_landmarks_3d);
     EXPECT_EQ(a[i].bbox, b[i].bbox);
   }
 }
@@ -121,6 +123,8 @@ TEST(Dataset, SaveLoadRoundTripIsExactAndStable) {
   first.train[0].landmarks_2d_visible = std::vector<bool>(kNumLandmarks, true);
   (*first.train[0].landmarks_2d_visible)[5] = false;
   first.test[1].neutral_file_path = first.train[1].file_path;
+  first.test[1].neutral_landmarks_2d = first.train[1].landmarks_2d;
+  first.test[1].neutral_landmarks_3d = first.train[1].landmarks_3d;
   first.train[1].bbox = std::array<float, 4>{0.1f, 0.9f, 0.2f, 0.8f};
   first.background_file_path = first.train[0].file_path;
   first.background = Vec3f(0.25f, 0.5f, 0.125f);

@@ -23,7 +23,7 @@ namespace icef::eval {
 void BenchOptions::ApplyQuick() {
   identities = 1;
   ks = {3};
-  methods = {"icef", "icef-no-id", "icef-no-conf", "warp", "nerface"};
+  methods = {"icef", "icef-no-conf", "icef-uniform", "warp", "nerface"};
   resolution = 32;
   test_views = 1;
   novel_per_tier = 1;
@@ -39,9 +39,31 @@ void BenchOptions::ApplyQuick() {
   overrides.insert(overrides.begin(), tiny.begin(), tiny.end());
 }
 
+void BenchOptions::ApplyValidation() {
+  validation = true;
+  identities = kDefaultValidationIdentities;
+  first_identity_seed = kFirstValidationSeed;
+  ks = {5};
+}
+
+std::string BenchOptions::IdentityRole() const {
+  return validation ? "validation identities: for tuning and prior experiments, never reported as results"
+                    : "test identities: never used to choose a default or a hyperparameter; tuning uses the "
+                      "validation seeds " + std::to_string(kFirstValidationSeed) + " and up (`icef bench --validation`)";
+}
+
 Status BenchOptions::Validate() const {
   if (out_dir.empty()) return Status::Error("bench: --out is required");
   if (identities < 1) return Status::Error("bench: --identities must be >= 1");
+  const uint64_t last_seed = first_identity_seed + uint64_t(identities) - 1;
+  if (validation && first_identity_seed < kFirstValidationSeed)
+    return Status::Error("bench: --validation uses validation seeds (" + std::to_string(kFirstValidationSeed) +
+                         " and up), got --first-seed " + std::to_string(first_identity_seed));
+  if (!validation && last_seed >= kFirstValidationSeed)
+    return Status::Error("bench: seeds " + std::to_string(kFirstValidationSeed) +
+                         " and up are validation identities; a test bench uses seeds below it (got seeds " +
+                         std::to_string(first_identity_seed) + ".." + std::to_string(last_seed) +
+                         "; add --validation for a validation bench)");
   if (ks.empty()) return Status::Error("bench: --k needs at least one value");
   for (int k : ks)
     if (k < 1) return Status::Error("bench: --k values must be >= 1, got " + std::to_string(k));
@@ -61,6 +83,7 @@ Json BenchOptions::ToJson() const {
   Json j;
   j["identities"] = identities;
   j["first_identity_seed"] = first_identity_seed;
+  j["validation"] = validation;
   j["ks"] = ks;
   j["methods"] = methods;
   j["resolution"] = resolution;
@@ -294,6 +317,11 @@ Status RunBench(const BenchOptions& o, std::ostream& log, bool interactive) {
   ICEF_ASSIGN_OR_RETURN(const std::vector<RunRecord> records, ReadRunRecords(o.out_dir));
   ReportContext context;
   context.settings = o.ToJson();
+  context.identity_role = o.IdentityRole();
+  {
+    const synth::SynthOptions defaults;
+    context.tier_thresholds = std::array<double, 2>{defaults.near_threshold, defaults.far_threshold};
+  }
   const double wall = Seconds(start);
   if (todo.size() == runs.size() && o.shard_count == 1) context.wall_seconds = wall;
   if (o.shard_count > 1)
@@ -352,6 +380,13 @@ Status MergeBench(const std::vector<fs::path>& inputs, const fs::path& out_dir, 
   if (settings) {
     context.settings = *settings;
     ICEF_RETURN_IF_ERROR(WriteFileAtomic(out_dir / "bench.json", FormatJson(*settings)));
+    BenchOptions role;
+    role.validation = settings->value("validation", false);
+    context.identity_role = role.IdentityRole();
+  }
+  {
+    const synth::SynthOptions defaults;
+    context.tier_thresholds = std::array<double, 2>{defaults.near_threshold, defaults.far_threshold};
   }
   context.notes.push_back("Merged from " + std::to_string(inputs.size()) + " bench directories (renders stay there).");
   ICEF_RETURN_IF_ERROR(WriteReport(out_dir, records, context));

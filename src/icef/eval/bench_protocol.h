@@ -25,6 +25,13 @@ namespace icef::eval {
 constexpr int64_t kDefaultBenchSteps = 1000;
 constexpr double kDefaultBenchTimeBudget = 90.0;
 
+// Identity seeds are split once and for all: seeds below kFirstValidationSeed are test identities
+// (what the bench reports; never used to choose a default or a hyperparameter), seeds from
+// kFirstValidationSeed on are validation identities (`icef bench --validation`: what tuning and
+// prior experiments use).
+constexpr uint64_t kFirstValidationSeed = 101;
+constexpr int kDefaultValidationIdentities = 6;
+
 struct BenchOptions {
   // Output directory (created): data/, runs/, plots/, report.md, report.json, bench.json.
   std::filesystem::path out_dir;
@@ -35,7 +42,8 @@ struct BenchOptions {
   // Training-frame counts K.
   std::vector<int> ks = {3, 5, 10};
   // Methods (names of model/method.h).
-  std::vector<std::string> methods = {"icef", "icef-no-id", "icef-no-conf", "warp", "nerface"};
+  // (icef-no-id is left out: it trains the same model as warp, see model/method.h.)
+  std::vector<std::string> methods = {"icef", "icef-no-conf", "icef-uniform", "warp", "nerface"};
   // Image width = height in pixels.
   int resolution = 128;
   // Held-out test views per dataset.
@@ -60,6 +68,14 @@ struct BenchOptions {
   std::string lpips_weights;
   // Keep each run's trained model (runs/<name>/model/); by default it is deleted after evaluation.
   bool keep_models = false;
+  // Validation bench: the identities are validation seeds (>= kFirstValidationSeed); otherwise
+  // they must all be test seeds (< kFirstValidationSeed).
+  bool validation = false;
+
+  // The --validation settings: validation seeds 101..106, K = 5 (explicit options win).
+  void ApplyValidation();
+  // "test: ..." or "validation: ..." for the report.
+  std::string IdentityRole() const;
 
   // The --quick settings: 1 identity, K = 3, all methods, 32x32, 1 test view, 1 novel expression
   // per tier, 20 steps on a tiny model (seconds in all, for CI).

@@ -25,7 +25,7 @@ TEST(BenchProtocolTest, PlansRunsInStableOrder) {
   const std::vector<RunId> runs = PlanRuns(o);
   ASSERT_EQ(runs.size(), 3u * 3u * 5u);
   EXPECT_EQ(runs[0].Name(), "id1_k3_icef");
-  EXPECT_EQ(runs[1].Name(), "id1_k3_icef-no-id");
+  EXPECT_EQ(runs[1].Name(), "id1_k3_icef-no-conf");
   EXPECT_EQ(runs[4].Name(), "id1_k3_nerface");
   EXPECT_EQ(runs[5].Name(), "id1_k5_icef");
   EXPECT_EQ(runs[15].Name(), "id2_k3_icef");
@@ -52,7 +52,7 @@ TEST(BenchProtocolTest, ShardsPartitionTheRuns) {
   }
   const std::vector<RunId> s1 = ShardRuns(runs, 1, 4);
   ASSERT_GE(s1.size(), 2u);
-  EXPECT_EQ(s1[0].Name(), "id1_k3_icef-no-id");
+  EXPECT_EQ(s1[0].Name(), "id1_k3_icef-no-conf");
   EXPECT_EQ(s1[1].Name(), "id1_k5_icef");
 }
 

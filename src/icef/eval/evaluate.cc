@@ -5,6 +5,7 @@
 #include <map>
 #include <sstream>
 
+#include "icef/eval/expression_fidelity.h"
 #include "icef/eval/metrics.h"
 #include "icef/io/atomic_file.h"
 #include "icef/model/render_image.h"
@@ -68,6 +69,12 @@ Json FrameMetrics::ToJson() const {
   j["id_distance"] = OptionalJson(id_distance);
   j["id_distance_gt"] = OptionalJson(id_distance_gt);
   j["id_distance_reference"] = OptionalJson(id_distance_reference);
+  j["id_excess"] = OptionalJson(id_excess);
+  j["expr_gain"] = OptionalJson(expr_gain);
+  j["expr_corr"] = OptionalJson(expr_corr);
+  j["expr_true_rms"] = OptionalJson(expr_true_rms);
+  j["region_psnr"] = OptionalJson(region_psnr);
+  j["psnr_neutral_floor"] = OptionalJson(psnr_neutral_floor);
   j["nearest_index"] = nearest_index;
   j["model_delta"] = model_delta;
   j["kappa"] = kappa;
@@ -101,6 +108,14 @@ Result<FrameMetrics> FrameMetrics::FromJson(const Json& j, const std::string& wh
   if (j.contains("id_distance_reference")) {
     ICEF_ASSIGN_OR_RETURN(f.id_distance_reference, OptionalNumber(j, where, "id_distance_reference"));
   }
+  for (auto [key, field] : {std::pair{"id_excess", &f.id_excess}, std::pair{"expr_gain", &f.expr_gain},
+                            std::pair{"expr_corr", &f.expr_corr}, std::pair{"expr_true_rms", &f.expr_true_rms},
+                            std::pair{"region_psnr", &f.region_psnr},
+                            std::pair{"psnr_neutral_floor", &f.psnr_neutral_floor}}) {
+    if (j.contains(key)) {
+      ICEF_ASSIGN_OR_RETURN(*field, OptionalNumber(j, where, key));
+    }
+  }
   if (j.contains("nearest_index") && j["nearest_index"].is_number_integer()) f.nearest_index = j["nearest_index"].get<int>();
   if (j.contains("model_delta") && j["model_delta"].is_number()) f.model_delta = j["model_delta"].get<double>();
   if (j.contains("kappa") && j["kappa"].is_number()) f.kappa = j["kappa"].get<double>();
@@ -121,6 +136,13 @@ Json TierMetrics::ToJson() const {
   j["id_distance_gt"] = OptionalJson(id_distance_gt);
   j["id_share_under_0_6"] = OptionalJson(id_share_under_0_6);
   j["id_distance_reference"] = OptionalJson(id_distance_reference);
+  j["id_excess"] = OptionalJson(id_excess);
+  j["expr_gain"] = OptionalJson(expr_gain);
+  j["expr_corr"] = OptionalJson(expr_corr);
+  j["region_psnr"] = OptionalJson(region_psnr);
+  j["psnr_neutral_floor"] = OptionalJson(psnr_neutral_floor);
+  j["expr_count"] = expr_count;
+  j["expr_negligible"] = expr_negligible;
   j["id_count"] = id_count;
   j["mean_delta"] = mean_delta;
   return j;
@@ -142,6 +164,16 @@ Result<TierMetrics> TierMetrics::FromJson(const Json& j, const std::string& wher
   if (j.contains("id_distance_reference")) {
     ICEF_ASSIGN_OR_RETURN(t.id_distance_reference, OptionalNumber(j, where, "id_distance_reference"));
   }
+  for (auto [key, field] : {std::pair{"id_excess", &t.id_excess}, std::pair{"expr_gain", &t.expr_gain},
+                            std::pair{"expr_corr", &t.expr_corr}, std::pair{"region_psnr", &t.region_psnr},
+                            std::pair{"psnr_neutral_floor", &t.psnr_neutral_floor}}) {
+    if (j.contains(key)) {
+      ICEF_ASSIGN_OR_RETURN(*field, OptionalNumber(j, where, key));
+    }
+  }
+  if (j.contains("expr_count") && j["expr_count"].is_number_integer()) t.expr_count = j["expr_count"].get<int>();
+  if (j.contains("expr_negligible") && j["expr_negligible"].is_number_integer())
+    t.expr_negligible = j["expr_negligible"].get<int>();
   if (j.contains("id_count") && j["id_count"].is_number_integer()) t.id_count = j["id_count"].get<int>();
   if (j.contains("mean_delta") && j["mean_delta"].is_number()) t.mean_delta = j["mean_delta"].get<double>();
   return t;
@@ -157,7 +189,9 @@ std::array<TierMetrics, kNumTiers> AggregateTiers(const std::vector<FrameMetrics
     std::optional<double> Mean() const { return n > 0 ? std::optional<double>(sum / n) : std::nullopt; }
   };
   struct TierAcc {
-    Acc psnr, ssim, lpips, id_cosine, id_distance, id_distance_gt, under, delta, reference;
+    Acc psnr, ssim, lpips, id_cosine, id_distance, id_distance_gt, under, delta, reference, excess, gain, corr,
+        region_psnr, floor;
+    int negligible = 0;
   };
   std::array<TierAcc, kNumTiers> acc;
   std::array<TierMetrics, kNumTiers> out;
@@ -173,6 +207,12 @@ std::array<TierMetrics, kNumTiers> AggregateTiers(const std::vector<FrameMetrics
     a.id_distance.Add(f.id_distance);
     a.id_distance_gt.Add(f.id_distance_gt);
     a.reference.Add(f.id_distance_reference);
+    a.excess.Add(f.id_excess);
+    a.gain.Add(f.expr_gain);
+    a.corr.Add(f.expr_corr);
+    a.region_psnr.Add(f.region_psnr);
+    a.floor.Add(f.psnr_neutral_floor);
+    if (f.expr_true_rms && !f.expr_gain) ++a.negligible;
     if (f.id_distance) a.under.Add(*f.id_distance < kSamePersonThreshold ? 1.0 : 0.0);
   }
   for (int t = 0; t < kNumTiers; ++t) {
@@ -186,6 +226,13 @@ std::array<TierMetrics, kNumTiers> AggregateTiers(const std::vector<FrameMetrics
     m.id_distance_gt = a.id_distance_gt.Mean();
     m.id_share_under_0_6 = a.under.Mean();
     m.id_distance_reference = a.reference.Mean();
+    m.id_excess = a.excess.Mean();
+    m.expr_gain = a.gain.Mean();
+    m.expr_corr = a.corr.Mean();
+    m.region_psnr = a.region_psnr.Mean();
+    m.psnr_neutral_floor = a.floor.Mean();
+    m.expr_count = a.gain.n;
+    m.expr_negligible = a.negligible;
     m.id_count = a.id_distance.n;
     m.mean_delta = a.delta.Mean().value_or(0.0);
   }
@@ -195,6 +242,7 @@ std::array<TierMetrics, kNumTiers> AggregateTiers(const std::vector<FrameMetrics
 Json EvalResult::ToJson() const {
   Json j;
   j["method"] = method;
+  j["expression_scale"] = expression_scale;
   j["identity_available"] = identity_available;
   if (!identity_note.empty()) j["identity_note"] = identity_note;
   j["lpips_available"] = lpips_available;
@@ -214,6 +262,8 @@ Result<EvalResult> EvalResult::FromJson(const Json& j, const std::string& origin
   const auto method = j.find("method");
   if (method == j.end() || !method->is_string()) return Status::Error(origin + ": method: expected a string");
   r.method = method->get<std::string>();
+  if (j.contains("expression_scale") && j["expression_scale"].is_number())
+    r.expression_scale = j["expression_scale"].get<double>();
   if (j.contains("identity_available") && j["identity_available"].is_boolean())
     r.identity_available = j["identity_available"].get<bool>();
   if (j.contains("lpips_available") && j["lpips_available"].is_boolean())
@@ -242,21 +292,37 @@ Result<EvalResult> EvalResult::FromJson(const Json& j, const std::string& origin
 std::string EvalResult::Table() const {
   std::ostringstream s;
   char line[256];
-  std::snprintf(line, sizeof line, "%-9s %5s %7s %6s %6s %9s %7s %10s %7s %7s\n", "tier", "count", "psnr", "ssim",
-                "lpips", "id_cosine", "id_dist", "id_dist_gt", "id<0.6", "gt_ref");
+  if (expression_scale != 1) s << "every frame rendered at " << expression_scale << " x its expression\n";
+  std::snprintf(line, sizeof line, "%-9s %5s %7s %7s %6s %6s %9s %9s %10s %9s\n", "tier", "count", "psnr", "floor",
+                "ssim", "lpips", "expr_gain", "expr_corr", "region_psnr", "expr_n");
   s << line;
   for (Tier t : AllTiers()) {
     const TierMetrics& m = tiers[TierIndex(t)];
-    std::snprintf(line, sizeof line, "%-9s %5d %7s %6s %6s %9s %7s %10s %7s %7s\n", TierName(t), m.count,
-                  Fmt(m.psnr, "%.2f").c_str(), Fmt(m.ssim, "%.3f").c_str(), Fmt(m.lpips, "%.3f").c_str(),
-                  Fmt(m.id_cosine, "%.4f").c_str(), Fmt(m.id_distance, "%.3f").c_str(),
-                  Fmt(m.id_distance_gt, "%.3f").c_str(),
-                  m.id_share_under_0_6 ? Fmt(100.0 * *m.id_share_under_0_6, "%.0f%%").c_str() : "-",
-                  Fmt(m.id_distance_reference, "%.3f").c_str());
+    const std::string expr_n = std::to_string(m.expr_count) + (m.expr_negligible ? "+" + std::to_string(m.expr_negligible) : "");
+    std::snprintf(line, sizeof line, "%-9s %5d %7s %7s %6s %6s %9s %9s %10s %9s\n", TierName(t), m.count,
+                  Fmt(m.psnr, "%.2f").c_str(), Fmt(m.psnr_neutral_floor, "%.2f").c_str(), Fmt(m.ssim, "%.3f").c_str(),
+                  Fmt(m.lpips, "%.3f").c_str(), Fmt(m.expr_gain, "%.3f").c_str(), Fmt(m.expr_corr, "%.3f").c_str(),
+                  Fmt(m.region_psnr, "%.2f").c_str(), expr_n.c_str());
     s << line;
   }
+  std::snprintf(line, sizeof line, "%-9s %9s %7s %10s %7s %9s %7s\n", "tier", "id_cosine", "id_dist", "id_dist_gt",
+                "gt_ref", "id_excess", "id<0.6");
+  s << line;
+  for (Tier t : AllTiers()) {
+    const TierMetrics& m = tiers[TierIndex(t)];
+    std::snprintf(line, sizeof line, "%-9s %9s %7s %10s %7s %9s %7s\n", TierName(t), Fmt(m.id_cosine, "%.4f").c_str(),
+                  Fmt(m.id_distance, "%.3f").c_str(), Fmt(m.id_distance_gt, "%.3f").c_str(),
+                  Fmt(m.id_distance_reference, "%.3f").c_str(), Fmt(m.id_excess, "%+.3f").c_str(),
+                  m.id_share_under_0_6 ? Fmt(100.0 * *m.id_share_under_0_6, "%.0f%%").c_str() : "-");
+    s << line;
+  }
+  s << "floor: PSNR of the ground-truth neutral against the ground truth (a model that renders no expression); "
+       "expr_gain: share of the true change (ground truth - its neutral) that the render's change (render - the "
+       "model's neutral) reproduces in the brow/eye/mouth region (1 = all, 0 = none), expr_corr their cosine; "
+       "expr_n: frames in those means (+ frames left out: negligible true change)\n";
   s << "id_*: face-descriptor distance/cosine of each render to the model's own neutral render (same view); "
-       "id_dist_gt: to the ground truth; gt_ref: the ground truth's own distance to its neutral\n";
+       "id_dist_gt: to the ground truth; gt_ref: the ground truth's own distance to its neutral; "
+       "id_excess = id_dist - gt_ref (negative: the render moves less than the truth)\n";
   if (!lpips_available) s << "lpips: unavailable (no weights file given; see docs/evaluation.md)\n";
   if (!identity_available)
     s << "identity: unavailable" << (identity_note.empty() ? "" : " (" + identity_note + ")") << "\n";
@@ -274,17 +340,27 @@ Result<EvalResult> ReadMetricsFile(const fs::path& path) {
   return EvalResult::FromJson(j, path.string());
 }
 
+Status EvalOptions::Validate() const {
+  if (!std::isfinite(expression_scale))
+    return Status::Error("expression_scale: must be a finite number, got " + std::to_string(expression_scale));
+  return Status::Ok();
+}
+
 std::string EvalOptions::ToString() const {
-  return "EvalOptions(out_dir=" + out_dir.string() +
-         ", write_neutral_renders=" + (write_neutral_renders ? "true" : "false") + ")";
+  return "EvalOptions(out_dir=" + out_dir.string() + ", write_neutral_renders=" +
+         (write_neutral_renders ? "true" : "false") + ", expression_scale=" + std::to_string(expression_scale) +
+         ", occupancy=" + (occupancy == RenderOccupancyMode::kExpression ? "expression" : "training") + ")";
 }
 
 namespace {
 
-// One test view: the model's neutral render and its descriptor (computed once per view).
+// One test view: the model's neutral render and its descriptor (computed once per view), and the
+// ground-truth neutral with its landmarks when the dataset has them.
 struct NeutralView {
   int index = 0;
   Image render;
+  std::optional<Image> truth;                      // ground-truth neutral, composited
+  std::optional<std::vector<Vec2f>> truth_landmarks;  // its 68 landmarks (dataset)
   std::optional<FaceDescriptor> descriptor;
   std::optional<FaceDescriptor> gt_descriptor;  // of the ground-truth neutral, same landmarks
   std::string landmarks = "none";
@@ -305,11 +381,14 @@ std::string ViewKey(const Frame& frame) {
   return s.str();
 }
 
-// The 68 landmarks of a dataset frame whose image is `file_path` (any split), if any.
-std::optional<std::vector<Vec2f>> DatasetLandmarksOf(const Dataset& dataset, const std::string& file_path) {
+// The 68 landmarks of the frame's neutral image: the frame's neutral_landmarks_2d, else those of a
+// dataset frame whose image is the neutral image (any split), if any.
+std::optional<std::vector<Vec2f>> NeutralLandmarksOf(const Dataset& dataset, const Frame& frame) {
+  if (frame.neutral_landmarks_2d) return frame.neutral_landmarks_2d;
+  if (!frame.neutral_file_path) return std::nullopt;
   for (const auto* split : {&dataset.train, &dataset.test, &dataset.val})
     for (const Frame& f : *split)
-      if (f.file_path == file_path && f.landmarks_2d) return f.landmarks_2d;
+      if (f.file_path == *frame.neutral_file_path && f.landmarks_2d) return f.landmarks_2d;
   return std::nullopt;
 }
 
@@ -318,6 +397,69 @@ std::optional<FaceDescriptor> TryDescribe(FaceIdentity& identity, const Image& i
   Result<FaceIdentityResult> r = identity.Describe(image, landmarks);
   if (!r.ok()) return std::nullopt;
   return r->descriptor;
+}
+
+// The model's neutral render of the frame's view, the ground-truth neutral and their identity
+// descriptors. Landmarks of the neutral: from the dataset, else detected on the neutral ground
+// truth, else the frame's own, else detected on the neutral render.
+Result<NeutralView> MakeNeutralView(const AvatarModel& model, const Dataset& dataset, const Frame& frame, int index,
+                                    const EvalOptions& options, const EvalNetworks& networks,
+                                    const Executor& executor) {
+  NeutralView view;
+  view.index = index;
+  const std::vector<float> neutral_beta(dataset.expression_dim, 0.f);
+  view.render = RenderImage(model, frame.camera, neutral_beta, dataset.background, executor, options.occupancy).color;
+  if (!options.out_dir.empty() && options.write_neutral_renders) {
+    char name[64];
+    std::snprintf(name, sizeof name, "renders/neutral_%03d.png", view.index);
+    view.render_path = name;
+    ICEF_RETURN_IF_ERROR(WritePng(options.out_dir / view.render_path, view.render));
+  }
+  if (frame.neutral_file_path) {
+    ICEF_ASSIGN_OR_RETURN(const Image read, ReadImage(dataset.root / *frame.neutral_file_path));
+    view.truth = CompositeOver(read, dataset.background);
+    view.truth_landmarks = NeutralLandmarksOf(dataset, frame);
+  }
+  if (!networks.identity) return view;
+  std::optional<std::vector<Vec2f>> lm = view.truth_landmarks;
+  if (lm) {
+    view.landmarks = "dataset";
+  } else if (view.truth) {
+    Result<FaceIdentityResult> d = networks.identity->Describe(*view.truth, std::nullopt);
+    if (d.ok()) lm = d->landmarks, view.landmarks = "detector (ground truth)";
+  }
+  if (!lm && frame.landmarks_2d) lm = frame.landmarks_2d, view.landmarks = "frame";
+  if (lm) {
+    view.descriptor = TryDescribe(*networks.identity, view.render, lm);
+    if (view.truth) view.gt_descriptor = TryDescribe(*networks.identity, *view.truth, lm);
+  } else {
+    view.descriptor = TryDescribe(*networks.identity, view.render, std::nullopt);
+    if (view.descriptor) view.landmarks = "detector (render)";
+  }
+  if (!view.descriptor) view.landmarks = "none";
+  return view;
+}
+
+// Expression fidelity, region PSNR and the neutral floor of one frame (eval/expression_fidelity.h).
+Status MeasureExpressionMetrics(const Frame& frame, const Image& render, const Image& truth, const NeutralView& view,
+                                FrameMetrics* m) {
+  if (view.truth) {
+    ICEF_ASSIGN_OR_RETURN(const double floor, Psnr(*view.truth, truth));
+    m->psnr_neutral_floor = Finite(floor);
+  }
+  if (!frame.landmarks_2d) return Status::Ok();
+  const Image region = ExpressionRegion(truth.width, truth.height, *frame.landmarks_2d,
+                                        view.truth_landmarks.value_or(std::vector<Vec2f>()),
+                                        DefaultRegionDilation(truth.width));
+  Result<double> region_psnr = Psnr(render, truth, &region);
+  if (!region_psnr.ok()) return Status::Ok();  // the region lies outside the image: no values
+  m->region_psnr = Finite(*region_psnr);
+  if (!view.truth) return Status::Ok();
+  ICEF_ASSIGN_OR_RETURN(const ExpressionFidelity f, MeasureExpression(render, view.render, truth, *view.truth, region));
+  m->expr_true_rms = f.true_rms;
+  m->expr_gain = f.gain;
+  m->expr_corr = f.corr;
+  return Status::Ok();
 }
 
 std::string RenderName(const std::string& file_path) {
@@ -342,11 +484,11 @@ Result<EvalResult> EvaluateModel(const AvatarModel& model, const Dataset& datase
   }
   EvalResult result;
   result.method = MethodName(model.method());
+  result.expression_scale = options.expression_scale;
   result.identity_available = networks.identity != nullptr;
   result.identity_note = networks.identity ? "" : networks.identity_note;
   result.lpips_available = networks.lpips != nullptr;
   const Vec3f background = dataset.background;
-  const std::vector<float> neutral_beta(dataset.expression_dim, 0.f);
   std::map<std::string, NeutralView> views;
 
   for (size_t i = 0; i < dataset.test.size(); ++i) {
@@ -358,7 +500,9 @@ Result<EvalResult> EvaluateModel(const AvatarModel& model, const Dataset& datase
       return Status::Error(where + ": image is " + std::to_string(gt.width) + "x" + std::to_string(gt.height) +
                            ", camera says " + std::to_string(frame.camera.width()) + "x" +
                            std::to_string(frame.camera.height()));
-    const RenderedImage render = RenderImage(model, frame.camera, frame.expression, background, executor);
+    std::vector<float> beta = frame.expression;
+    for (float& v : beta) v = static_cast<float>(options.expression_scale * v);
+    const RenderedImage render = RenderImage(model, frame.camera, beta, background, executor, options.occupancy);
 
     FrameMetrics m;
     m.file_path = frame.file_path;
@@ -387,46 +531,14 @@ Result<EvalResult> EvaluateModel(const AvatarModel& model, const Dataset& datase
     const std::string key = ViewKey(frame);
     auto it = views.find(key);
     if (it == views.end()) {
-      NeutralView view;
-      view.index = static_cast<int>(views.size());
-      view.render = RenderImage(model, frame.camera, neutral_beta, background, executor).color;
-      if (write && options.write_neutral_renders) {
-        char name[64];
-        std::snprintf(name, sizeof name, "renders/neutral_%03d.png", view.index);
-        view.render_path = name;
-        ICEF_RETURN_IF_ERROR(WritePng(out_root / view.render_path, view.render));
-      }
-      if (networks.identity) {
-        // Landmarks of the neutral: from the dataset when a frame holds the neutral image, else
-        // detected on the neutral ground truth, else (below) the frame's own, else detected on
-        // the neutral render.
-        std::optional<std::vector<Vec2f>> lm;
-        std::optional<Image> neutral_gt;
-        if (frame.neutral_file_path) {
-          Result<Image> read = ReadImage(dataset.root / *frame.neutral_file_path);
-          if (read.ok()) neutral_gt = CompositeOver(*read, background);
-          lm = DatasetLandmarksOf(dataset, *frame.neutral_file_path);
-          if (lm) {
-            view.landmarks = "dataset";
-          } else if (neutral_gt) {
-            Result<FaceIdentityResult> d = networks.identity->Describe(*neutral_gt, std::nullopt);
-            if (d.ok()) lm = d->landmarks, view.landmarks = "detector (ground truth)";
-          }
-        }
-        if (!lm && frame.landmarks_2d) lm = frame.landmarks_2d, view.landmarks = "frame";
-        if (lm) {
-          view.descriptor = TryDescribe(*networks.identity, view.render, lm);
-          if (neutral_gt) view.gt_descriptor = TryDescribe(*networks.identity, *neutral_gt, lm);
-        } else {
-          view.descriptor = TryDescribe(*networks.identity, view.render, std::nullopt);
-          if (view.descriptor) view.landmarks = "detector (render)";
-        }
-        if (!view.descriptor) view.landmarks = "none";
-      }
-      it = views.emplace(key, std::move(view)).first;
+      Result<NeutralView> view = MakeNeutralView(model, dataset, frame, static_cast<int>(views.size()), options,
+                                                 networks, executor);
+      if (!view.ok()) return view.status().WithContext(where);
+      it = views.emplace(key, std::move(*view)).first;
     }
     const NeutralView& view = it->second;
     m.neutral_landmarks = view.landmarks;
+    ICEF_RETURN_IF_ERROR(MeasureExpressionMetrics(frame, render.color, gt, view, &m).WithContext(where));
 
     if (networks.identity) {
       FaceIdentity& identity = *networks.identity;
@@ -447,6 +559,7 @@ Result<EvalResult> EvaluateModel(const AvatarModel& model, const Dataset& datase
       }
       if (render_desc && gt_desc) m.id_distance_gt = DescriptorDistance(*render_desc, *gt_desc);
       if (gt_desc && view.gt_descriptor) m.id_distance_reference = DescriptorDistance(*gt_desc, *view.gt_descriptor);
+      if (m.id_distance && m.id_distance_reference) m.id_excess = *m.id_distance - *m.id_distance_reference;
       if (!m.id_distance) ++result.identity_missing;
     } else {
       m.landmarks = "none";
@@ -455,7 +568,8 @@ Result<EvalResult> EvaluateModel(const AvatarModel& model, const Dataset& datase
     if (progress) {
       const FrameMetrics& last = result.frames.back();
       progress->Update(static_cast<int64_t>(i) + 1, std::string(TierName(last.tier)) + " psnr " +
-                                                        Fmt(last.psnr, "%.2f") + " id " + Fmt(last.id_distance, "%.3f"));
+                                                        Fmt(last.psnr, "%.2f") + " gain " + Fmt(last.expr_gain, "%.2f") +
+                                                        " id " + Fmt(last.id_distance, "%.3f"));
     }
   }
   result.tiers = AggregateTiers(result.frames);

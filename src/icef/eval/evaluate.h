@@ -24,6 +24,7 @@
 #include "icef/eval/lpips.h"
 #include "icef/io/json_util.h"
 #include "icef/model/avatar_model.h"
+#include "icef/model/render_image.h"
 
 namespace icef::eval {
 
@@ -46,6 +47,19 @@ struct FrameMetrics {
   // Ground truth vs the ground-truth neutral of the view, chips made exactly as for id_distance:
   // the drift a perfect model would show (null without a neutral image in the dataset).
   std::optional<double> id_distance_reference;
+  // id_distance - id_distance_reference: drift beyond what the expression itself causes
+  // (negative: the render moved less than the ground truth, i.e. under-expression).
+  std::optional<double> id_excess;
+  // Expression fidelity (eval/expression_fidelity.h), inside the frame's expression region; null
+  // without ground-truth landmarks or a ground-truth neutral, and gain/corr null where the true
+  // change is negligible (expr_true_rms below kNegligibleExpressionRms).
+  std::optional<double> expr_gain;
+  std::optional<double> expr_corr;
+  std::optional<double> expr_true_rms;  // RMS of ground truth - ground-truth neutral in the region
+  std::optional<double> region_psnr;    // PSNR inside the expression region, dB
+  // PSNR of the ground-truth neutral of the view against the ground truth: what a model that
+  // renders no expression at all would score (null without a neutral image).
+  std::optional<double> psnr_neutral_floor;
   int nearest_index = -1;              // the model's nearest training expression k
   double model_delta = 0;              // ||beta - beta_n|| as the model sees it
   double kappa = 1;                    // confidence at that distance
@@ -70,6 +84,13 @@ struct TierMetrics {
   std::optional<double> id_distance_gt;
   std::optional<double> id_share_under_0_6;  // share of id_distance values under 0.6
   std::optional<double> id_distance_reference;  // mean ground-truth drift (see FrameMetrics)
+  std::optional<double> id_excess;           // mean over frames with both distances
+  std::optional<double> expr_gain;           // means over the frames with a non-negligible true change
+  std::optional<double> expr_corr;
+  std::optional<double> region_psnr;
+  std::optional<double> psnr_neutral_floor;
+  int expr_count = 0;                        // frames in the expr_gain mean
+  int expr_negligible = 0;                   // frames left out of it: negligible true change
   int id_count = 0;                          // frames with identity metrics
   double mean_delta = 0;                     // mean dataset delta (0 when count is 0)
 
@@ -83,6 +104,7 @@ std::array<TierMetrics, kNumTiers> AggregateTiers(const std::vector<FrameMetrics
 // One model evaluated on one dataset: the content of metrics.json.
 struct EvalResult {
   std::string method;
+  double expression_scale = 1;       // every frame was rendered at expression_scale * beta
   std::vector<FrameMetrics> frames;
   std::array<TierMetrics, kNumTiers> tiers;
   bool identity_available = false;   // the face-descriptor network was loaded
@@ -105,7 +127,13 @@ struct EvalOptions {
   std::filesystem::path out_dir;
   // Also write each frame's model neutral render (renders/neutral_<view>.png).
   bool write_neutral_renders = true;
-  Status Validate() const { return Status::Ok(); }
+  // Each frame is rendered at expression_scale * beta (1 = as given; 0 = every frame at neutral,
+  // the model that renders no expression at all, for checking the protocol).
+  double expression_scale = 1;
+  // Samples placed by the grid of the rendered expression (default) or by the training grid
+  // (training expressions only, cut to the training visual hull): `icef eval --training-occupancy`.
+  RenderOccupancyMode occupancy = RenderOccupancyMode::kExpression;
+  Status Validate() const;
   std::string ToString() const;
 };
 
@@ -116,7 +144,9 @@ struct EvalNetworks {
   std::string identity_note;         // why `identity` is null (copied into the result)
 };
 
-// Evaluates `model` on the test frames of `dataset`. A frame without a tier gets one from its
+// Evaluates `model` on the test frames of `dataset` (expression fidelity needs the frames' 2D
+// landmarks and neutral images; the neutral's landmarks come from neutral_landmarks_2d, else from a
+// dataset frame of the neutral image, else the frame's own hull stands alone). A frame without a tier gets one from its
 // delta (the model's when the frame has none) and the dataset's tier thresholds. Errors:
 // unreadable images, size mismatches, an expression dimension other than the model's.
 // progress (may be null) counts frames.

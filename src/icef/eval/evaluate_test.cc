@@ -4,6 +4,7 @@
 
 #include <filesystem>
 
+#include "icef/eval/expression_fidelity.h"
 #include "icef/eval/metrics.h"
 #include "icef/io/atomic_file.h"
 #include "icef/model/render_image.h"
@@ -201,6 +202,35 @@ TEST(EvaluateTest, EvaluatesTinyTrainedModel) {
     EXPECT_EQ(f.nearest_index, r.nearest.index);
   }
   EXPECT_TRUE(fs::exists(options.out_dir / "renders" / "neutral_000.png"));
+  // Expression fidelity: every synthetic test frame has landmarks and a neutral, so region PSNR and
+  // the neutral floor are measured everywhere, and gain/corr wherever the true change is not negligible.
+  for (const FrameMetrics& f : result->frames) {
+    ASSERT_TRUE(f.region_psnr && f.psnr_neutral_floor && f.expr_true_rms) << f.file_path;
+    EXPECT_EQ(f.expr_gain.has_value(), *f.expr_true_rms >= kNegligibleExpressionRms);
+  }
+  const TierMetrics& far = result->tiers[TierIndex(Tier::kFar)];
+  EXPECT_EQ(far.expr_count + far.expr_negligible, far.count);
+
+  // A model that renders no expression (every frame at 0 x beta): its change against its own neutral
+  // is exactly zero, so it reproduces none of the expression, and scores the render's neutral PSNR.
+  EvalOptions still;
+  still.expression_scale = 0;
+  const Result<EvalResult> zero = EvaluateModel(model, *dataset, still, networks, executor, nullptr);
+  ASSERT_TRUE(zero.ok()) << zero.status().message();
+  EXPECT_EQ(zero->expression_scale, 0.0);
+  int gains = 0;
+  for (const FrameMetrics& f : zero->frames) {
+    if (!f.expr_gain) continue;
+    ++gains;
+    EXPECT_EQ(*f.expr_gain, 0.0) << f.file_path;
+    EXPECT_FALSE(f.expr_corr.has_value());
+  }
+  EXPECT_GT(gains, 0);
+  EXPECT_EQ(*zero->tiers[TierIndex(Tier::kFar)].expr_gain, 0.0);
+  const Result<EvalResult> reread = EvalResult::FromJson(zero->ToJson(), "zero");
+  ASSERT_TRUE(reread.ok()) << reread.status().message();
+  EXPECT_EQ(reread->ToJson(), zero->ToJson());
+  EXPECT_NE(zero->Table().find("every frame rendered at 0 x its expression"), std::string::npos);
 
   // Frames without a stored tier get it from their delta and the dataset's thresholds.
   Dataset untiered = *dataset;

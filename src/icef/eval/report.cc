@@ -20,22 +20,29 @@ namespace icef::eval {
 std::string RunId::Name() const { return "id" + std::to_string(identity_seed) + "_k" + std::to_string(k) + "_" + method; }
 
 const std::array<Metric, kNumMetrics>& AllMetrics() {
-  static const std::array<Metric, kNumMetrics> kAll = {Metric::kPsnr,       Metric::kSsim,          Metric::kLpips,
-                                                       Metric::kIdCosine,   Metric::kIdDistance,    Metric::kIdDistanceGt,
-                                                       Metric::kIdShareUnder06, Metric::kIdDistanceReference};
+  static const std::array<Metric, kNumMetrics> kAll = {
+      Metric::kPsnr,          Metric::kPsnrNeutralFloor, Metric::kSsim,          Metric::kLpips,
+      Metric::kExprGain,      Metric::kExprCorr,         Metric::kRegionPsnr,    Metric::kIdCosine,
+      Metric::kIdDistance,    Metric::kIdDistanceGt,     Metric::kIdShareUnder06, Metric::kIdDistanceReference,
+      Metric::kIdExcess};
   return kAll;
 }
 
 const char* MetricName(Metric m) {
   switch (m) {
     case Metric::kPsnr: return "psnr";
+    case Metric::kPsnrNeutralFloor: return "psnr_neutral_floor";
     case Metric::kSsim: return "ssim";
     case Metric::kLpips: return "lpips";
+    case Metric::kExprGain: return "expr_gain";
+    case Metric::kExprCorr: return "expr_corr";
+    case Metric::kRegionPsnr: return "region_psnr";
     case Metric::kIdCosine: return "id_cosine";
     case Metric::kIdDistance: return "id_distance";
     case Metric::kIdDistanceGt: return "id_distance_gt";
     case Metric::kIdShareUnder06: return "id_share_under_0_6";
     case Metric::kIdDistanceReference: return "id_distance_reference";
+    case Metric::kIdExcess: return "id_excess";
   }
   return "?";
 }
@@ -43,33 +50,82 @@ const char* MetricName(Metric m) {
 const char* MetricLabel(Metric m) {
   switch (m) {
     case Metric::kPsnr: return "PSNR, dB (higher = better)";
+    case Metric::kPsnrNeutralFloor: return "PSNR of the ground-truth neutral, dB (a face that does not move)";
     case Metric::kSsim: return "SSIM (higher = better)";
     case Metric::kLpips: return "LPIPS (lower = better)";
+    case Metric::kExprGain: return "share of the true expression change reproduced (1 = all, 0 = none)";
+    case Metric::kExprCorr: return "cosine of the render's change with the true change (higher = better)";
+    case Metric::kRegionPsnr: return "PSNR in the brow/eye/mouth region, dB (higher = better)";
     case Metric::kIdCosine: return "identity cosine to own neutral render (higher = better)";
-    case Metric::kIdDistance: return "identity distance to own neutral render (lower = better)";
+    case Metric::kIdDistance: return "identity distance to own neutral render";
     case Metric::kIdDistanceGt: return "identity distance to ground truth (lower = better)";
-    case Metric::kIdShareUnder06: return "share of renders under 0.6 from own neutral (higher = better)";
+    case Metric::kIdShareUnder06: return "share of renders under 0.6 from own neutral";
     case Metric::kIdDistanceReference: return "ground truth's own distance to its neutral (reference)";
+    case Metric::kIdExcess: return "drift beyond the ground truth's own (0 = as the truth; < 0 = under-expression)";
   }
   return "?";
 }
 
 bool HigherIsBetter(Metric m) {
-  return m == Metric::kPsnr || m == Metric::kSsim || m == Metric::kIdCosine || m == Metric::kIdShareUnder06;
+  return m == Metric::kPsnr || m == Metric::kSsim || m == Metric::kIdCosine || m == Metric::kIdShareUnder06 ||
+         m == Metric::kExprGain || m == Metric::kExprCorr || m == Metric::kRegionPsnr;
 }
 
 std::optional<double> TierValue(const TierMetrics& t, Metric m) {
   switch (m) {
     case Metric::kPsnr: return t.psnr;
+    case Metric::kPsnrNeutralFloor: return t.psnr_neutral_floor;
     case Metric::kSsim: return t.ssim;
     case Metric::kLpips: return t.lpips;
+    case Metric::kExprGain: return t.expr_gain;
+    case Metric::kExprCorr: return t.expr_corr;
+    case Metric::kRegionPsnr: return t.region_psnr;
     case Metric::kIdCosine: return t.id_cosine;
     case Metric::kIdDistance: return t.id_distance;
     case Metric::kIdDistanceGt: return t.id_distance_gt;
     case Metric::kIdShareUnder06: return t.id_share_under_0_6;
     case Metric::kIdDistanceReference: return t.id_distance_reference;
+    case Metric::kIdExcess: return t.id_excess;
   }
   return std::nullopt;
+}
+
+const char* OutcomeName(Outcome o) {
+  switch (o) {
+    case Outcome::kBetter: return "better";
+    case Outcome::kUnderExpresses: return "under-expresses";
+    case Outcome::kWorseIdentity: return "not better on identity";
+    case Outcome::kWorsePsnr: return "not better on PSNR";
+    case Outcome::kNoData: return "no data";
+  }
+  return "?";
+}
+
+Json PairVerdict::ToJson() const {
+  return Json{{"k", k}, {"tier", TierName(tier)}, {"method", method}, {"other", other}, {"outcome", OutcomeName(outcome)}};
+}
+
+PairVerdict ComparePair(const Aggregate& a, int k, Tier tier, const std::string& method, const std::string& other) {
+  PairVerdict v;
+  v.k = k, v.tier = tier, v.method = method, v.other = other;
+  const AggregateCell* ca = a.Find(k, method, tier);
+  const AggregateCell* cb = a.Find(k, other, tier);
+  if (!ca || !cb) return v;
+  const auto ga = ca->Get(Metric::kExprGain), gb = cb->Get(Metric::kExprGain);
+  const auto ia = ca->Get(Metric::kIdDistanceGt), ib = cb->Get(Metric::kIdDistanceGt);
+  const auto pa = ca->Get(Metric::kPsnr), pb = cb->Get(Metric::kPsnr);
+  if (!ga || !gb || !pa || !pb) return v;
+  const double tolerance = std::max({ga->std, gb->std, kGainTolerance});
+  if (ga->mean < kMinExpressionGain || ga->mean < gb->mean - tolerance) {
+    v.outcome = Outcome::kUnderExpresses;
+  } else if (ia && ib && !(ia->mean < ib->mean)) {
+    v.outcome = Outcome::kWorseIdentity;
+  } else if (!(pa->mean > pb->mean)) {
+    v.outcome = Outcome::kWorsePsnr;
+  } else {
+    v.outcome = Outcome::kBetter;
+  }
+  return v;
 }
 
 std::optional<Spread> Spread::Of(const std::vector<double>& values) {
@@ -135,6 +191,9 @@ std::string Pm(const std::optional<Spread>& s, const char* format) {
 const char* MetricFormat(Metric m) {
   switch (m) {
     case Metric::kPsnr: return "%.2f";
+    case Metric::kPsnrNeutralFloor: return "%.2f";
+    case Metric::kRegionPsnr: return "%.2f";
+    case Metric::kIdExcess: return "%+.3f";
     case Metric::kIdShareUnder06: return "%.2f";
     case Metric::kIdCosine: return "%.4f";
     default: return "%.3f";
@@ -229,6 +288,12 @@ Aggregate AggregateRuns(const std::vector<RunRecord>& runs) {
       }
     }
   }
+  for (Tier tier : {Tier::kNear, Tier::kModerate, Tier::kFar})
+    for (int k : a.ks) {
+      if (!by_cell.count({k, "icef"})) continue;
+      for (const std::string& other : a.methods)
+        if (other != "icef" && by_cell.count({k, other})) a.verdicts.push_back(ComparePair(a, k, tier, "icef", other));
+    }
   return a;
 }
 
@@ -240,42 +305,86 @@ std::vector<std::string> Verdict(const Aggregate& a) {
   const bool has_icef = std::find(a.methods.begin(), a.methods.end(), "icef") != a.methods.end();
   if (!has_icef || baselines.empty()) {
     lines.push_back("No verdict: the bench did not run icef together with a baseline (warp, nerface).");
-    return lines;
   }
-  auto describe = [&](Metric m, const char* what) {
-    int cells = 0, better = 0;
-    std::string detail;
-    for (int k : a.ks)
-      for (const std::string& b : baselines)
-        for (const Comparison& c : a.far_comparisons) {
-          if (c.k != k || c.other != b || c.metric != m) continue;
-          ++cells;
-          if (c.icef_better) ++better;
-          char buf[256];
-          std::snprintf(buf, sizeof buf, "%sK=%d vs %s: %s (%s %s vs %s; icef better in %d/%d identities)",
-                        detail.empty() ? "" : "; ", k, b.c_str(), c.icef_better ? "better" : "not better",
-                        MetricName(m), Pm(a.Find(k, "icef", Tier::kFar)->Get(m), MetricFormat(m)).c_str(),
-                        Pm(a.Find(k, b, Tier::kFar)->Get(m), MetricFormat(m)).c_str(), c.icef_wins, c.paired);
-          detail += buf;
-        }
-    if (cells == 0) {
-      lines.push_back(std::string("**") + what + "**: not measured in the far tier (no values).");
-      return;
-    }
-    std::string head;
-    if (better == cells)
-      head = "icef **beats** the baselines in every far-tier comparison";
-    else if (better == 0)
-      head = "icef does **not** beat the baselines in any far-tier comparison";
-    else
-      head = "icef beats the baselines in **" + std::to_string(better) + " of " + std::to_string(cells) +
-             "** far-tier comparisons only";
-    lines.push_back(std::string("**") + what + "** (" + MetricName(m) + ", mean ± std [min, max] over identities): " +
-                    head + ". " + detail + ".");
+  auto value = [&](int k, const std::string& method, Tier tier, Metric m) {
+    const AggregateCell* c = a.Find(k, method, tier);
+    return c ? Pm(c->Get(m), MetricFormat(m)) : std::string("-");
   };
-  describe(Metric::kIdDistance, "Identity similarity");
-  describe(Metric::kIdCosine, "Identity similarity (cosine)");
-  describe(Metric::kPsnr, "PSNR");
+  auto pair_detail = [&](const PairVerdict& v) {
+    std::string d = "K=" + std::to_string(v.k) + " vs " + v.other + ": " + OutcomeName(v.outcome);
+    Metric shown = Metric::kExprGain;
+    if (v.outcome == Outcome::kWorseIdentity) shown = Metric::kIdDistanceGt;
+    if (v.outcome == Outcome::kWorsePsnr || v.outcome == Outcome::kBetter) shown = Metric::kPsnr;
+    if (v.outcome != Outcome::kNoData)
+      d += std::string(" (") + MetricName(shown) + " " + value(v.k, v.method, v.tier, shown) + " vs " +
+           value(v.k, v.other, v.tier, shown) + ")";
+    return d;
+  };
+  auto tier_line = [&](Tier tier, const std::vector<std::string>& others, const std::string& label) {
+    int pairs = 0, better = 0;
+    std::string detail;
+    for (const PairVerdict& v : a.verdicts) {
+      if (v.tier != tier || v.outcome == Outcome::kNoData ||
+          std::find(others.begin(), others.end(), v.other) == others.end())
+        continue;
+      ++pairs;
+      better += v.outcome == Outcome::kBetter;
+      detail += (detail.empty() ? "" : "; ") + pair_detail(v);
+    }
+    if (pairs == 0) return;
+    std::string head;
+    if (better == pairs)
+      head = "icef is **better** in every comparison";
+    else if (better == 0)
+      head = "icef is **not better** in any comparison";
+    else
+      head = "icef is better in **" + std::to_string(better) + " of " + std::to_string(pairs) + "** comparisons";
+    lines.push_back("**" + std::string(TierName(tier)) + " tier, icef vs " + label + "**: " + head + ". " + detail + ".");
+  };
+  if (has_icef && !baselines.empty()) {
+    std::vector<std::string> ablations;
+    for (const std::string& m : a.methods)
+      if (m != "icef" && std::find(baselines.begin(), baselines.end(), m) == baselines.end()) ablations.push_back(m);
+    for (Tier tier : {Tier::kFar, Tier::kModerate, Tier::kNear}) tier_line(tier, baselines, "the baselines");
+    tier_line(Tier::kFar, ablations, "its ablations and the other methods");
+  }
+  // How much of the expression each method shows, and its identity drift against the truth's own.
+  for (int k : a.ks) {
+    std::string gains, drift, under;
+    for (const std::string& method : a.methods) {
+      std::string g;
+      for (Tier tier : {Tier::kNear, Tier::kModerate, Tier::kFar}) {
+        const AggregateCell* c = a.Find(k, method, tier);
+        char buf[32] = "-";
+        if (c && c->Get(Metric::kExprGain)) std::snprintf(buf, sizeof buf, "%.2f", c->Get(Metric::kExprGain)->mean);
+        if (!g.empty()) g += "/";
+        g += buf;
+      }
+      if (!gains.empty()) gains += ", ";
+      gains += "`" + method + "` " + g;
+      const AggregateCell* far = a.Find(k, method, Tier::kFar);
+      if (far && far->Get(Metric::kIdExcess)) {
+        char buf[96];
+        std::snprintf(buf, sizeof buf, "`%s` %+.3f", method.c_str(), far->Get(Metric::kIdExcess)->mean);
+        drift += (drift.empty() ? "" : ", ") + std::string(buf);
+      }
+      if (far && far->Get(Metric::kExprGain) && far->Get(Metric::kExprGain)->mean < 0.5) {
+        char buf[128];
+        std::snprintf(buf, sizeof buf, "`%s` (%.0f%%)", method.c_str(), 100 * far->Get(Metric::kExprGain)->mean);
+        under += (under.empty() ? "" : ", ") + std::string(buf);
+      }
+    }
+    lines.push_back("**Expression reproduced, K=" + std::to_string(k) +
+                    "** (expr_gain near/moderate/far, mean over identities; 1 = the full expression, 0 = none): " +
+                    gains + "." +
+                    (under.empty() ? std::string()
+                                   : " **Under-expression** in the far tier (less than half of the expression): " +
+                                         under + "."));
+    if (!drift.empty())
+      lines.push_back("**Identity drift beyond the ground truth's own, K=" + std::to_string(k) +
+                      "** (far-tier id_excess = id_distance - id_distance_reference; negative = the render moves "
+                      "less than the truth): " + drift + ".");
+  }
   return lines;
 }
 
@@ -287,7 +396,16 @@ std::string ReportMarkdown(const Aggregate& a, const std::vector<RunRecord>& run
     << "`metrics.json` files; `report.json` holds the same numbers).\n\n";
   s << "- identities (seeds): ";
   for (size_t i = 0; i < a.identities.size(); ++i) s << (i ? ", " : "") << a.identities[i];
-  s << "\n- K (training frames): ";
+  if (!ctx.identity_role.empty()) s << " (" << ctx.identity_role << ")";
+  s << "\n";
+  if (ctx.tier_thresholds) {
+    char t[160];
+    std::snprintf(t, sizeof t, "- tiers by delta: observed = 0, near (0, %.2f], moderate (%.2f, %.2f], far > %.2f\n",
+                  (*ctx.tier_thresholds)[0], (*ctx.tier_thresholds)[0], (*ctx.tier_thresholds)[1],
+                  (*ctx.tier_thresholds)[1]);
+    s << t;
+  }
+  s << "- K (training frames): ";
   for (size_t i = 0; i < a.ks.size(); ++i) s << (i ? ", " : "") << a.ks[i];
   s << "\n- methods: ";
   for (size_t i = 0; i < a.methods.size(); ++i) s << (i ? ", " : "") << "`" << a.methods[i] << "`";
@@ -306,11 +424,25 @@ std::string ReportMarkdown(const Aggregate& a, const std::vector<RunRecord>& run
       << ProgressBar::FormatDuration(train_total / runs.size()) << " per run on average)\n";
   }
   if (!ctx.settings.empty()) s << "- settings: `" << ctx.settings.dump() << "`\n";
-  s << "\n## Verdict (far tier, computed)\n\n";
+  char rule[512];
+  std::snprintf(rule, sizeof rule,
+                "Rule: a method is better than another in a tier only where it reproduces at least %.0f%% of the "
+                "expression (expr_gain), its expr_gain is not lower than the other's beyond the spread over identities "
+                "(the larger sample std, at least %.2f), and it is better on both id_distance_gt and PSNR. A face "
+                "that does not move never wins.",
+                100 * kMinExpressionGain, kGainTolerance);
+  s << "\n## Verdict (computed)\n\n" << rule << "\n\n";
   for (const std::string& line : Verdict(a)) s << "- " << line << "\n";
   s << "\n## Methods and caveats\n\n"
     << "- `icef`: deformation + static canonical field + L_id + L_smooth + confidence-weighted warping; "
-    << "`icef-no-id` and `icef-no-conf` are its ablations.\n"
+    << "`icef-no-id` (no L_id, no L_smooth), `icef-no-conf` (kappa = 1) and `icef-uniform` (L_id with M = 0 "
+    << "everywhere: deformation damped everywhere, not only outside the landmark regions) are its ablations.\n"
+    << "- Expression fidelity: `expr_gain` is the share of the true change (ground truth - ground-truth neutral) "
+    << "that the render's change (render - the model's own neutral render, same view) reproduces inside the "
+    << "brow/eye/mouth region (1 = all, 0 = none), `expr_corr` their cosine, `region_psnr` the PSNR there; "
+    << "`psnr_neutral_floor` is the PSNR a model that renders no expression would score (the ground-truth "
+    << "neutral against the ground truth). `id_excess` = `id_distance` - `id_distance_reference`: identity "
+    << "drift beyond what the expression itself causes (negative = under-expression).\n"
     << "- Baselines are stand-ins built on the same engine: `warp` (a single learned warp, no identity losses, "
     << "no confidence) stands in for FDNeRF-style deformation methods, `nerface` (expression concatenated into "
     << "the radiance field, no warp) for NeRFFaceEditing/NerFace-style entangled methods. **FDNeRF and "
@@ -339,22 +471,30 @@ std::string ReportMarkdown(const Aggregate& a, const std::vector<RunRecord>& run
 
   s << "\n## Results\n\nCells: mean ± sample std [min, max] over identities of the per-run tier means; "
     << "`runs` = identities contributing, `delta` = mean expression distance of the tier's frames.\n";
+  const std::vector<Metric> image_metrics = {Metric::kPsnr,     Metric::kPsnrNeutralFloor, Metric::kSsim,
+                                             Metric::kLpips,    Metric::kExprGain,         Metric::kExprCorr,
+                                             Metric::kRegionPsnr};
+  const std::vector<Metric> identity_metrics = {Metric::kIdDistanceGt, Metric::kIdDistance, Metric::kIdDistanceReference,
+                                                Metric::kIdExcess,     Metric::kIdCosine,   Metric::kIdShareUnder06};
   for (int k : a.ks) {
-    s << "\n### K = " << k << "\n\n| tier | method | runs | delta |";
-    for (Metric m : AllMetrics()) s << " " << MetricName(m) << " |";
-    s << "\n|---|---|---|---|";
-    for (int i = 0; i < kNumMetrics; ++i) s << "---|";
-    s << "\n";
-    for (Tier tier : AllTiers())
-      for (const std::string& method : a.methods) {
-        const AggregateCell* c = a.Find(k, method, tier);
-        if (!c || c->runs == 0) continue;
-        char d[32];
-        std::snprintf(d, sizeof d, "%.2f", c->delta ? c->delta->mean : 0.0);
-        s << "| " << TierName(tier) << " | `" << method << "` | " << c->runs << " | " << d << " |";
-        for (Metric m : AllMetrics()) s << " " << Pm(c->Get(m), MetricFormat(m)) << " |";
-        s << "\n";
-      }
+    for (const auto& [title, metrics] : {std::pair{"image and expression", &image_metrics},
+                                         std::pair{"identity", &identity_metrics}}) {
+      s << "\n### K = " << k << ", " << title << "\n\n| tier | method | runs | delta |";
+      for (Metric m : *metrics) s << " " << MetricName(m) << " |";
+      s << "\n|---|---|---|---|";
+      for (size_t i = 0; i < metrics->size(); ++i) s << "---|";
+      s << "\n";
+      for (Tier tier : AllTiers())
+        for (const std::string& method : a.methods) {
+          const AggregateCell* c = a.Find(k, method, tier);
+          if (!c || c->runs == 0) continue;
+          char d[32];
+          std::snprintf(d, sizeof d, "%.2f", c->delta ? c->delta->mean : 0.0);
+          s << "| " << TierName(tier) << " | `" << method << "` | " << c->runs << " | " << d << " |";
+          for (Metric m : *metrics) s << " " << Pm(c->Get(m), MetricFormat(m)) << " |";
+          s << "\n";
+        }
+    }
   }
   if (!plots.empty()) {
     s << "\n## Plots\n\nEach metric against delta (x = mean delta of each tier), one line per method, error bars "
@@ -393,6 +533,11 @@ Json ReportJson(const Aggregate& a, const std::vector<RunRecord>& runs, const Re
   Json comps = Json::array();
   for (const Comparison& c : a.far_comparisons) comps.push_back(c.ToJson());
   j["far_comparisons"] = std::move(comps);
+  Json verdicts = Json::array();
+  for (const PairVerdict& v : a.verdicts) verdicts.push_back(v.ToJson());
+  j["pair_verdicts"] = std::move(verdicts);
+  if (!ctx.identity_role.empty()) j["identity_role"] = ctx.identity_role;
+  if (ctx.tier_thresholds) j["tier_thresholds"] = *ctx.tier_thresholds;
   j["verdict"] = Verdict(a);
   Json rj = Json::array();
   for (const RunRecord& r : runs)

@@ -39,8 +39,12 @@ struct RunRecord {
 
 // The metrics a report aggregates, in table order.
 // kIdDistanceReference: the ground truth's own drift (GT vs GT neutral), the floor a perfect model shows.
-enum class Metric { kPsnr, kSsim, kLpips, kIdCosine, kIdDistance, kIdDistanceGt, kIdShareUnder06, kIdDistanceReference };
-constexpr int kNumMetrics = 8;
+// The expression metrics (kExprGain, kExprCorr, kRegionPsnr) and kPsnrNeutralFloor, kIdExcess: eval/evaluate.h.
+enum class Metric {
+  kPsnr, kPsnrNeutralFloor, kSsim, kLpips, kExprGain, kExprCorr, kRegionPsnr,
+  kIdCosine, kIdDistance, kIdDistanceGt, kIdShareUnder06, kIdDistanceReference, kIdExcess
+};
+constexpr int kNumMetrics = 13;
 const std::array<Metric, kNumMetrics>& AllMetrics();
 const char* MetricName(Metric metric);   // the metrics.json key, e.g. "id_distance"
 const char* MetricLabel(Metric metric);  // axis label, e.g. "identity distance to own neutral (lower = better)"
@@ -83,12 +87,41 @@ struct Comparison {
   Json ToJson() const;
 };
 
+// The verdict rule (DESIGN.md §6): method A is better than B in a tier only where A reproduces at
+// least kMinExpressionGain of the expression, its expr_gain is not lower than B's beyond the spread
+// over identities (max of the two sample stds, at least kGainTolerance), and it is better on both
+// id_distance_gt and PSNR. A face that does not move (expr_gain 0) therefore never wins.
+constexpr double kMinExpressionGain = 0.1;
+constexpr double kGainTolerance = 0.02;
+
+enum class Outcome {
+  kBetter,           // all conditions hold
+  kUnderExpresses,   // A's expr_gain is below kMinExpressionGain or lower than B's beyond the spread
+  kWorseIdentity,    // expression fine, id_distance_gt not better
+  kWorsePsnr,        // expression and identity fine, PSNR not better
+  kNoData,           // a metric is missing
+};
+const char* OutcomeName(Outcome outcome);
+
+// icef against one other method at one K in one tier, by the rule above.
+struct PairVerdict {
+  int k = 0;
+  Tier tier = Tier::kFar;
+  std::string method;  // "icef"
+  std::string other;
+  Outcome outcome = Outcome::kNoData;
+  Json ToJson() const;
+};
+PairVerdict ComparePair(const struct Aggregate& aggregate, int k, Tier tier, const std::string& method,
+                        const std::string& other);
+
 struct Aggregate {
   std::vector<int> ks;                     // ascending
   std::vector<std::string> methods;        // in AllMethods() order, then others by name
   std::vector<uint64_t> identities;        // ascending
   std::vector<AggregateCell> cells;        // k-major, then method, then tier
-  std::vector<Comparison> far_comparisons;  // icef vs every other method, far tier, per K
+  std::vector<Comparison> far_comparisons;  // icef vs every other method, far tier, per K, per metric
+  std::vector<PairVerdict> verdicts;        // icef vs every other method, per K, near/moderate/far
   const AggregateCell* Find(int k, const std::string& method, Tier tier) const;
 };
 
@@ -100,10 +133,15 @@ struct ReportContext {
   Json settings = Json::object();        // bench options, shown verbatim
   std::vector<std::string> notes;        // extra lines for report.md
   double wall_seconds = 0;               // whole bench (0: not shown)
+  // What the identities are for, e.g. "test: never used for tuning" (empty: not shown).
+  std::string identity_role;
+  // The tiers' delta thresholds [near/moderate, moderate/far] (nullopt: not shown).
+  std::optional<std::array<double, 2>> tier_thresholds;
 };
 
-// The verdict lines (markdown bullets) derived from the far-tier comparisons against the
-// baselines warp and nerface; the ablations are reported separately.
+// The verdict lines (markdown bullets): per novel tier, icef against the baselines (warp, nerface)
+// and the other methods by the rule above, naming under-expression; then how much of each tier's
+// expression every method reproduces and how its identity drift compares with the ground truth's.
 std::vector<std::string> Verdict(const Aggregate& aggregate);
 
 std::string ReportMarkdown(const Aggregate& aggregate, const std::vector<RunRecord>& runs, const ReportContext& context,

@@ -26,7 +26,7 @@ struct ModelWorkspace {
   DeformationContext smooth_ctx;
   // L_sym: m samples (gathered) and their mirror images.
   std::vector<int64_t> sym_index;
-  std::vector<float> sym_positions, sym_dirs, sym_betas, sym_sigma_a, sym_rgb_a, sym_sigma_b, sym_rgb_b, sym_dt;
+  std::vector<float> sym_positions, sym_dirs, sym_sigma_a, sym_rgb_a, sym_sigma_b, sym_rgb_b, sym_dt;
   std::vector<float> sym_d_sigma_a, sym_d_rgb_a, sym_d_sigma_b, sym_d_rgb_b, sym_d_positions;
   StaticFieldContext sym_ctx;
 };
@@ -247,7 +247,9 @@ LossTerms AvatarModel::TrainForwardBackward(const TrainRays& batch, const LossWe
     terms.occlusion = occ * inv_r;
   }
 
-  const bool symmetry = weights.lambda_symmetry > 0 && symmetry_;
+  // Mirroring acts in canonical space; nerface has none (its density depends on beta, and mirroring
+  // it would penalise exactly its asymmetric expressions), so the prior does not apply to it.
+  const bool symmetry = weights.lambda_symmetry > 0 && symmetry_ && !traits_.entangled_beta;
   if (symmetry) terms.symmetry = SymmetryTerm(ws, n, canonical, weights, executor);
 
   if (deformation_) Fit(ws.d_canonical, 3 * n);
@@ -269,7 +271,11 @@ LossTerms AvatarModel::TrainForwardBackward(const TrainRays& batch, const LossWe
     const Vec3f inv_half2 = half.cwiseProduct(half).cwiseInverse();
     if (id_terms) {
       Fit(ws.mask_values, n);
-      mask_.EvaluateBatch(positions, n, ws.mask_values.data());
+      if (traits_.uniform_mask) {
+        std::fill(ws.mask_values.begin(), ws.mask_values.begin() + n, 0.f);
+      } else {
+        mask_.EvaluateBatch(positions, n, ws.mask_values.data());
+      }
     }
     if (id_terms && weights.lambda_id > 0) {
       const float inv_half2_arr[3] = {inv_half2.x(), inv_half2.y(), inv_half2.z()};
@@ -330,8 +336,6 @@ double AvatarModel::SymmetryTerm(ModelWorkspace& ws, int64_t n, const float* can
   const int64_t m = std::min<int64_t>(n, weights.symmetry_max_samples);
   ws.sym_index.clear();
   if (m <= 0) return 0.0;
-  const int b = setup_.expression_dim;
-  const bool cond = traits_.entangled_beta;
   Fit(ws.sym_index, m);
   Fit(ws.sym_positions, 3 * m);
   Fit(ws.sym_dirs, 3 * m);
@@ -344,7 +348,6 @@ double AvatarModel::SymmetryTerm(ModelWorkspace& ws, int64_t n, const float* can
   Fit(ws.sym_d_rgb_a, 3 * m);
   Fit(ws.sym_d_sigma_b, m);
   Fit(ws.sym_d_rgb_b, 3 * m);
-  if (cond) Fit(ws.sym_betas, m * b);
   for (int64_t j = 0; j < m; ++j) {
     const int64_t i = j * n / m;
     ws.sym_index[j] = i;
@@ -357,9 +360,8 @@ double AvatarModel::SymmetryTerm(ModelWorkspace& ws, int64_t n, const float* can
     }
     ws.sym_sigma_a[j] = ws.sigma[i];
     ws.sym_dt[j] = ws.samples.dt[i];
-    if (cond) std::copy(ws.betas.begin() + i * b, ws.betas.begin() + (i + 1) * b, ws.sym_betas.begin() + j * b);
   }
-  static_field_->Forward(executor, m, ws.sym_positions.data(), ws.sym_dirs.data(), cond ? ws.sym_betas.data() : nullptr,
+  static_field_->Forward(executor, m, ws.sym_positions.data(), ws.sym_dirs.data(), nullptr,
                          ws.sym_sigma_b.data(), ws.sym_rgb_b.data(), &ws.sym_ctx, true, deformation_ != nullptr);
   const float scale = static_cast<float>(weights.lambda_symmetry);
   const double loss = SymmetryLoss<float>(m, ws.sym_sigma_a.data(), ws.sym_rgb_a.data(), ws.sym_sigma_b.data(),
@@ -378,8 +380,39 @@ double AvatarModel::SymmetryTerm(ModelWorkspace& ws, int64_t n, const float* can
   return loss;
 }
 
+OccupancyGrid AvatarModel::RenderOccupancy(std::span<const float> beta, const Executor& executor) const {
+  ICEF_CHECK(static_cast<int>(beta.size()) == setup_.expression_dim, "beta has the wrong length");
+  if (!deformation_ && !traits_.entangled_beta) return occupancy_;  // the density does not depend on beta
+  const int b = setup_.expression_dim;
+  const std::vector<uint8_t>& hull = occupancy_.allowed();
+  StaticFieldContext sctx;
+  std::vector<float> betas, offsets, canonical;
+  auto query = [&](const float* positions, int64_t n, float* sigma) {
+    const float* c = positions;
+    if (deformation_) {
+      offsets.resize(3 * n);
+      canonical.resize(3 * n);
+      Offsets(executor, n, positions, beta, offsets.data());
+      for (int64_t i = 0; i < 3 * n; ++i) canonical[i] = positions[i] + offsets[i];
+      c = canonical.data();
+    } else {
+      betas.resize(n * b);
+      for (int64_t i = 0; i < n; ++i) std::copy(beta.begin(), beta.end(), betas.begin() + i * b);
+    }
+    static_field_->Density(executor, n, c, deformation_ ? nullptr : betas.data(), sigma, &sctx);
+    for (int64_t i = 0; i < n; ++i) {
+      const int64_t cell = occupancy_.CellOf(Vec3f(c[3 * i], c[3 * i + 1], c[3 * i + 2]));
+      if (cell < 0 || (!hull.empty() && !hull[cell])) sigma[i] = -1.f;  // not allowed
+    }
+  };
+  // One query per 2 x 2 x 2 cells: the training grid already holds the observed geometry, what is
+  // added here is bulky (a jaw, lips), and a quarter of a second per image at full resolution
+  // (64^3 warps) is not worth it.
+  return occupancy_.WithQueriedCells(query, 2);
+}
+
 void AvatarModel::Render(std::span<const Ray> rays, std::span<const float> beta, const Vec3f& background,
-                       const Executor& executor, RenderOutput* out) const {
+                       const Executor& executor, RenderOutput* out, const OccupancyGrid* occupancy) const {
   ICEF_CHECK(static_cast<int>(beta.size()) == setup_.expression_dim, "beta has the wrong length");
   ModelWorkspace& ws = *render_ws_;
   const int64_t total_rays = static_cast<int64_t>(rays.size());
@@ -396,8 +429,8 @@ void AvatarModel::Render(std::span<const Ray> rays, std::span<const float> beta,
   constexpr int64_t kChunk = 4096;
   for (int64_t r0 = 0; r0 < total_rays; r0 += kChunk) {
     const int64_t nr = std::min(kChunk, total_rays - r0);
-    SampleRays(rays.subspan(r0, nr), setup_.aabb, config_.SamplerOptions(false), &occupancy_, 0, 0, executor,
-               &ws.samples);
+    SampleRays(rays.subspan(r0, nr), setup_.aabb, config_.SamplerOptions(false), occupancy ? occupancy : &occupancy_,
+               0, 0, executor, &ws.samples);
     const int64_t n = ws.samples.size();
     const float* positions = ws.samples.positions.data();
     Fit(ws.dirs, 3 * n);

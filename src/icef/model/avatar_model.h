@@ -99,9 +99,18 @@ class AvatarModel {
   LossTerms TrainForwardBackward(const TrainRays& batch, const LossWeights& weights, uint64_t seed, int64_t step,
                                  const Executor& executor);
 
-  // Renders rays at expression beta [expression_dim] over `background`.
+  // Renders rays at expression beta [expression_dim] over `background`. Samples are placed by
+  // `occupancy` (null: the training grid occupancy(); RenderImage passes RenderOccupancy(beta)).
   void Render(std::span<const Ray> rays, std::span<const float> beta, const Vec3f& background,
-              const Executor& executor, RenderOutput* out) const;
+              const Executor& executor, RenderOutput* out, const OccupancyGrid* occupancy = nullptr) const;
+
+  // The occupancy for rendering expression beta (DESIGN.md §3): the training grid plus every cell
+  // whose canonical point D_final(x, beta) holds density above the threshold inside the region the
+  // visual hull allowed in training (the hull is looked up at the canonical point, through the
+  // warp). Geometry a new expression moves outside the training silhouettes (an opened jaw) is
+  // therefore not cut away, while space that training never constrained stays empty. nerface has
+  // no canonical space: its density at (x, beta) is looked up with the hull at x.
+  OccupancyGrid RenderOccupancy(std::span<const float> beta, const Executor& executor) const;
 
   // Folds the current density (max over the training expressions) into the occupancy grid.
   void UpdateOccupancy(uint64_t seed, int64_t step, const Executor& executor);

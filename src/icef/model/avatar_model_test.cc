@@ -294,3 +294,84 @@ TEST(AvatarModelTest, TrainLossGradientMatchesFiniteDifferences) {
 
 }  // namespace
 }  // namespace icef
+
+namespace icef {
+namespace {
+
+// No clipping of new expressions (DESIGN.md §3): geometry that an expression's warp moves out of
+// the training grid (and out of the visual hull carved in training) is rendered, because the
+// render-time grid is built for the rendered expression and the hull is looked up at canonical
+// points. The setup is a hand-made warp that shifts everything down by 0.2 * beta_0 (an "opening
+// jaw"), a canonical field dense everywhere, and a hull that allows only y >= 0 (the "training
+// silhouette" above the chin line y = 0).
+TEST(AvatarModelTest, RenderOccupancyFollowsTheWarpBeyondTheTrainingHull) {
+  ModelConfig config = TinyModelConfig("warp");
+  config.density_bias = 3.f;  // dense everywhere: opacity ~1 over any 0.25 of path
+  ModelSetup setup = TinySetup();
+  for (auto& e : setup.training_expressions) std::fill(e.begin(), e.end(), 0.f);
+  auto created = AvatarModel::Create(config, setup, Executor(2));
+  ASSERT_TRUE(created.ok()) << created.status().message();
+  AvatarModel& model = **created;
+  model.Initialize(3);
+  // g(x, beta) = (0, 0.4 beta_0, 0) half-extents for beta_0 >= 0: D(x) = x + (0, 0.2 beta_0, 0), so
+  // what sits at canonical y appears 0.2 beta_0 lower.
+  nn::ParameterStore& store = model.store();
+  const int block = store.FindBlock("deformation");
+  ASSERT_GE(block, 0);
+  float* w = store.params() + store.block(block).offset;
+  std::fill(w, w + store.block(block).size, 0.f);
+  const int input = 3 * (1 + 2 * config.deform_frequencies) + setup.expression_dim;  // [freq(x), beta]
+  const int h0 = config.deform_hidden[0], h1 = config.deform_hidden[1];
+  w[(input - setup.expression_dim) * h0 + 0] = 1.f;  // beta_0 -> hidden unit 0
+  w[input * h0 + 0 * h1 + 0] = 1.f;                  // unit 0 -> unit 0
+  w[input * h0 + h0 * h1 + 0 * 3 + 1] = 0.4f;        // unit 0 -> y offset
+  const std::vector<float> open = {1.f, 0.f, 0.f}, neutral = {0.f, 0.f, 0.f};
+  std::vector<float> probe = {0.f, -0.1f, 0.f}, offset(3);
+  model.OffsetsPhi(Executor(1), 1, probe.data(), open, offset.data());
+  ASSERT_NEAR(offset[1], 0.2f, 1e-5f);  // the hand-made warp is what the comment says
+
+  const int r = model.occupancy().resolution();
+  std::vector<uint8_t> hull(model.occupancy().num_cells(), 0);
+  for (int z = 0; z < r; ++z)
+    for (int y = r / 2; y < r; ++y)
+      for (int x = 0; x < r; ++x) hull[model.occupancy().CellIndex(x, y, z)] = 1;
+  ASSERT_TRUE(model.occupancy().SetAllowed(hull).ok());
+
+  // Horizontal rays at heights y through the middle of the box.
+  auto opacity = [&](float y, std::span<const float> beta, const OccupancyGrid* grid) {
+    RenderOutput out;
+    const std::vector<Ray> rays = {Ray{Vec3f(0.f, y, 2.f), Vec3f(0.f, 0.f, -1.f)}};
+    model.Render(rays, beta, Vec3f::Ones(), Executor(1), &out, grid);
+    return out.opacity[0];
+  };
+  const OccupancyGrid open_grid = model.RenderOccupancy(open, Executor(2));
+  const OccupancyGrid neutral_grid = model.RenderOccupancy(neutral, Executor(2));
+  // Above the chin line: rendered either way.
+  EXPECT_GT(opacity(0.2f, open, nullptr), 0.9f);
+  EXPECT_GT(opacity(0.2f, open, &open_grid), 0.9f);
+  // Below it, where the opened "jaw" now is: the training grid clips it, the expression's grid does not.
+  EXPECT_LT(opacity(-0.1f, open, nullptr), 1e-6f);
+  EXPECT_GT(opacity(-0.1f, open, &open_grid), 0.9f);
+  // At neutral nothing moved, and nothing is added below the hull.
+  EXPECT_LT(opacity(-0.1f, neutral, &neutral_grid), 1e-6f);
+  // Far below, where the warp brings no canonical geometry from inside the hull: still empty.
+  EXPECT_LT(opacity(-0.4f, open, &open_grid), 1e-6f);
+  // RenderImage builds the expression's grid by default; the training grid on request.
+  Intrinsics in;
+  in.width = in.height = 16;
+  in.fl_x = in.fl_y = 16;
+  in.cx = in.cy = 8;
+  const Camera camera = Camera::LookAt(in, Vec3d(0, 0, 2), Vec3d::Zero());
+  const RenderedImage with = RenderImage(model, camera, open, Vec3f::Ones(), Executor(2));
+  const RenderedImage without =
+      RenderImage(model, camera, open, Vec3f::Ones(), Executor(2), RenderOccupancyMode::kTraining);
+  auto covered_rows = [](const Image& alpha) {
+    int rows = 0;
+    for (int y = 0; y < alpha.height; ++y) rows += alpha.At(alpha.width / 2, y, 0) > 0.5f;
+    return rows;
+  };
+  EXPECT_GT(covered_rows(with.opacity), covered_rows(without.opacity) + 1);
+}
+
+}  // namespace
+}  // namespace icef

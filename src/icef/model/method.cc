@@ -8,6 +8,7 @@ MethodTraits TraitsOf(Method method) {
     case Method::kIcef: break;
     case Method::kIcefNoId: t.identity_losses = false; break;
     case Method::kIcefNoConf: t.confidence = false; break;
+    case Method::kIcefUniform: t.uniform_mask = true; break;
     case Method::kWarp: t.identity_losses = false, t.confidence = false; break;
     case Method::kNerface:
       t.deformation = false, t.identity_losses = false, t.confidence = false, t.entangled_beta = true;
@@ -21,6 +22,7 @@ const char* MethodName(Method method) {
     case Method::kIcef: return "icef";
     case Method::kIcefNoId: return "icef-no-id";
     case Method::kIcefNoConf: return "icef-no-conf";
+    case Method::kIcefUniform: return "icef-uniform";
     case Method::kWarp: return "warp";
     case Method::kNerface: return "nerface";
   }
@@ -28,8 +30,8 @@ const char* MethodName(Method method) {
 }
 
 const std::vector<Method>& AllMethods() {
-  static const std::vector<Method> kAll = {Method::kIcef, Method::kIcefNoId, Method::kIcefNoConf, Method::kWarp,
-                                           Method::kNerface};
+  static const std::vector<Method> kAll = {Method::kIcef, Method::kIcefNoId, Method::kIcefNoConf, Method::kIcefUniform,
+                                           Method::kWarp, Method::kNerface};
   return kAll;
 }
 

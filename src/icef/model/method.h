@@ -3,8 +3,15 @@
 //   icef          deformation + static field + L_id + L_smooth + confidence-weighted warping
 //   icef-no-id    as icef with lambda_id = lambda_smooth = 0
 //   icef-no-conf  as icef with kappa = 1 always (no linearised fallback)
+//   icef-uniform  as icef with the region mask M = 0 everywhere in L_id (deformation damped
+//                 everywhere; isolates the landmark mask from plain damping; L_smooth, which acts
+//                 on the mask's boundary, has nothing to act on)
 //   warp          deformation + static field only: no L_id, no L_smooth, no confidence
 //   nerface       no deformation: beta is concatenated into the static field's density-MLP input
+//                 (no canonical space, so the left-right symmetry prior does not apply to it)
+//
+// `warp` and `icef-no-id` train the same model (confidence acts only at render time); the bench
+// runs `warp` as the baseline and leaves `icef-no-id` out by default.
 #pragma once
 
 #include <string>
@@ -14,13 +21,14 @@
 
 namespace icef {
 
-enum class Method { kIcef, kIcefNoId, kIcefNoConf, kWarp, kNerface };
+enum class Method { kIcef, kIcefNoId, kIcefNoConf, kIcefUniform, kWarp, kNerface };
 
 struct MethodTraits {
   bool deformation = true;       // observation -> canonical warp D_phi
   bool identity_losses = true;   // L_id and L_smooth active (their lambdas apply)
   bool confidence = true;        // kappa-weighted blend with the linearised warp at inference
   bool entangled_beta = false;   // beta fed into the static field (NerFace-style)
+  bool uniform_mask = false;     // L_id with M = 0 everywhere instead of the landmark mask
 };
 
 MethodTraits TraitsOf(Method method);

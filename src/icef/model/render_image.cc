@@ -2,11 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 namespace icef {
 
 RenderedImage RenderImage(const AvatarModel& model, const Camera& camera, std::span<const float> beta,
-                          const Vec3f& background, const Executor& executor) {
+                          const Vec3f& background, const Executor& executor, RenderOccupancyMode occupancy_mode) {
+  std::optional<OccupancyGrid> occupancy;
+  if (occupancy_mode == RenderOccupancyMode::kExpression) occupancy = model.RenderOccupancy(beta, executor);
   const int w = camera.width(), h = camera.height();
   const int s = model.config().render_supersample, s2 = s * s;
   RenderedImage img;
@@ -30,7 +33,7 @@ RenderedImage RenderImage(const AvatarModel& model, const Camera& camera, std::s
       for (int i = 0; i < w; ++i)
         for (int q = 0; q < s2; ++q)
           rays[(size_t(j - j0) * w + i) * s2 + q] = camera.RayThrough(i + (q % s + 0.5) / s, j + (q / s + 0.5) / s);
-    model.Render(rays, beta, background, executor, &out);
+    model.Render(rays, beta, background, executor, &out, occupancy ? &*occupancy : nullptr);
     const size_t first = size_t(j0) * w, pixels = size_t(j1 - j0) * w;
     auto average = [&](const std::vector<float>& v, int channels, Image& dst) {
       for (size_t p = 0; p < pixels; ++p)

@@ -19,8 +19,14 @@ struct RenderedImage {
   NearestExpression nearest;  // beta_n, delta, kappa of the expression
 };
 
+// Which occupancy grid places the samples: the one built for the rendered expression
+// (AvatarModel::RenderOccupancy, the default) or the training grid as it is (training expressions
+// only, cut to the training visual hull: clips geometry a far expression moves; for comparisons).
+enum class RenderOccupancyMode { kExpression, kTraining };
+
 RenderedImage RenderImage(const AvatarModel& model, const Camera& camera, std::span<const float> beta,
-                          const Vec3f& background, const Executor& executor);
+                          const Vec3f& background, const Executor& executor,
+                          RenderOccupancyMode occupancy = RenderOccupancyMode::kExpression);
 
 // Maps a 1-channel image to RGB for viewing: values over [lo, hi] through a perceptual colour map
 // (viridis-like); hi <= lo uses the image's own range.

@@ -110,12 +110,12 @@ void OccupancyGrid::Update(const DensityQuery& query, uint64_t seed, int64_t ste
   RecomputeBits();
 }
 
-void OccupancyGrid::RecomputeBits() {
+void OccupancyGrid::Dilate(std::vector<uint8_t>* bits) const {
   const int r = options_.resolution;
   const int k = options_.dilation;
-  // Separable max filter (dilation by a (2k+1)^3 box) over the thresholded bits, axis by axis.
-  std::vector<uint8_t> a(num_cells()), b(num_cells());
-  for (int64_t c = 0; c < num_cells(); ++c) a[c] = density_[c] > options_.threshold ? 1 : 0;
+  // Separable max filter, axis by axis.
+  std::vector<uint8_t>& a = *bits;
+  std::vector<uint8_t> b(num_cells());
   for (int axis = 0; axis < 3 && k > 0; ++axis) {
     for (int z = 0; z < r; ++z)
       for (int y = 0; y < r; ++y)
@@ -133,9 +133,52 @@ void OccupancyGrid::RecomputeBits() {
         }
     a.swap(b);
   }
+}
+
+void OccupancyGrid::RecomputeBits() {
+  std::vector<uint8_t> a(num_cells());
+  for (int64_t c = 0; c < num_cells(); ++c) a[c] = density_[c] > options_.threshold ? 1 : 0;
+  Dilate(&a);
   if (!allowed_.empty())
     for (int64_t c = 0; c < num_cells(); ++c) a[c] &= allowed_[c];
   bits_.swap(a);
+}
+
+OccupancyGrid OccupancyGrid::WithQueriedCells(const DensityQuery& query, int stride) const {
+  ICEF_CHECK(stride >= 1, "stride must be >= 1");
+  const int r = options_.resolution;
+  const int rb = (r + stride - 1) / stride;  // blocks per axis
+  const int64_t blocks = int64_t(rb) * rb * rb;
+  const Vec3f cell_size = aabb_.Extent() / float(r);
+  std::vector<float> sigma(blocks);
+  const int64_t batch = std::max<int64_t>(1, std::min<int64_t>(options_.query_batch, blocks));
+  std::vector<float> positions(3 * batch);
+  for (int64_t begin = 0; begin < blocks; begin += batch) {
+    const int64_t n = std::min(batch, blocks - begin);
+    for (int64_t i = 0; i < n; ++i) {
+      const int64_t c = begin + i;
+      const int64_t idx[3] = {c % rb, (c / rb) % rb, c / (int64_t(rb) * rb)};
+      for (int a = 0; a < 3; ++a) {
+        const float lo = float(idx[a] * stride), hi = float(std::min<int64_t>((idx[a] + 1) * stride, r));
+        positions[3 * i + a] = aabb_.min[a] + 0.5f * (lo + hi) * cell_size[a];
+      }
+    }
+    query(positions.data(), n, sigma.data() + begin);
+  }
+  const int64_t cells = num_cells();
+  std::vector<uint8_t> hit(cells), allowed(cells);
+  for (int z = 0; z < r; ++z)
+    for (int y = 0; y < r; ++y)
+      for (int x = 0; x < r; ++x) {
+        const float v = sigma[(int64_t(z / stride) * rb + y / stride) * rb + x / stride];
+        hit[CellIndex(x, y, z)] = std::isfinite(v) && v > options_.threshold ? 1 : 0;
+        allowed[CellIndex(x, y, z)] = v >= 0.f ? 1 : 0;
+      }
+  Dilate(&hit);
+  OccupancyGrid out = *this;
+  out.allowed_.clear();
+  for (int64_t c = 0; c < cells; ++c) out.bits_[c] = bits_[c] | (hit[c] & allowed[c]);
+  return out;
 }
 
 Status OccupancyGrid::SetDensities(std::vector<float> densities) {

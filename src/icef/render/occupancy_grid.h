@@ -42,6 +42,15 @@ class OccupancyGrid {
   // dilation). Deterministic for (seed, step) and the query.
   void Update(const DensityQuery& query, uint64_t seed, int64_t step);
 
+  // The grid for rendering one expression: the cells occupied here (bits, hull included) plus the
+  // cells `cell_query` finds dense. The query gets the centre of every block of stride^3 cells
+  // (stride 1: every cell centre; in batches of query_batch) and returns its density, or a
+  // negative value where the block is not allowed (e.g. outside a hull); blocks above the
+  // threshold are dilated by the grid's dilation (in cells), and the dilation stays within the
+  // allowed blocks. The result has no allowed set of its own and is meant for sampling only (its
+  // stored densities are this grid's).
+  OccupancyGrid WithQueriedCells(const DensityQuery& cell_query, int stride = 1) const;
+
   // True when the cell containing p (world frame) is occupied; false outside the aabb.
   bool IsOccupied(const Vec3f& p) const;
   bool IsCellOccupied(int x, int y, int z) const { return bits_[CellIndex(x, y, z)] != 0; }
@@ -72,6 +81,8 @@ class OccupancyGrid {
 
  private:
   void RecomputeBits();
+  // Dilates `bits` [R^3] by options_.dilation cells (a (2k+1)^3 box), in place.
+  void Dilate(std::vector<uint8_t>* bits) const;
 
   Aabb aabb_;
   OccupancyGridOptions options_;

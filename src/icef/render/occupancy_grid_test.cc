@@ -129,5 +129,56 @@ TEST(OccupancyGridTest, AllowedCellsAreAHardPrior) {
   EXPECT_EQ(grid.NumOccupied(), grid.num_cells());
 }
 
+TEST(OccupancyGridTest, QueriedCellsAddCellsOutsideTheAllowedSet) {
+  OccupancyGridOptions o;
+  o.resolution = 8;
+  o.dilation = 0;
+  OccupancyGrid grid(Aabb{}, o);
+  std::vector<uint8_t> allowed(grid.num_cells(), 0);
+  allowed[grid.CellIndex(1, 1, 1)] = 1;
+  ASSERT_TRUE(grid.SetAllowed(allowed).ok());
+  ASSERT_EQ(grid.NumOccupied(), 1);
+  // Dense at cell (5, 5, 5) only (centre (0.375, 0.375, 0.375), cell size 0.25): that cell is
+  // added, outside the grid's allowed set; the grid's own occupied cell stays.
+  int64_t queried = 0;
+  auto one_cell = [&](const float* p, int64_t n, float* sigma) {
+    queried += n;
+    for (int64_t i = 0; i < n; ++i)
+      sigma[i] = (Vec3f(p[3 * i], p[3 * i + 1], p[3 * i + 2]) - Vec3f(0.375f, 0.375f, 0.375f)).norm() < 0.01f ? 1.f : 0.f;
+  };
+  const OccupancyGrid render = grid.WithQueriedCells(one_cell);
+  EXPECT_EQ(queried, grid.num_cells());
+  EXPECT_TRUE(render.IsCellOccupied(1, 1, 1));
+  EXPECT_TRUE(render.IsCellOccupied(5, 5, 5));
+  EXPECT_EQ(render.NumOccupied(), 2);
+  EXPECT_TRUE(render.allowed().empty());
+  EXPECT_EQ(grid.NumOccupied(), 1);  // the grid itself is unchanged
+  // Dilation grows the added cells, but only into cells the query allows (sigma >= 0).
+  o.dilation = 1;
+  OccupancyGrid dilated(Aabb{}, o);
+  dilated.Fill(false);
+  EXPECT_EQ(dilated.WithQueriedCells([](const float*, int64_t n, float* s) { std::fill(s, s + n, 0.f); }).NumOccupied(),
+            0);
+  EXPECT_EQ(dilated.WithQueriedCells(one_cell).NumOccupied(), 27);
+  const OccupancyGrid half = dilated.WithQueriedCells([&](const float* p, int64_t n, float* sigma) {
+    one_cell(p, n, sigma);
+    for (int64_t i = 0; i < n; ++i)
+      if (p[3 * i] > 0.4f) sigma[i] = -1.f;  // cells x >= 6 not allowed
+  });
+  EXPECT_EQ(half.NumOccupied(), 18);  // x in {4, 5} of the 3 x 3 x 3 block
+  // Stride 2: one query per 2 x 2 x 2 block; a dense block occupies its 8 cells (dilated: 4^3).
+  queried = 0;
+  const OccupancyGrid coarse = dilated.WithQueriedCells([&](const float* p, int64_t n, float* sigma) {
+    queried += n;
+    for (int64_t i = 0; i < n; ++i)  // block (2, 2, 2): cells 4..5, centre (0.25, 0.25, 0.25)
+      sigma[i] = (Vec3f(p[3 * i], p[3 * i + 1], p[3 * i + 2]) - Vec3f(0.25f, 0.25f, 0.25f)).norm() < 0.01f ? 1.f : 0.f;
+  }, 2);
+  EXPECT_EQ(queried, 4 * 4 * 4);
+  EXPECT_EQ(coarse.NumOccupied(), 4 * 4 * 4);
+  EXPECT_TRUE(coarse.IsCellOccupied(3, 3, 3));
+  EXPECT_TRUE(coarse.IsCellOccupied(6, 6, 6));
+  EXPECT_FALSE(coarse.IsCellOccupied(7, 6, 6));
+}
+
 }  // namespace
 }  // namespace icef

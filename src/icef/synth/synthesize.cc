@@ -224,15 +224,20 @@ Status SynthesizeDataset(const SynthOptions& options, const Executor& executor, 
     ds.train.push_back(std::move(f));
   }
   const std::vector<float> neutral(kNumExpressions, 0.f);
-  for (int v = 0; v < num_views; ++v)
-    ICEF_RETURN_IF_ERROR(render(MakeFrame(head, plan.test_cameras[v], neutral, Numbered("test_neutral", v))).status());
+  std::vector<Frame> neutral_frames;  // [V]: their landmarks go into the test frames of the view
+  for (int v = 0; v < num_views; ++v) {
+    ICEF_ASSIGN_OR_RETURN(Frame f, render(MakeFrame(head, plan.test_cameras[v], neutral, Numbered("test_neutral", v))));
+    neutral_frames.push_back(std::move(f));
+  }
   int index = 0;
   for (const TestExpression& t : plan.test_expressions) {
     for (int v = 0; v < num_views; ++v) {
       Frame frame = MakeFrame(head, plan.test_cameras[v], t.beta, Numbered("test", index++));
       frame.delta = t.delta;
       frame.tier = t.tier;
-      frame.neutral_file_path = Numbered("test_neutral", v);
+      frame.neutral_file_path = neutral_frames[v].file_path;
+      frame.neutral_landmarks_2d = neutral_frames[v].landmarks_2d;
+      frame.neutral_landmarks_3d = neutral_frames[v].landmarks_3d;
       ICEF_ASSIGN_OR_RETURN(Frame f, render(std::move(frame)));
       ds.test.push_back(std::move(f));
     }

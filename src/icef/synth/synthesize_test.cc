@@ -127,6 +127,14 @@ TEST(SynthesizeTest, WritesALoadableDeterministicDataset) {
     EXPECT_NEAR(*f.delta, delta, 1e-6);  // the JSON's delta agrees with the expressions
     EXPECT_EQ(*f.tier, TierForDelta(delta < 1e-9 ? 0.0 : delta, (*ds.tier_thresholds)[0], (*ds.tier_thresholds)[1]));
     EXPECT_TRUE(f.landmarks_2d && f.landmarks_3d && f.landmarks_2d_visible);
+    // The neutral of the view keeps its landmarks (eval aligns the neutral reference with them):
+    // the same for every frame of the view, and brows, eyes or lips move with the expression.
+    ASSERT_TRUE(f.neutral_landmarks_2d && f.neutral_landmarks_3d);
+    const Frame& first_of_view = ds.test[(&f - ds.test.data()) % 2];  // frames are expression-major, 2 views
+    EXPECT_EQ(*f.neutral_landmarks_2d, *first_of_view.neutral_landmarks_2d);
+    double lip_motion = 0;
+    for (int i = 17; i < 68; ++i) lip_motion += ((*f.landmarks_3d)[i] - (*f.neutral_landmarks_3d)[i]).norm();
+    EXPECT_GT(lip_motion, 1e-4) << f.file_path;
   }
   const Result<Image> sheet = MakeContactSheet(ds, ContactSheetOptions());
   ASSERT_TRUE(sheet.ok()) << sheet.status().message();

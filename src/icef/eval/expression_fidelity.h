@@ -1,0 +1,51 @@
+// Expression fidelity (DESIGN.md §6, docs/evaluation.md): how much of a test frame's expression a
+// render reproduces, measured against the ground truth inside the frame's expression region.
+//
+// - Expression region: the pixels within `dilation` pixels of the 2D convex hull of the frame's
+//   ground-truth landmarks of brows, eyes and mouth (iBUG 17–26, 36–67), united with the same
+//   hull of its neutral's landmarks (same view, expression zero).
+// - With m = render − the model's neutral render (same view) and t = ground truth − ground-truth
+//   neutral, both over the RGB values of the region's pixels:
+//     expr_gain = <m, t> / <t, t>   (1 = the expression at full strength, 0 = none, < 0 = the
+//                                    opposite way, > 1 = exaggerated)
+//     expr_corr = <m, t> / (|m| |t|) (cosine; null when the model's change is exactly zero)
+// - A frame whose true change is negligible (RMS of t over the region below
+//   kNegligibleExpressionRms) gets no gain or cosine: they would divide by nearly nothing.
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include "icef/core/status.h"
+#include "icef/io/image.h"
+#include "icef/math/types.h"
+
+namespace icef::eval {
+
+// RMS (per RGB value, [0, 1] units) below which a frame's true change counts as negligible.
+constexpr double kNegligibleExpressionRms = 0.004;
+
+// The iBUG-68 indices of brows, eyes and mouth.
+const std::vector<int>& ExpressionLandmarkIndices();
+
+// Default dilation of the region in pixels for an image `width` wide: 3 px at 128, scaled.
+int DefaultRegionDilation(int width);
+
+// 1-channel mask (1 inside, 0 outside) of the expression region. `neutral` may be empty (the
+// frame's hull alone). Landmarks are in pixel coordinates (pixel centres at +0.5).
+Image ExpressionRegion(int width, int height, const std::vector<Vec2f>& frame_landmarks,
+                       const std::vector<Vec2f>& neutral_landmarks, int dilation);
+
+struct ExpressionFidelity {
+  int pixels = 0;             // pixels in the region
+  double true_rms = 0;        // RMS of t over the region's RGB values
+  bool negligible = true;     // true_rms < kNegligibleExpressionRms: gain and corr are null
+  std::optional<double> gain;
+  std::optional<double> corr;
+};
+
+// All four images RGB (or RGBA, alpha ignored) of the region's size. Errors: size mismatches.
+Result<ExpressionFidelity> MeasureExpression(const Image& render, const Image& render_neutral, const Image& truth,
+                                             const Image& truth_neutral, const Image& region);
+
+}  // namespace icef::eval
