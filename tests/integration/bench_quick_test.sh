@@ -8,7 +8,7 @@ ICEF="$1"
 WORK="$(mktemp -d)"
 trap 'rm -rf "$WORK"' EXIT
 fail() { echo "FAIL: $*" >&2; exit 1; }
-RUNS=(id1_k3_icef id1_k3_icef-no-id id1_k3_icef-no-conf id1_k3_warp id1_k3_nerface)
+RUNS=(id1_k3_icef id1_k3_icef-no-conf id1_k3_icef-uniform id1_k3_warp id1_k3_nerface)
 
 start=$SECONDS
 "$ICEF" bench --quick --out "$WORK/a" --shard 0/2 --threads 2 > "$WORK/a.txt" || fail "shard 0/2 exited $?"
@@ -16,8 +16,8 @@ start=$SECONDS
 echo "two shards: $((SECONDS - start)) s"
 grep -q "bench: 3 runs in shard 0/2 (0 already done)" "$WORK/a.txt" || fail "shard 0/2 plan: $(head -1 "$WORK/a.txt")"
 grep -q "bench: 2 runs in shard 1/2 (0 already done)" "$WORK/b.txt" || fail "shard 1/2 plan: $(head -1 "$WORK/b.txt")"
-for r in id1_k3_icef id1_k3_icef-no-conf id1_k3_nerface; do test -s "$WORK/a/runs/$r/metrics.json" || fail "a: $r"; done
-for r in id1_k3_icef-no-id id1_k3_warp; do test -s "$WORK/b/runs/$r/metrics.json" || fail "b: $r"; done
+for r in id1_k3_icef id1_k3_icef-uniform id1_k3_nerface; do test -s "$WORK/a/runs/$r/metrics.json" || fail "a: $r"; done
+for r in id1_k3_icef-no-conf id1_k3_warp; do test -s "$WORK/b/runs/$r/metrics.json" || fail "b: $r"; done
 test ! -e "$WORK/a/runs/id1_k3_icef/model" || fail "model kept without --keep-models"
 grep -q "Shard 0/2 only" "$WORK/a/report.md" || fail "shard report lacks the shard note"
 
@@ -26,26 +26,37 @@ cat "$WORK/m.txt"
 for r in "${RUNS[@]}"; do test -s "$WORK/m/runs/$r/metrics.json" || fail "merged: $r"; done
 grep -q "bench merge: 5 runs" "$WORK/m.txt" || fail "merge count"
 R="$WORK/m/report.md"
-grep -q "## Verdict (far tier, computed)" "$R" || fail "no verdict"
-grep -Eq "\*\*Identity similarity\*\* \(id_distance.*K=3 vs warp: (better|not better)" "$R" || fail "no identity verdict"
-grep -Eq "\*\*PSNR\*\* .*K=3 vs nerface: (better|not better)" "$R" || fail "no PSNR verdict"
+grep -q "## Verdict (computed)" "$R" || fail "no verdict"
+grep -q "a method is better than another in a tier only where it reproduces at least 10% of the expression" "$R" \
+  || fail "no verdict rule"
+outcome="(better|under-expresses|not better on identity|not better on PSNR)"
+grep -Eq "\*\*far tier, icef vs the baselines\*\*: .*K=3 vs warp: $outcome" "$R" || fail "no far-tier verdict vs warp"
+grep -Eq "\*\*far tier, icef vs the baselines\*\*: .*K=3 vs nerface: $outcome" "$R" || fail "no far-tier verdict vs nerface"
+grep -q "\*\*Expression reproduced, K=3\*\*" "$R" || fail "no expression line"
+grep -q "tiers by delta: observed = 0, near (0, 0.35]" "$R" || fail "no tier thresholds"
+grep -q "identities (seeds): 1 (test identities" "$R" || fail "identities not named as test identities"
 grep -q "FDNeRF and NeRFFaceEditing proper are not available" "$R" || fail "no stand-in caveat"
 grep -q "^| far | \`icef\` | 1 |" "$R" || fail "no far-tier icef row"
-[ "$(grep -c '^| observed | ' "$R")" = 5 ] || fail "expected 5 observed rows"
+[ "$(grep -c '^| observed | ' "$R")" = 10 ] || fail "expected 10 observed rows (5 methods, 2 tables)"
 python3 - "$WORK/m/report.json" <<'PY' || fail "report.json"
 import json, sys
 r = json.load(open(sys.argv[1]))
 assert r["ks"] == [3] and r["identities"] == [1], (r["ks"], r["identities"])
-assert r["methods"] == ["icef", "icef-no-id", "icef-no-conf", "warp", "nerface"], r["methods"]
+assert r["methods"] == ["icef", "icef-no-conf", "icef-uniform", "warp", "nerface"], r["methods"]
 assert len(r["runs"]) == 5 and len(r["aggregate"]) == 5 * 4
 for c in r["aggregate"]:
     if c["runs"] > 0:
         assert c["psnr"]["n"] == 1 and c["psnr"]["std"] == 0
 assert any(c["metric"] == "id_distance" and c["other"] == "warp" for c in r["far_comparisons"])
-assert len(r["verdict"]) == 3
+assert len(r["verdict"]) >= 3, r["verdict"]
+assert {v["other"] for v in r["pair_verdicts"]} == {"icef-no-conf", "icef-uniform", "warp", "nerface"}
+assert r["tier_thresholds"] == [0.35, 0.8]
+far = [c for c in r["aggregate"] if c["tier"] == "far" and c["method"] == "icef"][0]
+for k in ["expr_gain", "expr_corr", "region_psnr", "psnr_neutral_floor", "id_distance_gt"]:
+    assert far[k] is not None, k
 PY
 if command -v gnuplot > /dev/null; then
-  for p in psnr ssim id_distance id_cosine; do
+  for p in psnr ssim expr_gain region_psnr id_distance id_cosine; do
     test -s "$WORK/m/plots/$p.png" || fail "no $p.png"
     test -s "$WORK/m/plots/$p.svg" || fail "no $p.svg"
   done
@@ -68,4 +79,9 @@ if "$ICEF" bench --out "$WORK/x" --shard 2/2 2> "$WORK/err.txt"; then fail "bad 
 grep -q "shard" "$WORK/err.txt" || fail "unclear shard error"
 if "$ICEF" bench --out "$WORK/x" --methods icef,fdnerf 2> "$WORK/err.txt"; then fail "unknown method accepted"; fi
 grep -q "fdnerf" "$WORK/err.txt" || fail "unclear method error"
+# Validation seeds (101 and up) only with --validation, and --validation only with them.
+if "$ICEF" bench --out "$WORK/x" --first-seed 101 2> "$WORK/err.txt"; then fail "validation seed in a test bench"; fi
+grep -q "validation identities" "$WORK/err.txt" || fail "unclear seed error: $(cat "$WORK/err.txt")"
+if "$ICEF" bench --out "$WORK/x" --validation --first-seed 3 2> "$WORK/err.txt"; then fail "test seed in a validation bench"; fi
+grep -q "validation seeds" "$WORK/err.txt" || fail "unclear validation error: $(cat "$WORK/err.txt")"
 echo "bench_quick_test: OK ($((SECONDS - start)) s)"

@@ -38,8 +38,11 @@ m = json.load(open(sys.argv[1]))
 assert m["method"] == "icef"
 assert len(m["frames"]) == 6
 for f in m["frames"]:
-    for k in ["file_path", "tier", "delta", "psnr", "ssim", "lpips", "id_cosine", "id_distance", "id_distance_gt"]:
+    for k in ["file_path", "tier", "delta", "psnr", "ssim", "lpips", "id_cosine", "id_distance", "id_distance_gt",
+              "id_distance_reference", "id_excess", "expr_gain", "expr_corr", "expr_true_rms", "region_psnr",
+              "psnr_neutral_floor"]:
         assert k in f, k
+    assert isinstance(f["region_psnr"], float) and isinstance(f["psnr_neutral_floor"], float)
     assert f["lpips"] is None
     assert isinstance(f["psnr"], float) and isinstance(f["ssim"], float)
     if m["identity_available"]:
@@ -47,13 +50,33 @@ for f in m["frames"]:
 counts = {t: m["tiers"][t]["count"] for t in ["observed", "near", "moderate", "far"]}
 assert counts == {"observed": 3, "near": 1, "moderate": 1, "far": 1}, counts
 for t, v in m["tiers"].items():
-    for k in ["count", "psnr", "ssim", "lpips", "id_cosine", "id_distance", "id_distance_gt", "id_share_under_0_6"]:
+    for k in ["count", "psnr", "ssim", "lpips", "id_cosine", "id_distance", "id_distance_gt", "id_share_under_0_6",
+              "id_excess", "expr_gain", "expr_corr", "region_psnr", "psnr_neutral_floor", "expr_count",
+              "expr_negligible"]:
         assert k in v, (t, k)
+    assert v["expr_count"] + v["expr_negligible"] == v["count"], (t, v)
     frames = [f for f in m["frames"] if f["tier"] == t]
     assert abs(v["psnr"] - sum(f["psnr"] for f in frames) / len(frames)) < 1e-9
     assert v["lpips"] is None
 print("metrics.json ok; identity available:", m["identity_available"])
 PY
+
+# A model that renders no expression (--expression-scale 0): expr_gain exactly 0 wherever measured.
+"$ICEF" eval "$WORK/model" "$WORK/data" --out "$WORK/still" --expression-scale 0 --threads 2 > "$WORK/still.txt" \
+  || fail "icef eval --expression-scale 0 exited $?"
+grep -q "every frame rendered at 0 x its expression" "$WORK/still.txt" || fail "no expression-scale line"
+python3 - "$WORK/still/metrics.json" <<'PY' || fail "--expression-scale 0 did not give expr_gain 0"
+import json, sys
+m = json.load(open(sys.argv[1]))
+assert m["expression_scale"] == 0
+gains = [f["expr_gain"] for f in m["frames"] if f["expr_gain"] is not None]
+assert gains and all(g == 0 for g in gains), gains
+print("still model: expr_gain 0 on", len(gains), "frames")
+PY
+if "$ICEF" eval "$WORK/model" "$WORK/data" --out "$WORK/e4" --expression-scale nan 2> "$WORK/err.txt"; then
+  fail "--expression-scale nan accepted"
+fi
+grep -q "expression" "$WORK/err.txt" || fail "NaN scale error does not name the option: $(cat "$WORK/err.txt")"
 
 # Errors: a missing model, an unreadable LPIPS weights file.
 if "$ICEF" eval "$WORK/none" "$WORK/data" --out "$WORK/e2" 2> "$WORK/err.txt"; then fail "missing model accepted"; fi

@@ -19,7 +19,7 @@ grep -q "face-identity model not found" "$TMP/err" || fail "unclear missing-mode
 
 MODEL="${ICEF_FACEID_MODEL:-/usr/local/share/icef/face-api}"
 for f in "$MODEL/face_recognition_model.bin" /usr/share/dlib/shape_predictor_68_face_landmarks.dat "${PHOTOS[@]}"; do
-  if [ ! -f "$f" ]; then echo "SKIP: $f not installed (run scripts/install-deps.sh)"; exit 0; fi
+  if [ ! -f "$f" ]; then echo "SKIP: $f not installed (run scripts/install-deps.sh)"; exit 77; fi
 done
 
 "$ICEF" faceid "${PHOTOS[@]}" >"$TMP/out.txt" || fail "faceid exited $?"

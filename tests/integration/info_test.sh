@@ -75,6 +75,8 @@ expect_error() {  # expect_error NAME EXPECTED-SUBSTRING EDIT-COMMAND...
   echo "ok: $name: $(cat "$WORK/$name.err")"
 }
 
+expect_error empty_train "transforms_train.json: frames: the train split has no frames" \
+  python3 -c 'import json; d = json.load(open("transforms_train.json")); d["frames"] = []; json.dump(d, open("transforms_train.json", "w"))'
 expect_error missing_image "transforms_train.json: frames[1].file_path: image not found" \
   rm images/train_1.png
 expect_error non_rigid "transforms_train.json: frames[0].transform_matrix: rotation is not orthonormal" \

@@ -13,7 +13,7 @@ fail() { echo "FAIL: $*" >&2; exit 1; }
 
 if [ ! -f /usr/share/dlib/shape_predictor_68_face_landmarks.dat ]; then
   echo "SKIP: dlib's shape predictor not installed (Debian libdlib-data; run scripts/install-deps.sh)"
-  exit 0
+  exit 77
 fi
 
 D="$TMP/head"

@@ -1,30 +1,77 @@
 #!/usr/bin/env bash
-# The README's benchmark summary quotes numbers; none may be typed by hand. Every decimal number
-# between the README's bench-results markers must appear in the report it links
-# (docs/results/bench/report.md, written by `icef bench`). Usage: readme_numbers_test.sh [ICEF]
+# The README's benchmark summary quotes numbers; none may be typed by hand.
+#
+# Bench: the section between <!-- bench-results:begin REPORT --> and <!-- bench-results:end -->
+# names the report.json it summarises. Its tables have columns K, tier, method and then metric
+# keys of report.json (psnr, expr_gain, id_distance_gt, ...); every cell "mean" or "mean ± std" must
+# equal that (K, method, tier) cell of the report's aggregate, rounded to the decimals shown. A
+# decimal number anywhere else in the section is an error: numbers live in checked tables.
+# Training curve: every row "| step | seconds | PSNR |" between the train-curve markers must be a
+# line of docs/results/train_k5_128_icef.jsonl (seconds to 0 and PSNR to 2 decimals).
+# Usage: readme_numbers_test.sh [ICEF]
 set -euo pipefail
 root="$(cd "$(dirname "$0")/../.." && pwd)"
 readme="$root/README.md"
-report="$root/docs/results/bench/report.md"
-section=$(sed -n '/<!-- bench-results:begin -->/,/<!-- bench-results:end -->/p' "$readme")
-if [ -z "$section" ]; then
-  echo "readme_numbers_test: README.md has no bench-results section" >&2
-  exit 1
-fi
-grep -q "docs/results/bench/report.md" <<<"$section" || { echo "readme_numbers_test: section does not link the report" >&2; exit 1; }
-[ -f "$report" ] || { echo "readme_numbers_test: $report missing" >&2; exit 1; }
-missing=0
-for n in $(grep -o -E '[0-9]+\.[0-9]+' <<<"$section" | sort -u); do
-  if ! grep -q -F -- "$n" "$report"; then
-    echo "readme_numbers_test: README quotes $n, which docs/results/bench/report.md does not contain" >&2
-    missing=1
-  fi
-done
-[ $missing -eq 0 ] && echo "readme_numbers_test: every number of the README's bench summary is in the report"
 
-# The README's training curve: every row "| step | seconds | PSNR |" between the train-curve markers
-# must be a line of docs/results/train_k5_128_icef.jsonl (seconds to 0 and PSNR to 2 decimals).
+python3 - "$root" "$readme" <<'PY'
+import json, re, sys
+root, readme = sys.argv[1], open(sys.argv[2]).read()
+m = re.search(r"<!-- bench-results:begin (\S+) -->(.*?)<!-- bench-results:end -->", readme, re.S)
+if not m:
+    sys.exit("readme_numbers_test: README.md has no '<!-- bench-results:begin REPORT.json -->' section")
+report_path, section = m.group(1), m.group(2)
+report = json.load(open(f"{root}/{report_path}"))
+if report_path.replace("report.json", "report.md") not in section:
+    sys.exit(f"readme_numbers_test: the section does not link {report_path.replace('report.json', 'report.md')}")
+cells = {(c["k"], c["method"], c["tier"]): c for c in report["aggregate"]}
+
+def decimals(text):
+    return len(text.split(".")[1]) if "." in text else 0
+
+errors, checked, header = [], 0, None
+outside = []
+for line in section.splitlines():
+    s = line.strip()
+    if not s.startswith("|"):
+        outside.append(line)
+        continue
+    cols = [c.strip() for c in s.strip("|").split("|")]
+    if cols[:3] == ["K", "tier", "method"]:
+        header = cols
+        continue
+    if header is None or set(s) <= set("|-: "):
+        continue
+    k, tier, method = int(cols[0]), cols[1], cols[2].strip("`")
+    cell = cells.get((k, method, tier))
+    if cell is None:
+        errors.append(f"row K={k} {tier} {method}: no such cell in {report_path}")
+        continue
+    for key, text in zip(header[3:], cols[3:]):
+        spread = cell.get(key)
+        nums = re.findall(r"[-+]?\d+\.\d+|[-+]?\d+", text)
+        if spread is None or not nums:
+            errors.append(f"row K={k} {tier} {method}: {key} '{text}' has no value in the report")
+            continue
+        for value, name in zip(nums, ["mean", "std"]):
+            want = f"{spread[name]:.{decimals(value)}f}"
+            if float(value) != float(want):
+                errors.append(f"row K={k} {tier} {method}: {key} {name} is {value} in the README, {want} in the report")
+            checked += 1
+for line in outside:
+    for n in re.findall(r"\d+\.\d+", line):
+        errors.append(f"a number outside the checked tables: {n} in '{line.strip()}'")
+for e in errors:
+    print("readme_numbers_test:", e, file=sys.stderr)
+if errors:
+    sys.exit(1)
+if checked < 10:
+    sys.exit(f"readme_numbers_test: only {checked} numbers checked: is the table there?")
+print(f"readme_numbers_test: {checked} numbers of the README's bench summary match {report_path} cell by cell")
+PY
+
+# The README's training curve.
 log="$root/docs/results/train_k5_128_icef.jsonl"
+missing=0
 rows=$(sed -n '/<!-- train-curve:begin -->/,/<!-- train-curve:end -->/p' "$readme" | grep -E '^ *\| [0-9]+ \|' || true)
 if [ -z "$rows" ]; then
   echo "readme_numbers_test: README.md has no train-curve rows" >&2

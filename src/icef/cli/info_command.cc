@@ -26,6 +26,9 @@ CommandFn RegisterInfo(CLI::App& app) {
   app.add_flag("--json", args->json, "Print the summary as JSON instead of text");
   return [args]() -> Status {
     ICEF_ASSIGN_OR_RETURN(const Dataset dataset, LoadDataset(args->dir));
+    if (dataset.train.empty())
+      return Status::Error((dataset.root / "transforms_train.json").string() +
+                           ": frames: the train split has no frames (a dataset needs at least one training frame)");
     const DatasetSummary summary = SummarizeDataset(dataset, Executor());
     std::cout << (args->json ? FormatJson(summary.ToJson()) : summary.ToString());
     return Status::Ok();
