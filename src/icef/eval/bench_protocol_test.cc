@@ -94,6 +94,34 @@ TEST(BenchProtocolTest, ValidatesOptions) {
   EXPECT_EQ(quick.resolution, 32);
 }
 
+// Test identities (seeds below 101) are reported, validation identities (101 and up) tuned on;
+// neither kind of bench accepts the other's seeds.
+TEST(BenchProtocolTest, TestAndValidationSeedsNeverMix) {
+  BenchOptions o;
+  o.out_dir = "x";
+  o.identities = 100;
+  EXPECT_TRUE(o.Validate().ok());  // seeds 1..100
+  o.identities = 101;
+  const Status overlap = o.Validate();
+  ASSERT_FALSE(overlap.ok());
+  EXPECT_NE(overlap.message().find("seeds 101 and up are validation identities"), std::string::npos)
+      << overlap.message();
+  BenchOptions v;
+  v.out_dir = "x";
+  v.ApplyValidation();
+  EXPECT_TRUE(v.Validate().ok());
+  EXPECT_EQ(v.identities, kDefaultValidationIdentities);
+  EXPECT_EQ(v.ks, std::vector<int>({5}));
+  const std::vector<RunId> runs = PlanRuns(v);
+  EXPECT_EQ(runs.front().identity_seed, kFirstValidationSeed);
+  EXPECT_EQ(runs.back().identity_seed, kFirstValidationSeed + kDefaultValidationIdentities - 1);
+  EXPECT_NE(v.IdentityRole().find("validation"), std::string::npos);
+  EXPECT_NE(o.IdentityRole().find("test identities"), std::string::npos);
+  v.first_identity_seed = 100;
+  EXPECT_FALSE(v.Validate().ok());
+  EXPECT_TRUE(v.ToJson()["validation"].get<bool>());
+}
+
 // Merging two shard directories: runs are unioned; the same run in both must be identical.
 TEST(BenchProtocolTest, MergesShardDirectories) {
   const fs::path dir = TempDir("merge");

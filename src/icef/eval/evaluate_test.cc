@@ -6,6 +6,7 @@
 
 #include "icef/eval/expression_fidelity.h"
 #include "icef/eval/metrics.h"
+#include "icef/eval/report.h"
 #include "icef/io/atomic_file.h"
 #include "icef/model/render_image.h"
 #include "icef/synth/synthesize.h"
@@ -231,6 +232,16 @@ TEST(EvaluateTest, EvaluatesTinyTrainedModel) {
   ASSERT_TRUE(reread.ok()) << reread.status().message();
   EXPECT_EQ(reread->ToJson(), zero->ToJson());
   EXPECT_NE(zero->Table().find("every frame rendered at 0 x its expression"), std::string::npos);
+  // ... and in the bench verdict it never beats the real model (here labelled as a baseline).
+  RunRecord real_run, still_run;
+  real_run.id = RunId{1, 3, "icef"};
+  real_run.metrics = *result;
+  still_run.id = RunId{1, 3, "warp"};
+  still_run.metrics = *zero;
+  still_run.metrics.method = "warp";
+  const Aggregate aggregate = AggregateRuns({real_run, still_run});
+  for (Tier tier : {Tier::kNear, Tier::kModerate, Tier::kFar})
+    EXPECT_EQ(ComparePair(aggregate, 3, tier, "warp", "icef").outcome, Outcome::kUnderExpresses) << TierName(tier);
 
   // Frames without a stored tier get it from their delta and the dataset's thresholds.
   Dataset untiered = *dataset;
