@@ -24,7 +24,7 @@ struct TrainConfig {
   double lambda_id = 1.0;            // weight of L_id (identity preservation outside the expression regions)
   double lambda_smooth = 1e-4;       // weight of L_smooth (deformation smoothness at the region boundary)
   double lambda_mask = 0.1;          // weight of the alpha-mask loss (images with alpha only)
-  double lambda_distortion = 0.35;   // weight of the mip-NeRF 360 distortion loss (0 = off)
+  double lambda_distortion = 0.035;  // weight of the mip-NeRF 360 distortion loss (0 = off)
   double smooth_epsilon = 0.01;      // finite-difference offset of L_smooth (half-extent units)
   int smooth_max_samples = 4096;     // boundary samples per step used by L_smooth
   double lambda_occlusion = 1e-4;    // weight of the occlusion sparsity prior (0 = off)

@@ -1,0 +1,80 @@
+// What `icef render` / `icef eval` cost per image: a 128x128 frame (the default 2x2 supersampling)
+// of a model trained with the default config on the synthetic K = 5 subject of identity seed 1,
+// at a far expression, with the occupancy grid built for that expression (the default) and with
+// the training grid; and building that grid alone. The model is trained once per process (300
+// steps, about half a minute on 2 cores), so the first benchmark that needs it pays for it.
+#include <benchmark/benchmark.h>
+
+#include <filesystem>
+#include <memory>
+#include <unistd.h>
+
+#include "icef/model/render_image.h"
+#include "icef/synth/synthesize.h"
+#include "icef/train/trainer.h"
+
+namespace {
+
+struct Subject {
+  icef::Dataset dataset;
+  std::unique_ptr<icef::Trainer> trainer;
+  std::string error;
+};
+
+icef::Status Train(Subject* s) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("icef_render_bench_" + std::to_string(::getpid()));
+  icef::synth::SynthOptions so;
+  so.out_dir = dir / "data";
+  ICEF_RETURN_IF_ERROR(icef::synth::SynthesizeDataset(so, icef::Executor(2)));
+  ICEF_ASSIGN_OR_RETURN(s->dataset, icef::LoadDataset(so.out_dir));
+  icef::RunConfig config;
+  config.train.steps = 300;
+  config.train.threads = 2;
+  config.train.checkpoint_every = 0;
+  ICEF_ASSIGN_OR_RETURN(s->trainer, icef::Trainer::Create(s->dataset, dir / "model", config));
+  return s->trainer->Run(nullptr, nullptr).status();
+}
+
+const Subject& TrainedSubject() {
+  static Subject subject;
+  static const bool done = [] {
+    if (icef::Status st = Train(&subject); !st.ok()) subject.error = st.message();
+    return true;
+  }();
+  (void)done;
+  return subject;
+}
+
+// The first far-tier test frame of the subject.
+const icef::Frame& FarFrame(const Subject& s) {
+  for (const icef::Frame& f : s.dataset.test)
+    if (f.tier == icef::Tier::kFar) return f;
+  return s.dataset.test.back();
+}
+
+// Arg: 0 = the grid of the rendered expression (default), 1 = the training grid.
+void BM_RenderImage128(benchmark::State& state) {
+  const Subject& s = TrainedSubject();
+  if (!s.error.empty()) return state.SkipWithError(s.error.c_str());
+  const icef::Frame& frame = FarFrame(s);
+  const icef::Executor executor(2);
+  const auto mode = state.range(0) == 0 ? icef::RenderOccupancyMode::kExpression : icef::RenderOccupancyMode::kTraining;
+  for (auto _ : state)
+    benchmark::DoNotOptimize(
+        icef::RenderImage(s.trainer->model(), frame.camera, frame.expression, s.dataset.background, executor, mode));
+  state.counters["frames/s"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_RenderImage128)->ArgName("training_grid")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// AvatarModel::RenderOccupancy alone: one density query per 2x2x2 cells through the warp.
+void BM_RenderOccupancy(benchmark::State& state) {
+  const Subject& s = TrainedSubject();
+  if (!s.error.empty()) return state.SkipWithError(s.error.c_str());
+  const icef::Frame& frame = FarFrame(s);
+  const icef::Executor executor(2);
+  for (auto _ : state) benchmark::DoNotOptimize(s.trainer->model().RenderOccupancy(frame.expression, executor));
+}
+BENCHMARK(BM_RenderOccupancy)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
