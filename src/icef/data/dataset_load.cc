@@ -130,6 +130,19 @@ Result<std::pair<std::string, ImageInfo>> CheckImage(const JsonObjectView& obj, 
   return std::pair{*resolved, *info};
 }
 
+// The 68 landmarks under `key`: 2D (Vec2f) or 3D (Vec3f) points.
+template <typename Point>
+Result<std::vector<Point>> Landmarks(const JsonObjectView& f, const char* key) {
+  ICEF_ASSIGN_OR_RETURN(const auto rows, f.NumberMatrix(key, kNumLandmarks, Point::RowsAtCompileTime));
+  std::vector<Point> points;
+  for (const auto& row : rows) {
+    Point p;
+    for (int a = 0; a < Point::RowsAtCompileTime; ++a) p[a] = static_cast<float>(row[a]);
+    points.push_back(p);
+  }
+  return points;
+}
+
 Result<ParsedFrame> ParseFrame(const JsonObjectView& f, int expression_dim) {
   ParsedFrame p;
   Frame& frame = p.frame;
@@ -151,29 +164,20 @@ Result<ParsedFrame> ParseFrame(const JsonObjectView& f, int expression_dim) {
   }
 
   if (f.Has("landmarks_2d")) {
-    ICEF_ASSIGN_OR_RETURN(const auto l, f.NumberMatrix("landmarks_2d", kNumLandmarks, 2));
-    frame.landmarks_2d.emplace();
-    for (const auto& xy : l) frame.landmarks_2d->push_back(Vec2f(float(xy[0]), float(xy[1])));
+    ICEF_ASSIGN_OR_RETURN(frame.landmarks_2d, Landmarks<Vec2f>(f, "landmarks_2d"));
   }
   if (f.Has("landmarks_2d_visible")) {
     if (!frame.landmarks_2d) return f.Error("landmarks_2d_visible", "given without landmarks_2d");
     ICEF_ASSIGN_OR_RETURN(frame.landmarks_2d_visible, f.BoolArray("landmarks_2d_visible", kNumLandmarks));
   }
   if (f.Has("landmarks_3d")) {
-    ICEF_ASSIGN_OR_RETURN(const auto l, f.NumberMatrix("landmarks_3d", kNumLandmarks, 3));
-    frame.landmarks_3d.emplace();
-    for (const auto& xyz : l) frame.landmarks_3d->push_back(Vec3f(float(xyz[0]), float(xyz[1]), float(xyz[2])));
+    ICEF_ASSIGN_OR_RETURN(frame.landmarks_3d, Landmarks<Vec3f>(f, "landmarks_3d"));
   }
   if (f.Has("neutral_landmarks_2d")) {
-    ICEF_ASSIGN_OR_RETURN(const auto l, f.NumberMatrix("neutral_landmarks_2d", kNumLandmarks, 2));
-    frame.neutral_landmarks_2d.emplace();
-    for (const auto& xy : l) frame.neutral_landmarks_2d->push_back(Vec2f(float(xy[0]), float(xy[1])));
+    ICEF_ASSIGN_OR_RETURN(frame.neutral_landmarks_2d, Landmarks<Vec2f>(f, "neutral_landmarks_2d"));
   }
   if (f.Has("neutral_landmarks_3d")) {
-    ICEF_ASSIGN_OR_RETURN(const auto l, f.NumberMatrix("neutral_landmarks_3d", kNumLandmarks, 3));
-    frame.neutral_landmarks_3d.emplace();
-    for (const auto& xyz : l)
-      frame.neutral_landmarks_3d->push_back(Vec3f(float(xyz[0]), float(xyz[1]), float(xyz[2])));
+    ICEF_ASSIGN_OR_RETURN(frame.neutral_landmarks_3d, Landmarks<Vec3f>(f, "neutral_landmarks_3d"));
   }
   if (f.Has("delta")) {
     ICEF_ASSIGN_OR_RETURN(const double delta, f.Number("delta"));

@@ -29,6 +29,14 @@ Json FloatArray(const float* values, int n) {
   return a;
 }
 
+// [[x, y(, z)] ...] of 2D or 3D points.
+template <typename Point>
+Json PointArray(const std::vector<Point>& points) {
+  Json l = Json::array();
+  for (const Point& p : points) l.push_back(FloatArray(p.data(), static_cast<int>(p.size())));
+  return l;
+}
+
 // Checks what the loader would reject, so that a saved dataset always loads back.
 Status CheckFrame(const Dataset& d, const Frame& f, const std::string& where) {
   if (f.file_path.empty()) return Status::Error(where + ".file_path: empty");
@@ -63,34 +71,18 @@ Json FrameToJson(const Frame& f, const std::optional<Intrinsics>& global) {
   j["transform_matrix"] = m;
   if (!global || !SameIntrinsics(*global, f.camera.intrinsics())) PutIntrinsics(f.camera.intrinsics(), j);
   if (!f.expression.empty()) j["expression"] = FloatArray(f.expression.data(), int(f.expression.size()));
-  if (f.landmarks_2d) {
-    Json l = Json::array();
-    for (const Vec2f& p : *f.landmarks_2d) l.push_back(FloatArray(p.data(), 2));
-    j["landmarks_2d"] = l;
-  }
+  if (f.landmarks_2d) j["landmarks_2d"] = PointArray(*f.landmarks_2d);
   if (f.landmarks_2d_visible) {
     Json v = Json::array();
     for (bool b : *f.landmarks_2d_visible) v.push_back(b);
     j["landmarks_2d_visible"] = v;
   }
-  if (f.landmarks_3d) {
-    Json l = Json::array();
-    for (const Vec3f& p : *f.landmarks_3d) l.push_back(FloatArray(p.data(), 3));
-    j["landmarks_3d"] = l;
-  }
+  if (f.landmarks_3d) j["landmarks_3d"] = PointArray(*f.landmarks_3d);
   if (f.delta) j["delta"] = *f.delta;
   if (f.tier) j["tier"] = TierName(*f.tier);
   if (f.neutral_file_path) j["neutral_file_path"] = *f.neutral_file_path;
-  if (f.neutral_landmarks_2d) {
-    Json l = Json::array();
-    for (const Vec2f& p : *f.neutral_landmarks_2d) l.push_back(FloatArray(p.data(), 2));
-    j["neutral_landmarks_2d"] = l;
-  }
-  if (f.neutral_landmarks_3d) {
-    Json l = Json::array();
-    for (const Vec3f& p : *f.neutral_landmarks_3d) l.push_back(FloatArray(p.data(), 3));
-    j["neutral_landmarks_3d"] = l;
-  }
+  if (f.neutral_landmarks_2d) j["neutral_landmarks_2d"] = PointArray(*f.neutral_landmarks_2d);
+  if (f.neutral_landmarks_3d) j["neutral_landmarks_3d"] = PointArray(*f.neutral_landmarks_3d);
   if (f.bbox) j["bbox"] = FloatArray(f.bbox->data(), 4);
   return j;
 }
