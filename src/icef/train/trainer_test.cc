@@ -161,6 +161,23 @@ TEST(TrainerTest, SameSeedSameNumbersDifferentSeedDifferent) {
   EXPECT_FALSE(bytes[0] == bytes[2]);
 }
 
+// warp and icef-no-id differ only in confidence, which acts at render time: they train the same
+// model bit for bit, which is why the bench runs only warp (model/method.h).
+TEST(TrainerTest, WarpAndIcefNoIdTrainTheSameModel) {
+  const Dataset& dataset = TinySubject();
+  std::string bytes[2];
+  int i = 0;
+  for (const char* method : {"warp", "icef-no-id"}) {
+    RunConfig config = SmallConfig(method);
+    config.train.steps = 12;
+    auto t = Trainer::Create(dataset, testing::MakeTempDir(std::string("trainer_same_") + method), config);
+    ASSERT_TRUE(t.ok());
+    ASSERT_TRUE((*t)->Run(nullptr, nullptr).ok());
+    bytes[i++] = ParamBytes((*t)->model());
+  }
+  EXPECT_TRUE(bytes[0] == bytes[1]);
+}
+
 TEST(TrainerTest, EveryMethodTrainsAndWritesItsModelDirectory) {
   const Dataset& dataset = TinySubject();
   for (Method m : AllMethods()) {
