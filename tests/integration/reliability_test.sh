@@ -18,7 +18,10 @@ failures=0
 fail() { echo "FAIL: $*" >&2; failures=$((failures + 1)); }
 
 # Whether this build's CLI has a subcommand (the integrator adds train/render later).
-has_command() { "$ICEF" --help 2>/dev/null | grep -qE "^ +$1( |$)"; }
+# The help text is read once: piping `icef --help` into `grep -q` lets grep exit at the first match,
+# and under pipefail the SIGPIPE that icef may then get made the check fail at random.
+ICEF_HELP=$("$ICEF" --help 2>/dev/null || true)
+has_command() { grep -qE "^ +$1( |$)" <<<"$ICEF_HELP"; }
 
 # Shared fixtures, made on first use: a synthetic dataset and a tiny trained model.
 SYNTH=$WORK/fixtures/synth
