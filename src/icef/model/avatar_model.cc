@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "icef/core/rng.h"
+#include "icef/model/face_prior.h"
 #include "icef/model/identity_losses.h"
 #include "icef/model/symmetry_loss.h"
 #include "icef/render/distortion_loss.h"
@@ -14,12 +15,13 @@ namespace icef {
 
 struct ModelWorkspace {
   RaySamples samples;
-  std::vector<float> dirs, betas, offsets, canonical, sigma, rgb, d_sigma, d_rgb, d_canonical, mask_values;
-  std::vector<float> lin_offsets, anchors, tangents;
+  std::vector<float> dirs, betas, offsets, residual, canonical, sigma, rgb, d_sigma, d_rgb, d_canonical, mask_values;
+  std::vector<uint8_t> cavity;
   CompositeOutputs<float> composite;
   std::vector<float> d_color, d_opacity, d_weights;
   StaticFieldContext static_ctx;
   DeformationContext deform_ctx;
+  DeformationWorkspace warp_ws;
   // L_smooth: 2m points (x_i, then x_i + delta_i).
   std::vector<float> smooth_positions, smooth_betas, smooth_offsets, smooth_d_offsets, smooth_weight;
   std::vector<int64_t> smooth_index;
@@ -35,6 +37,29 @@ namespace {
 template <typename V>
 void Fit(V& v, size_t size) {
   v.resize(size);
+}
+
+// The face model's open-mouth interior (DESIGN.md §2.1): an absorbing dark volume. Its density
+// makes a cavity sample opaque within about a hundredth of the aabb; its colour is a dark red-brown
+// mouth interior. Neither is learned: no training frame needs to show an open mouth.
+constexpr float kCavityDensity = 400.f;
+constexpr float kCavityColor[3] = {0.12f, 0.04f, 0.04f};
+
+// Samples inside the cavity take its density and colour; their gradients are dropped (the static
+// field did not produce them).
+void ApplyCavity(int64_t n, const uint8_t* inside, float* sigma, float* rgb) {
+  for (int64_t i = 0; i < n; ++i) {
+    if (!inside[i]) continue;
+    sigma[i] = kCavityDensity;
+    for (int a = 0; a < 3; ++a) rgb[3 * i + a] = kCavityColor[a];
+  }
+}
+void DropCavityGradients(int64_t n, const uint8_t* inside, float* d_sigma, float* d_rgb) {
+  for (int64_t i = 0; i < n; ++i) {
+    if (!inside[i]) continue;
+    d_sigma[i] = 0.f;
+    for (int a = 0; a < 3; ++a) d_rgb[3 * i + a] = 0.f;
+  }
 }
 }  // namespace
 
@@ -68,7 +93,8 @@ AvatarModel::AvatarModel(const ModelConfig& config, const ModelSetup& setup, Reg
 AvatarModel::~AvatarModel() = default;
 
 Result<std::unique_ptr<AvatarModel>> AvatarModel::Create(const ModelConfig& config, const ModelSetup& setup,
-                                                     const Executor& executor) {
+                                                     const Executor& executor,
+                                                     std::unique_ptr<DeformationPrior> prior) {
   ICEF_RETURN_IF_ERROR(config.Validate().WithContext("model config"));
   if (!setup.aabb.IsValid()) return Status::Error("model setup: invalid aabb " + setup.aabb.ToString());
   if (setup.expression_dim < 1) return Status::Error("model setup: expression_dim must be >= 1");
@@ -83,15 +109,28 @@ Result<std::unique_ptr<AvatarModel>> AvatarModel::Create(const ModelConfig& conf
   model->static_field_ = std::make_unique<StaticField>(config.StaticOptions(setup.expression_dim), setup.aabb,
                                                        &model->store_, "static", kGridGroup, kMlpGroup);
   if (model->traits_.deformation) {
-    model->deformation_ = std::make_unique<DeformationField>(config.DeformationOptions(), setup.expression_dim,
-                                                             setup.aabb, &model->store_, "deformation", kDeformGroup);
+    model->residual_field_ = std::make_unique<DeformationField>(
+        config.DeformationOptions(), setup.expression_dim, setup.aabb, &model->store_, "deformation", kDeformGroup);
+  }
+  if (model->traits_.prior) {
+    if (prior) {
+      if (prior->expression_dims() != setup.expression_dim)
+        return Status::Error("model setup: the prior's expression_dim differs from the setup's");
+      model->prior_ = std::move(prior);
+    } else {
+      ICEF_ASSIGN_OR_RETURN(model->prior_, MakeFacePrior(setup));
+    }
+  }
+  if (model->residual_field_ || model->prior_) {
+    model->warp_ = std::make_unique<Deformation>(model->residual_field_.get(), model->prior_.get(),
+                                                 &model->confidence_, model->traits_.confidence);
   }
   return model;
 }
 
 void AvatarModel::Initialize(uint64_t seed) {
   static_field_->Initialize(Mix64(seed ^ StreamId("static_field")));
-  if (deformation_) deformation_->Initialize(Mix64(seed ^ StreamId("deformation_field")));
+  if (residual_field_) residual_field_->Initialize(Mix64(seed ^ StreamId("deformation_field")));
   occupancy_.Fill(true);
 }
 
@@ -103,64 +142,39 @@ void AvatarModel::QueryStatic(const Executor& executor, int64_t n, const float* 
   static_field_->Forward(executor, n, canonical, directions, condition, sigma, rgb, &ctx, false, false);
 }
 
-void AvatarModel::OffsetsPhi(const Executor& executor, int64_t n, const float* positions,
-                           std::span<const float> beta, float* offsets) const {
-  if (!deformation_) {
+void AvatarModel::WarpOffsets(const Executor& executor, int64_t n, const float* positions, std::span<const float> beta,
+                              float* offsets, WarpPart part) const {
+  ICEF_CHECK(static_cast<int>(beta.size()) == setup_.expression_dim, "beta has the wrong length");
+  if (!warp_) {
     std::fill(offsets, offsets + 3 * n, 0.f);
     return;
   }
-  std::vector<float> betas(n * setup_.expression_dim);
-  for (int64_t i = 0; i < n; ++i) std::copy(beta.begin(), beta.end(), betas.begin() + i * setup_.expression_dim);
-  DeformationContext ctx;
-  deformation_->Forward(executor, n, positions, betas.data(), offsets, &ctx, false);
-}
-
-void AvatarModel::OffsetsLinearized(const Executor& executor, int64_t n, const float* positions,
-                                  std::span<const float> beta, float* offsets) const {
-  if (!deformation_) {
-    std::fill(offsets, offsets + 3 * n, 0.f);
-    return;
-  }
-  const int b = setup_.expression_dim;
-  const NearestExpression near = Nearest(beta);
-  const std::vector<float>& anchor = setup_.training_expressions[near.index];
-  std::vector<float> anchors(n * b), directions(n * b);
-  for (int64_t i = 0; i < n; ++i)
-    for (int k = 0; k < b; ++k) {
-      anchors[i * b + k] = anchor[k];
-      directions[i * b + k] = beta[k] - anchor[k];
-    }
-  DeformationContext ctx;
-  deformation_->LinearizedForward(executor, n, positions, anchors.data(), directions.data(), offsets, &ctx);
+  DeformationWorkspace ws;
+  warp_->Offsets(executor, n, positions, beta, offsets, &ws, part);
 }
 
 void AvatarModel::Offsets(const Executor& executor, int64_t n, const float* positions, std::span<const float> beta,
                         float* offsets) const {
-  OffsetsPhi(executor, n, positions, beta, offsets);
-  if (!deformation_ || !traits_.confidence) return;
-  const NearestExpression near = Nearest(beta);
-  if (near.kappa >= 1.0) return;  // delta = 0: D_final = D_phi exactly
-  std::vector<float> lin(3 * n);
-  OffsetsLinearized(executor, n, positions, beta, lin.data());
-  const float kappa = static_cast<float>(near.kappa);
-  for (int64_t i = 0; i < 3 * n; ++i) offsets[i] = kappa * offsets[i] + (1.f - kappa) * lin[i];
+  WarpOffsets(executor, n, positions, beta, offsets, WarpPart::kFinal);
 }
 
-LossTerms AvatarModel::TrainForwardBackward(const TrainRays& batch, const LossWeights& weights, uint64_t seed,
-                                          int64_t step, const Executor& executor) {
-  ModelWorkspace& ws = *train_ws_;
-  const int64_t num_rays = static_cast<int64_t>(batch.rays.size());
-  const int b = setup_.expression_dim;
-  const bool has_alpha = !batch.target_alpha.empty();
-  SampleRays(batch.rays, setup_.aabb, config_.SamplerOptions(true), &occupancy_, seed, step, executor, &ws.samples);
-  const int64_t n = ws.samples.size();
-  const float* positions = ws.samples.positions.data();
+void AvatarModel::OffsetsPhi(const Executor& executor, int64_t n, const float* positions,
+                           std::span<const float> beta, float* offsets) const {
+  WarpOffsets(executor, n, positions, beta, offsets, WarpPart::kPhi);
+}
 
-  // Per-sample view directions and expressions.
+void AvatarModel::OffsetsLinearized(const Executor& executor, int64_t n, const float* positions,
+                                  std::span<const float> beta, float* offsets) const {
+  WarpOffsets(executor, n, positions, beta, offsets, WarpPart::kLinearized);
+}
+
+void AvatarModel::ExpandRays(const TrainRays& batch, ModelWorkspace& ws, const Executor& executor) const {
+  const int64_t n = ws.samples.size();
+  const int b = setup_.expression_dim;
   Fit(ws.dirs, 3 * n);
-  const bool need_betas = deformation_ || traits_.entangled_beta;
+  const bool need_betas = warp_ || traits_.entangled_beta;
   if (need_betas) Fit(ws.betas, n * b);
-  ParallelFor(executor, num_rays, [&](int64_t r0, int64_t r1, int) {
+  ParallelFor(executor, static_cast<int64_t>(batch.rays.size()), [&](int64_t r0, int64_t r1, int) {
     for (int64_t r = r0; r < r1; ++r) {
       const int64_t off = ws.samples.ray_offset[r], cnt = ws.samples.ray_count[r];
       const Vec3f& d = batch.rays[r].direction;
@@ -171,32 +185,32 @@ LossTerms AvatarModel::TrainForwardBackward(const TrainRays& batch, const LossWe
       }
     }
   });
+}
 
-  // Observation -> canonical.
+void AvatarModel::FieldForward(ModelWorkspace& ws, bool train, const Executor& executor) const {
+  const int64_t n = ws.samples.size();
+  const float* positions = ws.samples.positions.data();
   const float* canonical = positions;
-  if (deformation_) {
-    Fit(ws.offsets, 3 * n);
+  if (warp_) {
     Fit(ws.canonical, 3 * n);
-    deformation_->Forward(executor, n, positions, ws.betas.data(), ws.offsets.data(), &ws.deform_ctx, true);
     for (int64_t i = 0; i < 3 * n; ++i) ws.canonical[i] = positions[i] + ws.offsets[i];
     canonical = ws.canonical.data();
   }
   Fit(ws.sigma, n);
   Fit(ws.rgb, 3 * n);
   static_field_->Forward(executor, n, canonical, ws.dirs.data(), traits_.entangled_beta ? ws.betas.data() : nullptr,
-                         ws.sigma.data(), ws.rgb.data(), &ws.static_ctx, true, deformation_ != nullptr);
+                         ws.sigma.data(), ws.rgb.data(), &ws.static_ctx, train, train && warp_ != nullptr);
+  if (warp_ && warp_->has_prior()) {
+    Fit(ws.cavity, n);
+    warp_->Cavity(executor, n, positions, ws.betas.data(), ws.cavity.data());
+    ApplyCavity(n, ws.cavity.data(), ws.sigma.data(), ws.rgb.data());
+  }
+}
 
-  // Compositing over the known background.
-  const float bg[3] = {setup_.background.x(), setup_.background.y(), setup_.background.z()};
-  ICEF_CHECK(batch.background.empty() || int64_t(batch.background.size()) == 3 * num_rays, "background size");
-  CompositeInputs<float> in{ws.sigma, ws.rgb, ws.samples.t, ws.samples.dt, ws.samples.ray_offset,
-                            ws.samples.ray_count,
-                            batch.background.empty() ? std::span<const float>(bg, 3) : std::span<const float>(batch.background)};
-  CompositeForward(in, config_.CompositeOpts(), executor, &ws.composite);
-
-  // Ray losses and their gradients.
-  LossTerms terms;
-  terms.samples = n;
+double AvatarModel::PhotoAndMaskLoss(const TrainRays& batch, const LossWeights& weights, ModelWorkspace& ws,
+                                     LossTerms* terms) const {
+  const int64_t num_rays = static_cast<int64_t>(batch.rays.size());
+  const bool has_alpha = !batch.target_alpha.empty() && weights.lambda_mask > 0;
   Fit(ws.d_color, 3 * num_rays);
   Fit(ws.d_opacity, num_rays);
   double photo = 0, mask_loss = 0;
@@ -207,55 +221,94 @@ LossTerms AvatarModel::TrainForwardBackward(const TrainRays& batch, const LossWe
       photo += e * e;
       ws.d_color[3 * r + a] = static_cast<float>(2.0 * e * inv_c);
     }
-    if (has_alpha && weights.lambda_mask > 0) {
+    ws.d_opacity[r] = 0.f;
+    if (has_alpha) {
       const double e = ws.composite.opacity[r] - batch.target_alpha[r];
       mask_loss += e * e;
       ws.d_opacity[r] = static_cast<float>(weights.lambda_mask * 2.0 * e * inv_r);
-    } else {
-      ws.d_opacity[r] = 0.f;
     }
   }
-  terms.photo = photo * inv_c;
-  terms.mask = mask_loss * inv_r;
-  std::span<const float> d_weights;
-  if (weights.lambda_distortion > 0) {
-    // Distances in units of the aabb diagonal, so the weight does not depend on the scene's scale.
-    const double inv_diag = 1.0 / setup_.aabb.Extent().norm();
-    Fit(ws.d_weights, n);
-    double dist = 0;
-    for (int64_t r = 0; r < num_rays; ++r) {
-      const int64_t off = ws.samples.ray_offset[r], cnt = ws.samples.ray_count[r];
-      if (cnt == 0) continue;
-      dist += DistortionLossRay<float>(cnt, &ws.composite.weights[off], &ws.samples.t[off], &ws.samples.dt[off]);
-      DistortionLossRayBackward<float>(cnt, &ws.composite.weights[off], &ws.samples.t[off], &ws.samples.dt[off],
-                                       static_cast<float>(weights.lambda_distortion * inv_r * inv_diag),
-                                       &ws.d_weights[off]);
-    }
-    terms.distortion = dist * inv_r * inv_diag;
-    d_weights = ws.d_weights;
+  terms->photo = photo * inv_c;
+  terms->mask = mask_loss * inv_r;
+  return inv_r;
+}
+
+std::span<const float> AvatarModel::DistortionTerm(int64_t num_rays, const LossWeights& weights, ModelWorkspace& ws,
+                                                   LossTerms* terms) const {
+  if (weights.lambda_distortion <= 0) return {};
+  // Distances in units of the aabb diagonal, so the weight does not depend on the scene's scale.
+  const double inv_r = 1.0 / std::max<int64_t>(num_rays, 1), inv_diag = 1.0 / setup_.aabb.Extent().norm();
+  Fit(ws.d_weights, ws.samples.size());
+  double dist = 0;
+  for (int64_t r = 0; r < num_rays; ++r) {
+    const int64_t off = ws.samples.ray_offset[r], cnt = ws.samples.ray_count[r];
+    if (cnt == 0) continue;
+    dist += DistortionLossRay<float>(cnt, &ws.composite.weights[off], &ws.samples.t[off], &ws.samples.dt[off]);
+    DistortionLossRayBackward<float>(cnt, &ws.composite.weights[off], &ws.samples.t[off], &ws.samples.dt[off],
+                                     static_cast<float>(weights.lambda_distortion * inv_r * inv_diag),
+                                     &ws.d_weights[off]);
   }
+  terms->distortion = dist * inv_r * inv_diag;
+  return ws.d_weights;
+}
+
+void AvatarModel::OcclusionTerm(int64_t num_rays, const LossWeights& weights, ModelWorkspace& ws,
+                                LossTerms* terms) const {
+  if (weights.lambda_occlusion <= 0) return;
+  const double inv_r = 1.0 / std::max<int64_t>(num_rays, 1);
+  double occ = 0;
+  const float scale = static_cast<float>(weights.lambda_occlusion * inv_r);
+  for (int64_t r = 0; r < num_rays; ++r) {
+    const int64_t off = ws.samples.ray_offset[r], cnt = ws.samples.ray_count[r];
+    occ += OcclusionLossRay<float>(static_cast<int>(cnt), &ws.composite.weights[off], &ws.sigma[off],
+                                   &ws.samples.dt[off], scale, &ws.d_sigma[off]);
+  }
+  terms->occlusion = occ * inv_r;
+}
+
+LossTerms AvatarModel::TrainForwardBackward(const TrainRays& batch, const LossWeights& weights, uint64_t seed,
+                                          int64_t step, const Executor& executor) {
+  ModelWorkspace& ws = *train_ws_;
+  const int64_t num_rays = static_cast<int64_t>(batch.rays.size());
+  SampleRays(batch.rays, setup_.aabb, config_.SamplerOptions(true), &occupancy_, seed, step, executor, &ws.samples);
+  const int64_t n = ws.samples.size();
+  ExpandRays(batch, ws, executor);
+  if (warp_) {  // observation -> canonical
+    Fit(ws.offsets, 3 * n);
+    Fit(ws.residual, 3 * n);
+    warp_->ForwardTrain(executor, n, ws.samples.positions.data(), ws.betas.data(), ws.offsets.data(),
+                        ws.residual.data(), &ws.deform_ctx, true);
+  }
+  FieldForward(ws, true, executor);
+
+  // Compositing over the known background.
+  const float bg[3] = {setup_.background.x(), setup_.background.y(), setup_.background.z()};
+  ICEF_CHECK(batch.background.empty() || int64_t(batch.background.size()) == 3 * num_rays, "background size");
+  CompositeInputs<float> in{ws.sigma, ws.rgb, ws.samples.t, ws.samples.dt, ws.samples.ray_offset,
+                            ws.samples.ray_count,
+                            batch.background.empty() ? std::span<const float>(bg, 3) : std::span<const float>(batch.background)};
+  CompositeForward(in, config_.CompositeOpts(), executor, &ws.composite);
+
+  // Ray losses and their gradients, back through compositing to the samples.
+  LossTerms terms;
+  terms.samples = n;
+  PhotoAndMaskLoss(batch, weights, ws, &terms);
+  const std::span<const float> d_weights = DistortionTerm(num_rays, weights, ws, &terms);
   CompositeOutputGradients<float> grads{ws.d_color, ws.d_opacity, {}, d_weights};
   CompositeBackward(in, ws.composite, grads, executor, &ws.d_sigma, &ws.d_rgb);
-  if (weights.lambda_occlusion > 0) {
-    double occ = 0;
-    const float scale = static_cast<float>(weights.lambda_occlusion * inv_r);
-    for (int64_t r = 0; r < num_rays; ++r) {
-      const int64_t off = ws.samples.ray_offset[r], cnt = ws.samples.ray_count[r];
-      occ += OcclusionLossRay<float>(static_cast<int>(cnt), &ws.composite.weights[off], &ws.sigma[off],
-                                     &ws.samples.dt[off], scale, &ws.d_sigma[off]);
-    }
-    terms.occlusion = occ * inv_r;
-  }
+  OcclusionTerm(num_rays, weights, ws, &terms);
+  if (warp_ && warp_->has_prior()) DropCavityGradients(n, ws.cavity.data(), ws.d_sigma.data(), ws.d_rgb.data());
 
   // Mirroring acts in canonical space; nerface has none (its density depends on beta, and mirroring
   // it would penalise exactly its asymmetric expressions), so the prior does not apply to it.
   const bool symmetry = weights.lambda_symmetry > 0 && symmetry_ && !traits_.entangled_beta;
+  const float* canonical = warp_ ? ws.canonical.data() : ws.samples.positions.data();
   if (symmetry) terms.symmetry = SymmetryTerm(ws, n, canonical, weights, executor);
 
-  if (deformation_) Fit(ws.d_canonical, 3 * n);
+  if (warp_) Fit(ws.d_canonical, 3 * n);
   static_field_->Backward(executor, n, ws.sigma.data(), ws.rgb.data(), ws.d_sigma.data(), ws.d_rgb.data(),
-                          &ws.static_ctx, deformation_ ? ws.d_canonical.data() : nullptr);
-  if (symmetry && deformation_) {
+                          &ws.static_ctx, warp_ ? ws.d_canonical.data() : nullptr);
+  if (symmetry && warp_) {
     // The mirror images P x_c move with the warp too: d/dx_c = H d/d(P x_c), H = I - 2 n n^T.
     for (size_t j = 0; j < ws.sym_index.size(); ++j) {
       const int64_t i = ws.sym_index[j];
@@ -264,70 +317,80 @@ LossTerms AvatarModel::TrainForwardBackward(const TrainRays& batch, const LossWe
       for (int a = 0; a < 3; ++a) ws.d_canonical[3 * i + a] += g[a];
     }
   }
-
-  if (deformation_) {
-    const bool id_terms = traits_.identity_losses && (weights.lambda_id > 0 || weights.lambda_smooth > 0);
-    const Vec3f half = 0.5f * setup_.aabb.Extent();
-    const Vec3f inv_half2 = half.cwiseProduct(half).cwiseInverse();
-    if (id_terms) {
-      Fit(ws.mask_values, n);
-      if (traits_.uniform_mask) {
-        std::fill(ws.mask_values.begin(), ws.mask_values.begin() + n, 0.f);
-      } else {
-        mask_.EvaluateBatch(positions, n, ws.mask_values.data());
-      }
-    }
-    if (id_terms && weights.lambda_id > 0) {
-      const float inv_half2_arr[3] = {inv_half2.x(), inv_half2.y(), inv_half2.z()};
-      terms.id = IdentityLoss<float>(n, ws.offsets.data(), ws.mask_values.data(), inv_half2_arr,
-                                     static_cast<float>(weights.lambda_id), ws.d_canonical.data());
-    }
-    deformation_->Backward(executor, n, ws.d_canonical.data(), &ws.deform_ctx);
-
-    if (id_terms && weights.lambda_smooth > 0) {
-      // L_smooth (identity_losses.h) on up to smooth_max_samples boundary samples (w_b > 0).
-      ws.smooth_index.clear();
-      for (int64_t i = 0; i < n; ++i) {
-        if (BoundaryWeight(ws.mask_values[i]) > 1e-3f) ws.smooth_index.push_back(i);
-      }
-      const int64_t avail = static_cast<int64_t>(ws.smooth_index.size());
-      const int64_t m = std::min<int64_t>(avail, weights.smooth_max_samples);
-      if (m > 0) {
-        Fit(ws.smooth_positions, 6 * m);
-        Fit(ws.smooth_betas, 2 * m * b);
-        Fit(ws.smooth_offsets, 6 * m);
-        Fit(ws.smooth_d_offsets, 6 * m);
-        Fit(ws.smooth_weight, m);
-        const float eps = static_cast<float>(weights.smooth_epsilon);
-        for (int64_t j = 0; j < m; ++j) {
-          const int64_t i = ws.smooth_index[j * avail / m];  // even stride over the boundary samples
-          Rng rng(seed, StreamId("smooth_direction"), uint64_t(step), uint64_t(j));
-          Vec3f u(static_cast<float>(rng.Normal()), static_cast<float>(rng.Normal()), static_cast<float>(rng.Normal()));
-          u /= std::max(u.norm(), 1e-6f);
-          for (int a = 0; a < 3; ++a) {
-            ws.smooth_positions[3 * j + a] = positions[3 * i + a];
-            ws.smooth_positions[3 * (m + j) + a] = positions[3 * i + a] + eps * u[a] * half[a];
-          }
-          std::copy(ws.betas.begin() + i * b, ws.betas.begin() + (i + 1) * b, ws.smooth_betas.begin() + j * b);
-          std::copy(ws.betas.begin() + i * b, ws.betas.begin() + (i + 1) * b, ws.smooth_betas.begin() + (m + j) * b);
-          const float mk = ws.mask_values[i];
-          ws.smooth_weight[j] = BoundaryWeight(mk);
-        }
-        deformation_->Forward(executor, 2 * m, ws.smooth_positions.data(), ws.smooth_betas.data(),
-                              ws.smooth_offsets.data(), &ws.smooth_ctx, true);
-        const float half_arr[3] = {half.x(), half.y(), half.z()};
-        terms.smooth = SmoothnessLoss<float>(m, ws.smooth_offsets.data(), ws.smooth_weight.data(), half_arr, eps,
-                                             static_cast<float>(weights.lambda_smooth), ws.smooth_d_offsets.data());
-        deformation_->Backward(executor, 2 * m, ws.smooth_d_offsets.data(), &ws.smooth_ctx);
-      }
-    }
-  }
+  if (warp_) IdentityTerms(weights, seed, step, ws, &terms, executor);
   const double lid = traits_.identity_losses ? weights.lambda_id : 0.0;
   const double lsm = traits_.identity_losses ? weights.lambda_smooth : 0.0;
   terms.total = terms.photo + weights.lambda_mask * terms.mask + lid * terms.id + lsm * terms.smooth +
                 weights.lambda_distortion * terms.distortion + weights.lambda_occlusion * terms.occlusion +
                 weights.lambda_symmetry * terms.symmetry;
   return terms;
+}
+
+void AvatarModel::IdentityTerms(const LossWeights& weights, uint64_t seed, int64_t step, ModelWorkspace& ws,
+                                LossTerms* terms, const Executor& executor) {
+  // L_id and L_smooth act on the learned residual R_phi only (DESIGN.md §2.1): what the face-model
+  // prior knows is not penalised. Their gradients join d_canonical before R_phi's backward pass.
+  const int64_t n = ws.samples.size();
+  const bool id_terms = residual_field_ && traits_.identity_losses && (weights.lambda_id > 0 || weights.lambda_smooth > 0);
+  if (id_terms) {
+    Fit(ws.mask_values, n);
+    if (traits_.uniform_mask) {
+      std::fill(ws.mask_values.begin(), ws.mask_values.begin() + n, 0.f);
+    } else {
+      mask_.EvaluateBatch(ws.samples.positions.data(), n, ws.mask_values.data());
+    }
+  }
+  if (id_terms && weights.lambda_id > 0) {
+    const Vec3f half = 0.5f * setup_.aabb.Extent();
+    const Vec3f inv_half2 = half.cwiseProduct(half).cwiseInverse();
+    const float inv_half2_arr[3] = {inv_half2.x(), inv_half2.y(), inv_half2.z()};
+    terms->id = IdentityLoss<float>(n, ws.residual.data(), ws.mask_values.data(), inv_half2_arr,
+                                    static_cast<float>(weights.lambda_id), ws.d_canonical.data());
+  }
+  warp_->Backward(executor, n, ws.d_canonical.data(), &ws.deform_ctx);
+  if (id_terms && weights.lambda_smooth > 0) terms->smooth = SmoothTerm(weights, seed, step, ws, executor);
+}
+
+double AvatarModel::SmoothTerm(const LossWeights& weights, uint64_t seed, int64_t step, ModelWorkspace& ws,
+                               const Executor& executor) {
+  // L_smooth (identity_losses.h) on up to smooth_max_samples boundary samples (w_b > 0).
+  const int64_t n = ws.samples.size();
+  const int b = setup_.expression_dim;
+  const float* positions = ws.samples.positions.data();
+  ws.smooth_index.clear();
+  for (int64_t i = 0; i < n; ++i) {
+    if (BoundaryWeight(ws.mask_values[i]) > 1e-3f) ws.smooth_index.push_back(i);
+  }
+  const int64_t avail = static_cast<int64_t>(ws.smooth_index.size());
+  const int64_t m = std::min<int64_t>(avail, weights.smooth_max_samples);
+  if (m <= 0) return 0.0;
+  Fit(ws.smooth_positions, 6 * m);
+  Fit(ws.smooth_betas, 2 * m * b);
+  Fit(ws.smooth_offsets, 6 * m);
+  Fit(ws.smooth_d_offsets, 6 * m);
+  Fit(ws.smooth_weight, m);
+  const Vec3f half = 0.5f * setup_.aabb.Extent();
+  const float eps = static_cast<float>(weights.smooth_epsilon);
+  for (int64_t j = 0; j < m; ++j) {
+    const int64_t i = ws.smooth_index[j * avail / m];  // even stride over the boundary samples
+    Rng rng(seed, StreamId("smooth_direction"), uint64_t(step), uint64_t(j));
+    Vec3f u(static_cast<float>(rng.Normal()), static_cast<float>(rng.Normal()), static_cast<float>(rng.Normal()));
+    u /= std::max(u.norm(), 1e-6f);
+    for (int a = 0; a < 3; ++a) {
+      ws.smooth_positions[3 * j + a] = positions[3 * i + a];
+      ws.smooth_positions[3 * (m + j) + a] = positions[3 * i + a] + eps * u[a] * half[a];
+    }
+    std::copy(ws.betas.begin() + i * b, ws.betas.begin() + (i + 1) * b, ws.smooth_betas.begin() + j * b);
+    std::copy(ws.betas.begin() + i * b, ws.betas.begin() + (i + 1) * b, ws.smooth_betas.begin() + (m + j) * b);
+    ws.smooth_weight[j] = BoundaryWeight(ws.mask_values[i]);
+  }
+  residual_field_->Forward(executor, 2 * m, ws.smooth_positions.data(), ws.smooth_betas.data(),
+                           ws.smooth_offsets.data(), &ws.smooth_ctx, true);
+  const float half_arr[3] = {half.x(), half.y(), half.z()};
+  const double loss = SmoothnessLoss<float>(m, ws.smooth_offsets.data(), ws.smooth_weight.data(), half_arr, eps,
+                                            static_cast<float>(weights.lambda_smooth), ws.smooth_d_offsets.data());
+  residual_field_->Backward(executor, 2 * m, ws.smooth_d_offsets.data(), &ws.smooth_ctx);
+  return loss;
 }
 
 double AvatarModel::SymmetryTerm(ModelWorkspace& ws, int64_t n, const float* canonical, const LossWeights& weights,
@@ -362,7 +425,7 @@ double AvatarModel::SymmetryTerm(ModelWorkspace& ws, int64_t n, const float* can
     ws.sym_dt[j] = ws.samples.dt[i];
   }
   static_field_->Forward(executor, m, ws.sym_positions.data(), ws.sym_dirs.data(), nullptr,
-                         ws.sym_sigma_b.data(), ws.sym_rgb_b.data(), &ws.sym_ctx, true, deformation_ != nullptr);
+                         ws.sym_sigma_b.data(), ws.sym_rgb_b.data(), &ws.sym_ctx, true, warp_ != nullptr);
   const float scale = static_cast<float>(weights.lambda_symmetry);
   const double loss = SymmetryLoss<float>(m, ws.sym_sigma_a.data(), ws.sym_rgb_a.data(), ws.sym_sigma_b.data(),
                                           ws.sym_rgb_b.data(), ws.sym_dt.data(),
@@ -374,35 +437,41 @@ double AvatarModel::SymmetryTerm(ModelWorkspace& ws, int64_t n, const float* can
     ws.d_sigma[i] += ws.sym_d_sigma_a[j];
     for (int a = 0; a < 3; ++a) ws.d_rgb[3 * i + a] += ws.sym_d_rgb_a[3 * j + a];
   }
-  if (deformation_) Fit(ws.sym_d_positions, 3 * m);
+  if (warp_) Fit(ws.sym_d_positions, 3 * m);
   static_field_->Backward(executor, m, ws.sym_sigma_b.data(), ws.sym_rgb_b.data(), ws.sym_d_sigma_b.data(),
-                          ws.sym_d_rgb_b.data(), &ws.sym_ctx, deformation_ ? ws.sym_d_positions.data() : nullptr);
+                          ws.sym_d_rgb_b.data(), &ws.sym_ctx, warp_ ? ws.sym_d_positions.data() : nullptr);
   return loss;
 }
 
 OccupancyGrid AvatarModel::RenderOccupancy(std::span<const float> beta, const Executor& executor) const {
   ICEF_CHECK(static_cast<int>(beta.size()) == setup_.expression_dim, "beta has the wrong length");
-  if (!deformation_ && !traits_.entangled_beta) return occupancy_;  // the density does not depend on beta
-  const int b = setup_.expression_dim;
+  if (!warp_ && !traits_.entangled_beta) return occupancy_;  // the density does not depend on beta
   const std::vector<uint8_t>& hull = occupancy_.allowed();
   StaticFieldContext sctx;
+  DeformationWorkspace dws;
   std::vector<float> betas, offsets, canonical;
+  std::vector<uint8_t> cavity;
   auto query = [&](const float* positions, int64_t n, float* sigma) {
     const float* c = positions;
-    if (deformation_) {
+    if (warp_) {
       offsets.resize(3 * n);
       canonical.resize(3 * n);
-      Offsets(executor, n, positions, beta, offsets.data());
+      warp_->Offsets(executor, n, positions, beta, offsets.data(), &dws);
       for (int64_t i = 0; i < 3 * n; ++i) canonical[i] = positions[i] + offsets[i];
       c = canonical.data();
     } else {
-      betas.resize(n * b);
-      for (int64_t i = 0; i < n; ++i) std::copy(beta.begin(), beta.end(), betas.begin() + i * b);
+      BroadcastExpression(beta, n, &betas);
     }
-    static_field_->Density(executor, n, c, deformation_ ? nullptr : betas.data(), sigma, &sctx);
+    static_field_->Density(executor, n, c, warp_ ? nullptr : betas.data(), sigma, &sctx);
     for (int64_t i = 0; i < n; ++i) {
       const int64_t cell = occupancy_.CellOf(Vec3f(c[3 * i], c[3 * i + 1], c[3 * i + 2]));
       if (cell < 0 || (!hull.empty() && !hull[cell])) sigma[i] = -1.f;  // not allowed
+    }
+    if (warp_ && warp_->has_prior()) {  // the open mouth's interior is geometry too
+      cavity.resize(n);
+      warp_->Cavity(executor, n, positions, dws.betas.data(), cavity.data());
+      for (int64_t i = 0; i < n; ++i)
+        if (cavity[i]) sigma[i] = kCavityDensity;
     }
   };
   // One query per 2 x 2 x 2 cells: the training grid already holds the observed geometry, what is
@@ -421,10 +490,6 @@ void AvatarModel::Render(std::span<const Ray> rays, std::span<const float> beta,
   out->opacity.assign(total_rays, 0.f);
   out->mask.assign(total_rays, 0.f);
   out->deformation.assign(total_rays, 0.f);
-  const int b = setup_.expression_dim;
-  const NearestExpression near = Nearest(beta);
-  const bool blend = deformation_ && traits_.confidence && near.kappa < 1.0;
-  const float kappa = static_cast<float>(near.kappa);
   const float bg[3] = {background.x(), background.y(), background.z()};
   constexpr int64_t kChunk = 4096;
   for (int64_t r0 = 0; r0 < total_rays; r0 += kChunk) {
@@ -437,38 +502,11 @@ void AvatarModel::Render(std::span<const Ray> rays, std::span<const float> beta,
     for (int64_t r = 0; r < nr; ++r)
       for (int64_t i = ws.samples.ray_offset[r]; i < ws.samples.ray_offset[r] + ws.samples.ray_count[r]; ++i)
         for (int a = 0; a < 3; ++a) ws.dirs[3 * i + a] = rays[r0 + r].direction[a];
-    if (deformation_ || traits_.entangled_beta) {
-      Fit(ws.betas, n * b);
-      for (int64_t i = 0; i < n; ++i) std::copy(beta.begin(), beta.end(), ws.betas.begin() + i * b);
-    }
+    if (warp_ || traits_.entangled_beta) BroadcastExpression(beta, n, &ws.betas);
     Fit(ws.offsets, 3 * n);
     std::fill(ws.offsets.begin(), ws.offsets.end(), 0.f);
-    const float* canonical = positions;
-    if (deformation_) {
-      deformation_->Forward(executor, n, positions, ws.betas.data(), ws.offsets.data(), &ws.deform_ctx, false);
-      if (blend) {
-        const std::vector<float>& anchor = setup_.training_expressions[near.index];
-        Fit(ws.anchors, n * b);
-        Fit(ws.tangents, n * b);
-        for (int64_t i = 0; i < n; ++i)
-          for (int k = 0; k < b; ++k) {
-            ws.anchors[i * b + k] = anchor[k];
-            ws.tangents[i * b + k] = beta[k] - anchor[k];
-          }
-        Fit(ws.lin_offsets, 3 * n);
-        deformation_->LinearizedForward(executor, n, positions, ws.anchors.data(), ws.tangents.data(),
-                                        ws.lin_offsets.data(), &ws.deform_ctx);
-        for (int64_t i = 0; i < 3 * n; ++i)
-          ws.offsets[i] = kappa * ws.offsets[i] + (1.f - kappa) * ws.lin_offsets[i];
-      }
-      Fit(ws.canonical, 3 * n);
-      for (int64_t i = 0; i < 3 * n; ++i) ws.canonical[i] = positions[i] + ws.offsets[i];
-      canonical = ws.canonical.data();
-    }
-    Fit(ws.sigma, n);
-    Fit(ws.rgb, 3 * n);
-    static_field_->Forward(executor, n, canonical, ws.dirs.data(), traits_.entangled_beta ? ws.betas.data() : nullptr,
-                           ws.sigma.data(), ws.rgb.data(), &ws.static_ctx, false, false);
+    if (warp_) warp_->Offsets(executor, n, positions, beta, ws.offsets.data(), &ws.warp_ws);
+    FieldForward(ws, false, executor);
     CompositeInputs<float> in{ws.sigma, ws.rgb, ws.samples.t, ws.samples.dt, ws.samples.ray_offset,
                               ws.samples.ray_count, std::span<const float>(bg, 3)};
     CompositeForward(in, config_.CompositeOpts(), executor, &ws.composite);
@@ -492,26 +530,24 @@ void AvatarModel::Render(std::span<const Ray> rays, std::span<const float> beta,
 }
 
 void AvatarModel::UpdateOccupancy(uint64_t seed, int64_t step, const Executor& executor) {
-  const int b = setup_.expression_dim;
   StaticFieldContext sctx;
   DeformationContext dctx;
   std::vector<float> betas, offsets, canonical, sigma;
   auto query = [&](const float* positions, int64_t n, float* out) {
     std::fill(out, out + n, 0.f);
     sigma.resize(n);
-    betas.resize(n * b);
-    if (deformation_) offsets.resize(3 * n), canonical.resize(3 * n);
+    if (warp_) offsets.resize(3 * n), canonical.resize(3 * n);
     for (const std::vector<float>& beta : setup_.training_expressions) {
-      for (int64_t i = 0; i < n; ++i) std::copy(beta.begin(), beta.end(), betas.begin() + i * b);
+      BroadcastExpression(beta, n, &betas);
       const float* c = positions;
-      if (deformation_) {
-        deformation_->Forward(executor, n, positions, betas.data(), offsets.data(), &dctx, false);
+      if (warp_) {
+        warp_->ForwardTrain(executor, n, positions, betas.data(), offsets.data(), nullptr, &dctx, false);
         for (int64_t i = 0; i < 3 * n; ++i) canonical[i] = positions[i] + offsets[i];
         c = canonical.data();
       }
       static_field_->Density(executor, n, c, traits_.entangled_beta ? betas.data() : nullptr, sigma.data(), &sctx);
       for (int64_t i = 0; i < n; ++i) out[i] = std::max(out[i], sigma[i]);
-      if (!deformation_ && !traits_.entangled_beta) break;  // density does not depend on beta
+      if (!warp_ && !traits_.entangled_beta) break;  // density does not depend on beta
     }
   };
   occupancy_.Update(query, seed, step);
@@ -521,7 +557,7 @@ std::string AvatarModel::ToString() const {
   std::ostringstream os;
   os << "AvatarModel(method=" << MethodName(method_) << ", params=" << store_.size() << ", "
      << static_field_->ToString();
-  if (deformation_) os << ", " << deformation_->ToString();
+  if (warp_) os << ", " << warp_->ToString();
   os << ", mask from " << setup_.mask_source << ")";
   return os.str();
 }

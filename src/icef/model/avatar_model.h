@@ -4,7 +4,8 @@
 //   - TrainForwardBackward: loss terms of a batch of training rays, gradients accumulated into the
 //     slab (the trainer runs the optimiser);
 //   - Render: colour, depth, opacity, expected mask and deformation magnitude of any rays at any
-//     expression, with confidence-weighted warping D_final = kappa D_phi + (1 - kappa) D_lin.
+//     expression, with confidence-weighted warping D_final = P + kappa R_phi + (1 - kappa) R_lin
+//     (field/deformation.h; P, the face-model prior, only for the *-prior methods).
 #pragma once
 
 #include <memory>
@@ -15,6 +16,7 @@
 
 #include "icef/core/parallel.h"
 #include "icef/field/confidence.h"
+#include "icef/field/deformation.h"
 #include "icef/field/deformation_field.h"
 #include "icef/field/region_mask.h"
 #include "icef/field/static_field.h"
@@ -87,9 +89,12 @@ struct ModelWorkspace;
 
 class AvatarModel {
  public:
-  // Builds the fields and registers their parameters. Errors: invalid config or setup.
+  // Builds the fields and registers their parameters. The *-prior methods take `prior` when given
+  // (tests), else the face-model prior of setup.face_fit (model/face_prior.h). Errors: invalid
+  // config or setup, a *-prior method without a face-model fit.
   static Result<std::unique_ptr<AvatarModel>> Create(const ModelConfig& config, const ModelSetup& setup,
-                                                   const Executor& executor);
+                                                   const Executor& executor,
+                                                   std::unique_ptr<DeformationPrior> prior = nullptr);
   ~AvatarModel();
 
   // Draws initial parameters (deterministic for the seed).
@@ -124,7 +129,7 @@ class AvatarModel {
   // The warp D_final(x, beta) - x, confidence-weighted as in Render: offsets [n, 3] world frame.
   void Offsets(const Executor& executor, int64_t n, const float* positions, std::span<const float> beta,
                float* offsets) const;
-  // D_phi (kappa forced to 1) and D_lin around beta_n separately (tests).
+  // P + R_phi (kappa forced to 1) and P + R_lin around beta_n separately (tests).
   void OffsetsPhi(const Executor& executor, int64_t n, const float* positions, std::span<const float> beta,
                   float* offsets) const;
   void OffsetsLinearized(const Executor& executor, int64_t n, const float* positions, std::span<const float> beta,
@@ -143,8 +148,10 @@ class AvatarModel {
   // The face's symmetry plane (from the mask landmarks), or nullopt when they do not give one.
   const std::optional<SymmetryPlane>& symmetry_plane() const { return symmetry_; }
   StaticField& static_field() { return *static_field_; }
-  DeformationField* deformation() { return deformation_.get(); }
-  const DeformationField* deformation() const { return deformation_.get(); }
+  // The learned residual R_phi (null for nerface), and the whole warp (null for nerface).
+  DeformationField* residual_field() { return residual_field_.get(); }
+  const DeformationField* residual_field() const { return residual_field_.get(); }
+  const Deformation* warp() const { return warp_.get(); }
   std::string ToString() const;
 
  private:
@@ -153,6 +160,20 @@ class AvatarModel {
   // batch's sigma and rgb to ws.d_sigma / ws.d_rgb and back-propagates the mirror images' share.
   double SymmetryTerm(ModelWorkspace& ws, int64_t n, const float* canonical, const LossWeights& weights,
                       const Executor& executor);
+  // Pieces of TrainForwardBackward / Render.
+  void ExpandRays(const TrainRays& batch, ModelWorkspace& ws, const Executor& executor) const;
+  void FieldForward(ModelWorkspace& ws, bool train, const Executor& executor) const;
+  double PhotoAndMaskLoss(const TrainRays& batch, const LossWeights& weights, ModelWorkspace& ws,
+                          LossTerms* terms) const;
+  std::span<const float> DistortionTerm(int64_t num_rays, const LossWeights& weights, ModelWorkspace& ws,
+                                        LossTerms* terms) const;
+  void OcclusionTerm(int64_t num_rays, const LossWeights& weights, ModelWorkspace& ws, LossTerms* terms) const;
+  void IdentityTerms(const LossWeights& weights, uint64_t seed, int64_t step, ModelWorkspace& ws, LossTerms* terms,
+                     const Executor& executor);
+  double SmoothTerm(const LossWeights& weights, uint64_t seed, int64_t step, ModelWorkspace& ws,
+                    const Executor& executor);
+  void WarpOffsets(const Executor& executor, int64_t n, const float* positions, std::span<const float> beta,
+                   float* offsets, WarpPart part) const;
 
   ModelConfig config_;
   ModelSetup setup_;
@@ -160,7 +181,9 @@ class AvatarModel {
   MethodTraits traits_;
   nn::ParameterStore store_;
   std::unique_ptr<StaticField> static_field_;
-  std::unique_ptr<DeformationField> deformation_;
+  std::unique_ptr<DeformationField> residual_field_;
+  std::unique_ptr<DeformationPrior> prior_;
+  std::unique_ptr<Deformation> warp_;
   RegionMask mask_;
   ExpressionConfidence confidence_;
   OccupancyGrid occupancy_;

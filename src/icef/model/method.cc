@@ -13,6 +13,8 @@ MethodTraits TraitsOf(Method method) {
     case Method::kNerface:
       t.deformation = false, t.identity_losses = false, t.confidence = false, t.entangled_beta = true;
       break;
+    case Method::kIcefPrior: t.prior = true; break;
+    case Method::kWarpPrior: t.prior = true, t.identity_losses = false, t.confidence = false; break;
   }
   return t;
 }
@@ -25,13 +27,15 @@ const char* MethodName(Method method) {
     case Method::kIcefUniform: return "icef-uniform";
     case Method::kWarp: return "warp";
     case Method::kNerface: return "nerface";
+    case Method::kIcefPrior: return "icef-prior";
+    case Method::kWarpPrior: return "warp-prior";
   }
   return "?";
 }
 
 const std::vector<Method>& AllMethods() {
   static const std::vector<Method> kAll = {Method::kIcef, Method::kIcefNoId, Method::kIcefNoConf, Method::kIcefUniform,
-                                           Method::kWarp, Method::kNerface};
+                                           Method::kWarp, Method::kNerface, Method::kIcefPrior, Method::kWarpPrior};
   return kAll;
 }
 

@@ -91,7 +91,7 @@ Result<LoadedModel> LoadModel(const fs::path& given, const Executor& executor) {
   if (ckpt.Has("adam")) {
     ICEF_ASSIGN_OR_RETURN(out.adam_state, ckpt.Section("adam"));
   }
-  if (DeformationField* d = out.model->deformation()) d->SetAnnealing(DeformationAnnealing(out.config, out.state.step));
+  if (DeformationField* d = out.model->residual_field()) d->SetAnnealing(DeformationAnnealing(out.config, out.state.step));
   out.model->static_field().SetLevelWeights(GridLevelWeights(out.config, out.state.step));
   if (ckpt.Has("log")) {
     ICEF_ASSIGN_OR_RETURN(const std::string log, ckpt.Section("log"));

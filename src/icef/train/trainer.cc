@@ -134,7 +134,7 @@ Result<std::unique_ptr<Trainer>> Trainer::Resume(const Dataset& dataset, const f
 }
 
 void Trainer::ApplySchedules() {
-  if (DeformationField* d = model_->deformation()) d->SetAnnealing(DeformationAnnealing(config_, state_.step));
+  if (DeformationField* d = model_->residual_field()) d->SetAnnealing(DeformationAnnealing(config_, state_.step));
   model_->static_field().SetLevelWeights(GridLevelWeights(config_, state_.step));
 }
 

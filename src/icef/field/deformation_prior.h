@@ -1,0 +1,31 @@
+// A fixed, known part of the deformation (DESIGN.md §2.1): P(x, beta), an observation point's
+// canonical point as a face model predicts it. It has no parameters, so it is only evaluated,
+// never differentiated. The learned residual R_phi (DeformationField) is added on top of it.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "icef/core/parallel.h"
+
+namespace icef {
+
+class DeformationPrior {
+ public:
+  virtual ~DeformationPrior() = default;
+
+  // positions [n, 3] world frame, betas [n, B] (each sample's expression) -> offsets [n, 3] world
+  // frame: P(x_i, beta_i) - x_i.
+  virtual void Offsets(const Executor& executor, int64_t n, const float* positions, const float* betas,
+                       float* offsets) const = 0;
+
+  // inside [n]: 1 where x_i lies in the face model's mouth cavity at beta_i (open-mouth interior that
+  // no canonical point stands for), else 0.
+  virtual void Cavity(const Executor& executor, int64_t n, const float* positions, const float* betas,
+                      uint8_t* inside) const = 0;
+
+  virtual int expression_dims() const = 0;
+  virtual std::string ToString() const = 0;
+};
+
+}  // namespace icef
