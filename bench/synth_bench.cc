@@ -5,18 +5,19 @@
 #include <filesystem>
 #include <unistd.h>
 
+#include "icef/face/expression.h"
 #include "icef/synth/ground_truth_renderer.h"
 #include "icef/synth/synthesize.h"
 
 namespace {
 
-using icef::synth::kNumExpressions;
+using icef::face::kNumExpressions;
 
 std::vector<float> Expression(int which) {
   std::vector<float> beta(kNumExpressions, 0.f);
-  if (which == 1) beta[icef::synth::kJawOpen] = 0.5f, beta[icef::synth::kSmileLeft] = 0.4f, beta[icef::synth::kBrowRaiseRight] = 0.3f;
+  if (which == 1) beta[icef::face::kJawOpen] = 0.5f, beta[icef::face::kSmileLeft] = 0.4f, beta[icef::face::kBrowRaiseRight] = 0.3f;
   if (which == 2)
-    for (int e : {icef::synth::kJawOpen, icef::synth::kSmileLeft, icef::synth::kEyeCloseLeft, icef::synth::kCheekPuff})
+    for (int e : {icef::face::kJawOpen, icef::face::kSmileLeft, icef::face::kEyeCloseLeft, icef::face::kCheekPuff})
       beta[e] = 1.5f;
   return beta;
 }

@@ -4,6 +4,7 @@
 
 #include <filesystem>
 
+#include "icef/face/expression.h"
 #include "icef/synth/ground_truth_renderer.h"
 #include "icef/synth/head_model.h"
 #include "icef/synth/synthesize.h"
@@ -39,7 +40,7 @@ TEST(FaceLandmarkDetector, FindsTheSyntheticHeadAndClonesAgree) {
   k.fl_x = k.fl_y = 3.6 * 160;
   k.cx = k.cy = 80;
   const Camera camera = synth::OrbitCamera(k, 3.5, 0, 0);
-  const Image rgba = synth::RenderGroundTruth(head, camera, std::vector<float>(synth::kNumExpressions, 0.f),
+  const Image rgba = synth::RenderGroundTruth(head, camera, std::vector<float>(face::kNumExpressions, 0.f),
                                               Executor(2));
   const Image rgb = CompositeOver(rgba, Vec3f::Ones());
   const FaceLandmarkDetector detector = FaceLandmarkDetector::Load().value();

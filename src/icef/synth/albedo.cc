@@ -5,15 +5,20 @@
 
 #include "icef/synth/head_model.h"
 #include "icef/synth/noise.h"
-#include "icef/synth/sdf_primitives.h"
+#include "icef/face/sdf_primitives.h"
 
 namespace icef::synth {
+
+using face::EllipsoidBump;
+using face::ExpressionState;
+using face::Material;
+using face::SmoothStep;
 
 namespace {
 Vec3f Mix(const Vec3f& a, const Vec3f& b, float t) { return a + t * (b - a); }
 }  // namespace
 
-Vec3f HeadModel::Albedo(const Sample& sample, const Vec3f& x, const ExpressionState& state) const {
+Vec3f HeadModel::Albedo(const face::FaceModel::Sample& sample, const Vec3f& x, const ExpressionState& state) const {
   const Vec3f& p = sample.canonical;
   switch (sample.material) {
     case Material::kEyeball: return EyeAlbedo(p, p.x() < 0.f ? 0 : 1);
@@ -26,7 +31,7 @@ Vec3f HeadModel::Albedo(const Sample& sample, const Vec3f& x, const ExpressionSt
 
 Vec3f HeadModel::SkinAlbedo(const Vec3f& p) const {
   const IdentityParams& id = identity_;
-  const HeadGeometry& g = geometry_;
+  const face::FaceGeometry& g = face_.geometry();
   const uint32_t seed = id.detail_seed;
   Vec3f c = id.skin_tone;
   // Low-frequency blotches and a cheek flush.
@@ -67,7 +72,7 @@ Vec3f HeadModel::SkinAlbedo(const Vec3f& p) const {
   if (ear > 0.f) c = c.cwiseProduct(Vec3f::Ones() + std::min(1.f, 2.f * ear) * Vec3f(0.04f, -0.06f, -0.06f));
   // Lips.
   if (p.z() > g.lip_z - 0.06f && std::abs(p.x()) < g.mouth_half_width * 1.1f) {
-    const float lt = id.lip_thickness;
+    const float lt = id.shape.lip_thickness;
     const float bow = 0.003f * std::exp(-p.x() * p.x() / (0.012f * 0.012f));  // cupid's bow dip
     const float ux = p.x() / (g.mouth_half_width * 1.02f);
     const float uy_up = (p.y() - (g.mouth_y + 0.0085f * lt)) / (0.0095f * lt + (p.y() > g.mouth_y + 0.0085f * lt ? -bow : 0.f));
@@ -101,7 +106,7 @@ Vec3f HeadModel::SkinAlbedo(const Vec3f& p) const {
 }
 
 Vec3f HeadModel::EyeAlbedo(const Vec3f& p, int side) const {
-  const Vec3f q = (p - geometry_.eye_c[side]).normalized();
+  const Vec3f q = (p - face_.geometry().eye_c[side]).normalized();
   const float angle = std::acos(std::clamp(q.z(), -1.f, 1.f));  // from the gaze direction (+z)
   const uint32_t seed = identity_.detail_seed + 11u;
   if (angle < 0.17f) return Vec3f(0.03f, 0.03f, 0.035f);  // pupil
@@ -120,12 +125,12 @@ Vec3f HeadModel::EyeAlbedo(const Vec3f& p, int side) const {
 
 Vec3f HeadModel::LidAlbedo(const Vec3f& p, const ExpressionState& state) const {
   const int side = p.x() < 0.f ? 0 : 1;
-  const Vec3f q = p - geometry_.eye_c[side];
+  const Vec3f q = p - face_.geometry().eye_c[side];
   const float elevation = std::atan2(q.y(), std::max(q.z(), 1e-4f));
   Vec3f c = SkinAlbedo(p).cwiseProduct(Vec3f(0.93f, 0.88f, 0.88f));
   // Lashes along both lid edges (the upper edge moves as the eye closes).
   const float to_upper = std::abs(elevation - state.lid_upper[side]);
-  const float to_lower = std::abs(elevation - geometry_.lid_lower);
+  const float to_lower = std::abs(elevation - face_.geometry().lid_lower);
   const float lash = std::max(1.f - SmoothStep(0.04f, 0.11f, to_upper), 0.6f * (1.f - SmoothStep(0.02f, 0.06f, to_lower)));
   return Mix(c, Vec3f(0.07f, 0.05f, 0.05f), 0.85f * lash);
 }

@@ -24,8 +24,9 @@ Image RenderGroundTruth(const HeadModel& head, const Camera& camera, const std::
                         const Executor& executor, const RenderOptions& options) {
   const Status valid = options.Validate();
   ICEF_CHECK(valid.ok(), valid.message());
-  const ExpressionState state = head.Prepare(expression);
-  const Aabb bounds = head.Bounds();
+  const face::FaceModel& face_model = head.face();
+  const face::ExpressionState state = face_model.Prepare(expression);
+  const Aabb bounds = face_model.Bounds();
   const Vec3f light = options.light_direction.normalized();
   const int w = camera.width(), h = camera.height(), ss = options.supersample;
   Image image(w, h, 4);
@@ -39,12 +40,12 @@ Image RenderGroundTruth(const HeadModel& head, const Camera& camera, const std::
             const Ray ray = camera.RayThrough(x + (sx + 0.5) / ss, y + (sy + 0.5) / ss);
             const auto interval = bounds.Intersect(ray);
             if (!interval) continue;
-            const float t = head.Trace(ray, interval->t_near, interval->t_far, state, options.max_steps);
+            const float t = face_model.Trace(ray, interval->t_near, interval->t_far, state, options.max_steps);
             if (t < 0.f) continue;
             const Vec3f p = ray.At(t);
-            const HeadModel::Sample sample = head.Evaluate(p, state);
+            const face::FaceModel::Sample sample = face_model.Evaluate(p, state);
             const Vec3f albedo = head.Albedo(sample, p, state);
-            const float lambert = std::max(0.f, head.Normal(p, state).dot(light));
+            const float lambert = std::max(0.f, face_model.Normal(p, state).dot(light));
             sum += albedo * (options.ambient + options.diffuse * lambert);
             ++hits;
           }
@@ -60,10 +61,11 @@ Image RenderGroundTruth(const HeadModel& head, const Camera& camera, const std::
 }
 
 LandmarkView ProjectLandmarks(const HeadModel& head, const Camera& camera, const std::vector<float>& expression) {
-  const ExpressionState state = head.Prepare(expression);
-  const std::array<Vec3f, 68> points = head.Landmarks(state);
+  const face::FaceModel& face_model = head.face();
+  const face::ExpressionState state = face_model.Prepare(expression);
+  const std::array<Vec3f, 68> points = face_model.Landmarks(state);
   const Vec3f eye = camera.Center().cast<float>();
-  const Aabb bounds = head.Bounds();
+  const Aabb bounds = face_model.Bounds();
   LandmarkView view;
   for (const Vec3f& p : points) {
     view.landmarks_3d.push_back(p);
@@ -78,7 +80,7 @@ LandmarkView ProjectLandmarks(const HeadModel& head, const Camera& camera, const
         ray.direction = (eye - p).normalized();
         ray.origin = p + 0.02f * ray.direction;
         const auto interval = bounds.Intersect(ray);
-        if (interval) visible = head.Trace(ray, interval->t_near, interval->t_far, state) < 0.f;
+        if (interval) visible = face_model.Trace(ray, interval->t_near, interval->t_far, state) < 0.f;
       }
     }
     view.landmarks_2d.push_back(uv);

@@ -33,7 +33,7 @@ struct RenderOptions {
   std::string ToString() const;
 };
 
-// The RGBA image of the head at `expression` ([kNumExpressions] weights) seen by `camera`.
+// The RGBA image of the head at `expression` ([face::kNumExpressions] weights) seen by `camera`.
 // Deterministic: pixels are independent, so the result does not depend on the thread count.
 Image RenderGroundTruth(const HeadModel& head, const Camera& camera, const std::vector<float>& expression,
                         const Executor& executor = Executor(), const RenderOptions& options = RenderOptions());

@@ -9,6 +9,13 @@
 namespace icef::synth {
 namespace {
 
+using face::ExpressionRegionLandmarks;
+using face::kBrowRaiseLeft;
+using face::kExpressionNames;
+using face::kJawOpen;
+using face::kNumExpressions;
+using face::kSmileLeft;
+
 constexpr int kRes = 64;
 
 Camera TestCamera(double yaw = 0.0, double pitch = 0.0, int res = kRes) {

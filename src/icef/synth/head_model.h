@@ -1,122 +1,44 @@
-// The procedural parametric head: an implicit surface (signed distance bound) in the head frame
-// (+y up, the face looks down +z, the subject's left is +x; the head is ~0.75 tall, centred near
-// the origin, inside [-1, 1]^3 with the neck cut at y = -0.8).
-//
-// Expressions are a smooth, compactly supported space warp from the observed point x to the
-// canonical (neutral) point x_c = Warp(x), so the neutral surface and its albedo move together:
-//   distance(x, beta) = carve(neutral_with_eyelids(Warp(x), beta), mouth_cavity(x, beta)).
-// Eyelids are SDF caps over the eyeballs whose edge angle follows eye_close_*; jaw_open rotates
-// the lower face about a hinge and carves a dark mouth cavity between the lips.
+// A synthetic subject: the face model (face::FaceModel, geometry and expressions) with a
+// procedural albedo (skin, pores, freckles, moles, lips, brows, hair, eyes, eyelids, mouth
+// cavity) that is a function of the canonical point, so the texture moves with every expression.
+// The ground-truth renderer draws it; everything geometric goes through face().
 #pragma once
 
-#include <array>
-#include <cstdint>
 #include <string>
 #include <vector>
 
-#include "icef/math/ray.h"
+#include "icef/face/face_model.h"
 #include "icef/math/types.h"
-#include "icef/synth/expression.h"
 #include "icef/synth/identity.h"
 
 namespace icef::synth {
-
-enum class Material : uint8_t { kSkin, kEyeball, kEyelid, kMouthCavity };
-
-// Anchor positions of the face parts derived from the identity (head frame, canonical space).
-// Index 0 of the paired arrays is the subject's right side (x < 0), index 1 the left (x > 0).
-struct HeadGeometry {
-  Vec3f cranium_c, cranium_r, face_c, face_r, chin_c, chin_r;
-  std::array<Vec3f, 2> cheek_c, ear_c, eye_c, brow_ridge_c, nostril_c;
-  Vec3f cheek_r, ear_r, brow_ridge_r, nostril_r;
-  float eye_r = 0, lid_thickness = 0, brow_y = 0;
-  Vec3f nose_top, nose_tip;
-  float nose_top_r = 0, nose_tip_r = 0;
-  float mouth_y = 0, mouth_half_width = 0, lip_z = 0;
-  Vec3f upper_lip_c, upper_lip_r, lower_lip_c, lower_lip_r;
-  Vec3f neck_a, neck_b;
-  float neck_r = 0, neck_cut_y = 0;
-  Vec3f jaw_hinge;
-  float lid_upper_neutral = 0, lid_lower = 0;  // eyelid edge elevations (radians)
-
-  static HeadGeometry FromIdentity(const IdentityParams& p);
-};
-
-// An expression vector prepared for fast evaluation (derived angles, cavity, active terms).
-struct ExpressionState {
-  std::array<float, kNumExpressions> beta{};
-  float jaw_angle = 0;                     // radians about the hinge's x axis
-  std::array<float, 2> lid_upper{};        // upper-lid edge elevation per eye (radians)
-  bool cavity = false;                     // mouth cavity carved
-  Vec3f cavity_c = Vec3f::Zero(), cavity_r = Vec3f::Ones();  // observation space
-  float step_scale = 0.8f;                 // sphere-tracing step factor (smaller for larger warps)
-  bool neutral = true;                     // all weights zero
-};
 
 class HeadModel {
  public:
   explicit HeadModel(const IdentityParams& identity);
 
   const IdentityParams& identity() const { return identity_; }
-  const HeadGeometry& geometry() const { return geometry_; }
-  // A box holding the surface for expression weights up to ~2 (for ray bounds).
-  Aabb Bounds() const;
+  // The subject's face model (built from identity().shape).
+  const face::FaceModel& face() const { return face_; }
 
-  // Checks the vector with ICEF_CHECK (size kNumExpressions, finite, >= 0; use ValidateExpression
-  // for user input) and precomputes the expression terms.
-  ExpressionState Prepare(const std::vector<float>& expression) const;
-
-  // Observation -> canonical point for the expression (identity where no term is active).
-  Vec3f Warp(const Vec3f& x, const ExpressionState& state) const;
-  // Canonical -> observation point: the inverse of Warp by fixed-point iteration (the warp is a
-  // small smooth displacement). jaw_weight_override >= 0 forces the jaw-rotation weight.
-  Vec3f InverseWarp(const Vec3f& x_c, const ExpressionState& state, float jaw_weight_override = -1.f) const;
-
-  // Signed distance bound at observation point x.
-  float Distance(const Vec3f& x, const ExpressionState& state) const;
-  // Distance plus the material of the closest part and the canonical point.
-  struct Sample {
-    float distance;
-    Material material;
-    Vec3f canonical;
-  };
-  Sample Evaluate(const Vec3f& x, const ExpressionState& state) const;
-  // Surface normal (unit, observation space) by central differences of Distance.
-  Vec3f Normal(const Vec3f& x, const ExpressionState& state) const;
-
-  // Albedo (RGB in [0, 1]) of the surface point: canonical point x_c for skin/eyes/eyelids (so the
-  // texture moves with the expression), observation point x for the mouth cavity.
-  Vec3f Albedo(const Sample& sample, const Vec3f& x, const ExpressionState& state) const;
-
-  // The 68 iBUG-68 landmarks in the head (world) frame for the expression.
-  std::array<Vec3f, 68> Landmarks(const ExpressionState& state) const;
-  // Canonical (neutral) landmarks.
-  const std::array<Vec3f, 68>& NeutralLandmarks() const { return neutral_landmarks_; }
-
-  // Sphere-traces the ray in [t_near, t_far]; returns the hit distance t or a negative value.
-  float Trace(const Ray& ray, float t_near, float t_far, const ExpressionState& state, int max_steps = 192,
-              float epsilon = 2.5e-4f) const;
+  // Albedo (RGB in [0, 1]) of the surface point: canonical point sample.canonical for
+  // skin/eyes/eyelids (so the texture moves with the expression), observation point x for the
+  // mouth cavity.
+  Vec3f Albedo(const face::FaceModel::Sample& sample, const Vec3f& x,
+               const face::ExpressionState& state) const;
 
   std::string ToString() const;
 
  private:
-  // Neutral surface with eyelids at the state's lid angles (canonical space); material optional.
-  float CanonicalDistance(const Vec3f& x_c, const ExpressionState& state, Material* material) const;
-  // Backward displacement (x_c - x) of the jaw rotation and of every bump term.
-  Vec3f JawDisplacement(const Vec3f& x, float angle, float weight_override) const;
-  Vec3f BumpDisplacement(const Vec3f& x, const ExpressionState& state) const;
   Vec3f SkinAlbedo(const Vec3f& p) const;
   Vec3f EyeAlbedo(const Vec3f& p, int side) const;
-  Vec3f LidAlbedo(const Vec3f& p, const ExpressionState& state) const;
-  Vec3f CavityAlbedo(const Vec3f& x, const ExpressionState& state) const;
-  void BuildLandmarksAndMoles();
-  // The first surface point of the neutral head along origin + t * dir (t in [0, 2]).
-  Vec3f ProjectNeutral(const Vec3f& origin, const Vec3f& dir) const;
+  Vec3f LidAlbedo(const Vec3f& p, const face::ExpressionState& state) const;
+  Vec3f CavityAlbedo(const Vec3f& x, const face::ExpressionState& state) const;
+  // Places identity().num_moles moles on the neutral face, drawn from Rng(detail_seed, "synth.moles").
+  void BuildMoles();
 
   IdentityParams identity_;
-  HeadGeometry geometry_;
-  ExpressionState neutral_state_;
-  std::array<Vec3f, 68> neutral_landmarks_;
+  face::FaceModel face_;
   std::vector<Vec3f> moles_;  // canonical surface points
   std::vector<float> mole_radii_;
 };

@@ -14,19 +14,19 @@ IdentityParams IdentityParams::FromSeed(uint64_t seed) {
   Rng rng(seed, StreamId("synth.identity"));
   auto u = [&](double lo, double hi) { return static_cast<float>(rng.Uniform(lo, hi)); };
   IdentityParams p;
-  p.head_width = u(0.90, 1.10);
-  p.head_height = u(0.92, 1.08);
-  p.head_depth = u(0.92, 1.08);
-  p.jaw_width = u(0.84, 1.16);
-  p.chin_length = u(0.80, 1.25);
-  p.nose_length = u(0.82, 1.22);
-  p.nose_width = u(0.80, 1.30);
-  p.nose_bridge = u(0.70, 1.35);
-  p.eye_spacing = u(0.91, 1.09);
-  p.lip_thickness = u(0.70, 1.35);
-  p.brow_height = u(0.75, 1.30);
-  p.cheek_fullness = u(0.75, 1.30);
-  p.mouth_width = u(0.85, 1.18);
+  p.shape.head_width = u(0.90, 1.10);
+  p.shape.head_height = u(0.92, 1.08);
+  p.shape.head_depth = u(0.92, 1.08);
+  p.shape.jaw_width = u(0.84, 1.16);
+  p.shape.chin_length = u(0.80, 1.25);
+  p.shape.nose_length = u(0.82, 1.22);
+  p.shape.nose_width = u(0.80, 1.30);
+  p.shape.nose_bridge = u(0.70, 1.35);
+  p.shape.eye_spacing = u(0.91, 1.09);
+  p.shape.lip_thickness = u(0.70, 1.35);
+  p.shape.brow_height = u(0.75, 1.30);
+  p.shape.cheek_fullness = u(0.75, 1.30);
+  p.shape.mouth_width = u(0.85, 1.18);
 
   // Skin tones along a light-to-dark palette, with a warm/cool tint.
   const Vec3f light(0.93f, 0.76f, 0.66f), mid(0.76f, 0.55f, 0.42f), dark(0.42f, 0.28f, 0.20f);
@@ -54,10 +54,11 @@ IdentityParams IdentityParams::FromSeed(uint64_t seed) {
 
 std::string IdentityParams::ToString() const {
   std::ostringstream os;
-  os << "IdentityParams(head=" << head_width << "x" << head_height << "x" << head_depth << ", jaw=" << jaw_width
-     << ", chin=" << chin_length << ", nose=" << nose_length << "/" << nose_width << "/" << nose_bridge
-     << ", eyes=" << eye_spacing << ", lips=" << lip_thickness << ", brows=" << brow_height
-     << ", cheeks=" << cheek_fullness << ", mouth=" << mouth_width << ", skin=[" << skin_tone.transpose()
+  const face::ShapeParams& s = shape;
+  os << "IdentityParams(head=" << s.head_width << "x" << s.head_height << "x" << s.head_depth << ", jaw=" << s.jaw_width
+     << ", chin=" << s.chin_length << ", nose=" << s.nose_length << "/" << s.nose_width << "/" << s.nose_bridge
+     << ", eyes=" << s.eye_spacing << ", lips=" << s.lip_thickness << ", brows=" << s.brow_height
+     << ", cheeks=" << s.cheek_fullness << ", mouth=" << s.mouth_width << ", skin=[" << skin_tone.transpose()
      << "], freckles=" << freckle_density << ", moles=" << num_moles << ")";
   return os.str();
 }

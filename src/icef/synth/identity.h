@@ -1,30 +1,19 @@
-// Identity of a synthetic subject: face-shape parameters (dimensionless scales around 1) and the
-// albedo parameters (skin tone, blotches, pores, freckles, moles, lips, eyes, hair, brows), all
-// drawn from one identity seed.
+// Identity of a synthetic subject: the face model's shape parameters and the albedo parameters
+// (skin tone, blotches, pores, freckles, moles, lips, eyes, hair, brows), all drawn from one
+// identity seed.
 #pragma once
 
 #include <cstdint>
 #include <string>
 
+#include "icef/face/shape_params.h"
 #include "icef/math/types.h"
 
 namespace icef::synth {
 
 struct IdentityParams {
-  // Shape: multiplicative scales of the average head (1 = average) unless stated.
-  float head_width = 1.f;      // cranium width
-  float head_height = 1.f;     // cranium height
-  float head_depth = 1.f;      // cranium front-to-back depth
-  float jaw_width = 1.f;       // lower-face width
-  float chin_length = 1.f;     // chin drop below the mouth
-  float nose_length = 1.f;     // bridge-to-tip length (also moves the mouth down)
-  float nose_width = 1.f;      // tip and nostril-wing width
-  float nose_bridge = 1.f;     // bridge protrusion
-  float eye_spacing = 1.f;     // distance between the eye centres
-  float lip_thickness = 1.f;   // lip height and protrusion
-  float brow_height = 1.f;     // brow distance above the eyes
-  float cheek_fullness = 1.f;  // cheek volume
-  float mouth_width = 1.f;     // distance between the mouth corners
+  // Face shape: multiplicative scales of the average head (1 = average).
+  face::ShapeParams shape;
 
   // Albedo (linear RGB in [0, 1] as stored in the images).
   Vec3f skin_tone = Vec3f(0.80f, 0.62f, 0.52f);

@@ -1,1 +1,1 @@
-icef_module(synth DEPS icef_data)
+icef_module(synth DEPS icef_data icef_face)

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "icef/synth/sdf_primitives.h"
+#include "icef/face/sdf_primitives.h"
 
 namespace icef::synth {
 
@@ -60,7 +60,7 @@ float CellSpots(const Vec3f& p, float frequency, float density, uint32_t seed) {
   const Vec3f centre(fx + 0.25f + 0.5f * HashToUnit(h2), fy + 0.25f + 0.5f * HashToUnit(h2 * 0x9E3779B1u),
                      fz + 0.25f + 0.5f * HashToUnit(h3 * 0x85EBCA77u));
   const float r = (q - centre).norm() / radius;
-  return 1.f - SmoothStep(0.6f, 1.f, r);
+  return 1.f - face::SmoothStep(0.6f, 1.f, r);
 }
 
 }  // namespace icef::synth

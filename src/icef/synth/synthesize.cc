@@ -6,7 +6,7 @@
 #include <sstream>
 
 #include "icef/core/rng.h"
-#include "icef/synth/expression.h"
+#include "icef/face/expression.h"
 #include "icef/synth/head_model.h"
 
 namespace icef::synth {
@@ -74,36 +74,36 @@ double AngleBetweenDeg(const Camera& a, const Camera& b) {
 // Moderate training expression: 2-4 active parameters in [0.15, 0.65].
 std::vector<float> TrainExpression(uint64_t seed, int k) {
   Rng rng(seed, StreamId("synth.train_expression"), 0, k);
-  std::vector<float> beta(kNumExpressions, 0.f);
+  std::vector<float> beta(face::kNumExpressions, 0.f);
   const int active = 2 + static_cast<int>(rng.Below(3));
-  for (int a = 0; a < active; ++a) beta[rng.Below(kNumExpressions)] = static_cast<float>(rng.Uniform(0.15, 0.65));
+  for (int a = 0; a < active; ++a) beta[rng.Below(face::kNumExpressions)] = static_cast<float>(rng.Uniform(0.15, 0.65));
   return beta;
 }
 
 // A candidate novel expression for a tier (the tier of the result is decided from its delta).
 std::vector<float> NovelCandidate(Tier tier, const std::vector<std::vector<float>>& train, const SynthOptions& o,
                                   Rng& rng) {
-  std::vector<float> beta(kNumExpressions, 0.f);
+  std::vector<float> beta(face::kNumExpressions, 0.f);
   if (tier == Tier::kFar) {
     // Several parameters pushed to 0.9-1.5 on top of a softened training expression.
     const auto& base = train[rng.Below(train.size())];
-    for (int i = 0; i < kNumExpressions; ++i) beta[i] = 0.5f * base[i];
+    for (int i = 0; i < face::kNumExpressions; ++i) beta[i] = 0.5f * base[i];
     const int active = 3 + static_cast<int>(rng.Below(2));
-    for (int a = 0; a < active; ++a) beta[rng.Below(kNumExpressions)] = static_cast<float>(rng.Uniform(0.9, 1.5));
+    for (int a = 0; a < active; ++a) beta[rng.Below(face::kNumExpressions)] = static_cast<float>(rng.Uniform(0.9, 1.5));
     return beta;
   }
   // A training expression moved by a step of the tier's length along 2-4 random parameters.
   beta = train[rng.Below(train.size())];
   const double lo = tier == Tier::kNear ? 0.1 * o.near_threshold : o.near_threshold;
   const double hi = tier == Tier::kNear ? o.near_threshold : o.far_threshold;
-  std::vector<double> dir(kNumExpressions, 0.0);
+  std::vector<double> dir(face::kNumExpressions, 0.0);
   const int active = 2 + static_cast<int>(rng.Below(3));
-  for (int a = 0; a < active; ++a) dir[rng.Below(kNumExpressions)] = rng.Normal();
+  for (int a = 0; a < active; ++a) dir[rng.Below(face::kNumExpressions)] = rng.Normal();
   double norm = 0.0;
   for (double d : dir) norm += d * d;
   norm = std::sqrt(std::max(norm, 1e-12));
   const double step = rng.Uniform(lo, hi);
-  for (int i = 0; i < kNumExpressions; ++i)
+  for (int i = 0; i < face::kNumExpressions; ++i)
     beta[i] = static_cast<float>(std::max(0.0, beta[i] + step * dir[i] / norm));
   return beta;
 }
@@ -205,8 +205,8 @@ Status SynthesizeDataset(const SynthOptions& options, const Executor& executor, 
   Dataset ds;
   ds.root = options.out_dir;
   ds.aabb = Aabb();  // [-1, 1]^3
-  ds.expression_dim = kNumExpressions;
-  ds.expression_names = ExpressionNames();
+  ds.expression_dim = face::kNumExpressions;
+  ds.expression_names = face::ExpressionNames();
   ds.background = options.render.background;
   ds.tier_thresholds = std::array<double, 2>{options.near_threshold, options.far_threshold};
 
@@ -223,7 +223,7 @@ Status SynthesizeDataset(const SynthOptions& options, const Executor& executor, 
                                                     Numbered("train", k))));
     ds.train.push_back(std::move(f));
   }
-  const std::vector<float> neutral(kNumExpressions, 0.f);
+  const std::vector<float> neutral(face::kNumExpressions, 0.f);
   std::vector<Frame> neutral_frames;  // [V]: their landmarks go into the test frames of the view
   for (int v = 0; v < num_views; ++v) {
     ICEF_ASSIGN_OR_RETURN(Frame f, render(MakeFrame(head, plan.test_cameras[v], neutral, Numbered("test_neutral", v))));

@@ -52,7 +52,7 @@ struct SynthOptions {
 
 // A novel or observed test expression with its distance to the training set.
 struct TestExpression {
-  std::vector<float> beta;  // [kNumExpressions]
+  std::vector<float> beta;  // [face::kNumExpressions]
   double delta = 0;         // min_k ||beta - beta_k||_2
   Tier tier = Tier::kObserved;
 };
@@ -61,7 +61,7 @@ struct TestExpression {
 struct SynthPlan {
   Intrinsics intrinsics;
   std::vector<Camera> train_cameras;                 // [K]
-  std::vector<std::vector<float>> train_expressions;  // [K][kNumExpressions]
+  std::vector<std::vector<float>> train_expressions;  // [K][face::kNumExpressions]
   std::vector<Camera> test_cameras;                  // [V]
   std::vector<TestExpression> test_expressions;      // K observed, then near, moderate, far
 };

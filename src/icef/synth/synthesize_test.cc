@@ -9,7 +9,7 @@
 
 #include "icef/io/atomic_file.h"
 #include "icef/synth/contact_sheet.h"
-#include "icef/synth/expression.h"
+#include "icef/face/expression.h"
 
 namespace icef::synth {
 namespace {
@@ -113,8 +113,8 @@ TEST(SynthesizeTest, WritesALoadableDeterministicDataset) {
   const Dataset& ds = *loaded;
   EXPECT_EQ(ds.train.size(), 3u);
   EXPECT_EQ(ds.test.size(), static_cast<size_t>((3 + 3) * 2));
-  EXPECT_EQ(ds.expression_dim, kNumExpressions);
-  EXPECT_EQ(ds.expression_names, ExpressionNames());
+  EXPECT_EQ(ds.expression_dim, face::kNumExpressions);
+  EXPECT_EQ(ds.expression_names, face::ExpressionNames());
   ASSERT_TRUE(ds.tier_thresholds.has_value());
   std::vector<std::vector<float>> train;
   for (const Frame& f : ds.train) {

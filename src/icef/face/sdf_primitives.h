@@ -1,4 +1,4 @@
-// Signed-distance primitives and smooth blending operators for the procedural head (all in head
+// Signed-distance primitives and smooth blending operators for the face model (all in head
 // units, float). The ellipsoid distance is iq's first-order bound, not exact; callers sphere-trace
 // with a step factor < 1.
 #pragma once
@@ -8,7 +8,7 @@
 
 #include "icef/math/types.h"
 
-namespace icef::synth {
+namespace icef::face {
 
 inline float SdSphere(const Vec3f& p, float r) { return p.norm() - r; }
 
@@ -51,4 +51,4 @@ inline float EllipsoidBump(const Vec3f& p, const Vec3f& c, const Vec3f& inv_r) {
   return Bump((p - c).cwiseProduct(inv_r).squaredNorm());
 }
 
-}  // namespace icef::synth
+}  // namespace icef::face

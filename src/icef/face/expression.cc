@@ -1,12 +1,12 @@
-#include "icef/synth/expression.h"
+#include "icef/face/expression.h"
 
 #include <cmath>
 
-namespace icef::synth {
+namespace icef::face {
 
 std::vector<std::string> ExpressionNames() { return {kExpressionNames.begin(), kExpressionNames.end()}; }
 
-Status ValidateExpression(const std::vector<float>& expression) {
+Status ValidateExpression(std::span<const float> expression) {
   if (expression.size() != kNumExpressions)
     return Status::Error("expression: expected " + std::to_string(kNumExpressions) + " values, got " +
                          std::to_string(expression.size()));
@@ -38,4 +38,4 @@ std::vector<int> ExpressionRegionLandmarks(int e) {
   }
 }
 
-}  // namespace icef::synth
+}  // namespace icef::face

@@ -1,11 +1,11 @@
 #include <cmath>
 
-#include "icef/synth/head_model.h"
+#include "icef/face/face_model.h"
 
-namespace icef::synth {
+namespace icef::face {
 
-HeadGeometry HeadGeometry::FromIdentity(const IdentityParams& p) {
-  HeadGeometry g;
+FaceGeometry FaceGeometry::FromShape(const ShapeParams& p) {
+  FaceGeometry g;
   const float eye_y = 0.045f;
   const float eye_x = 0.098f * p.eye_spacing;
   g.cranium_c = Vec3f(0.f, 0.07f, -0.03f);
@@ -54,4 +54,4 @@ HeadGeometry HeadGeometry::FromIdentity(const IdentityParams& p) {
   return g;
 }
 
-}  // namespace icef::synth
+}  // namespace icef::face

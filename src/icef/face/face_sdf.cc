@@ -4,26 +4,25 @@
 #include <cmath>
 #include <sstream>
 
-#include "icef/synth/head_model.h"
-#include "icef/synth/sdf_primitives.h"
+#include "icef/face/face_model.h"
+#include "icef/face/sdf_primitives.h"
 
-namespace icef::synth {
+namespace icef::face {
 
-HeadModel::HeadModel(const IdentityParams& identity)
-    : identity_(identity), geometry_(HeadGeometry::FromIdentity(identity)) {
+FaceModel::FaceModel(const ShapeParams& shape) : shape_(shape), geometry_(FaceGeometry::FromShape(shape)) {
   neutral_state_ = Prepare(std::vector<float>(kNumExpressions, 0.f));
-  BuildLandmarksAndMoles();
+  BuildNeutralLandmarks();
 }
 
-Aabb HeadModel::Bounds() const {
+Aabb FaceModel::Bounds() const {
   Aabb box;
   box.min = Vec3f(-0.36f, -0.81f, -0.42f);
   box.max = Vec3f(0.36f, 0.45f, 0.45f);
   return box;
 }
 
-float HeadModel::CanonicalDistance(const Vec3f& p, const ExpressionState& s, Material* material) const {
-  const HeadGeometry& g = geometry_;
+float FaceModel::CanonicalDistance(const Vec3f& p, const ExpressionState& s, Material* material) const {
+  const FaceGeometry& g = geometry_;
   float d = SmoothMin(SdEllipsoid(p - g.cranium_c, g.cranium_r), SdEllipsoid(p - g.face_c, g.face_r), 0.07f);
   d = SmoothMin(d, SdEllipsoid(p - g.chin_c, g.chin_r), 0.05f);
   const float neck = std::max(SdCone(p, g.neck_a, g.neck_b, g.neck_r, g.neck_r), g.neck_cut_y - p.y());
@@ -67,14 +66,14 @@ float HeadModel::CanonicalDistance(const Vec3f& p, const ExpressionState& s, Mat
   return d;
 }
 
-float HeadModel::Distance(const Vec3f& x, const ExpressionState& s) const {
+float FaceModel::Distance(const Vec3f& x, const ExpressionState& s) const {
   const Vec3f x_c = Warp(x, s);
   float d = CanonicalDistance(x_c, s, nullptr);
   if (s.cavity) d = SmoothMax(d, -SdEllipsoid(x - s.cavity_c, s.cavity_r), 0.004f);
   return d;
 }
 
-HeadModel::Sample HeadModel::Evaluate(const Vec3f& x, const ExpressionState& s) const {
+FaceModel::Sample FaceModel::Evaluate(const Vec3f& x, const ExpressionState& s) const {
   Sample out;
   out.canonical = Warp(x, s);
   out.material = Material::kSkin;
@@ -87,7 +86,7 @@ HeadModel::Sample HeadModel::Evaluate(const Vec3f& x, const ExpressionState& s) 
   return out;
 }
 
-Vec3f HeadModel::Normal(const Vec3f& x, const ExpressionState& s) const {
+Vec3f FaceModel::Normal(const Vec3f& x, const ExpressionState& s) const {
   const float h = 4e-4f;
   const Vec3f k0(1.f, -1.f, -1.f), k1(-1.f, -1.f, 1.f), k2(-1.f, 1.f, -1.f), k3(1.f, 1.f, 1.f);
   const Vec3f n = k0 * Distance(x + h * k0, s) + k1 * Distance(x + h * k1, s) + k2 * Distance(x + h * k2, s) +
@@ -96,7 +95,7 @@ Vec3f HeadModel::Normal(const Vec3f& x, const ExpressionState& s) const {
   return len > 0.f ? Vec3f(n / len) : Vec3f::UnitZ();
 }
 
-float HeadModel::Trace(const Ray& ray, float t_near, float t_far, const ExpressionState& s, int max_steps,
+float FaceModel::Trace(const Ray& ray, float t_near, float t_far, const ExpressionState& s, int max_steps,
                        float epsilon) const {
   float t = t_near;
   for (int i = 0; i < max_steps && t <= t_far; ++i) {
@@ -107,6 +106,6 @@ float HeadModel::Trace(const Ray& ray, float t_near, float t_far, const Expressi
   return -1.f;
 }
 
-std::string HeadModel::ToString() const { return "HeadModel(" + identity_.ToString() + ")"; }
+std::string FaceModel::ToString() const { return "FaceModel(" + shape_.ToString() + ")"; }
 
-}  // namespace icef::synth
+}  // namespace icef::face

@@ -1,16 +1,17 @@
-// The named expression parameters of the synthetic head. Each is a weight in [0, 1] (0 = neutral,
-// 1 = the full expression); values above 1 extrapolate and still give a valid surface. "left" and
-// "right" are the subject's own: the subject's left side is +x and appears on the image's right in
-// a frontal view.
+// The named expression parameters of the face model. Each is a weight >= 0 (0 = neutral, 1 = the
+// full expression); values above 1 extrapolate and still give a valid surface. "left" and "right"
+// are the subject's own: the subject's left side is +x and appears on the image's right in a
+// frontal view.
 #pragma once
 
 #include <array>
+#include <span>
 #include <string>
 #include <vector>
 
 #include "icef/core/status.h"
 
-namespace icef::synth {
+namespace icef::face {
 
 enum ExpressionIndex : int {
   kJawOpen = 0,
@@ -34,10 +35,10 @@ inline constexpr std::array<const char*, kNumExpressions> kExpressionNames = {
 std::vector<std::string> ExpressionNames();
 
 // OK when `expression` has kNumExpressions finite values >= 0; the message names the entry.
-Status ValidateExpression(const std::vector<float>& expression);
+Status ValidateExpression(std::span<const float> expression);
 
 // The iBUG-68 landmark indices whose neighbourhood an expression parameter moves (used by the
 // locality tests and documentation): mouth, jaw, brows or eyes.
 std::vector<int> ExpressionRegionLandmarks(int expression_index);
 
-}  // namespace icef::synth
+}  // namespace icef::face

@@ -4,19 +4,19 @@
 #include <cmath>
 
 #include "icef/core/status.h"
-#include "icef/synth/head_model.h"
-#include "icef/synth/sdf_primitives.h"
+#include "icef/face/face_model.h"
+#include "icef/face/sdf_primitives.h"
 
-namespace icef::synth {
+namespace icef::face {
 
 namespace {
 constexpr float kJawAnglePerUnit = 0.20f;  // radians of jaw rotation at jaw_open = 1
 }  // namespace
 
-ExpressionState HeadModel::Prepare(const std::vector<float>& expression) const {
+ExpressionState FaceModel::Prepare(std::span<const float> expression) const {
   const Status valid = ValidateExpression(expression);
   ICEF_CHECK(valid.ok(), valid.message());
-  const HeadGeometry& g = geometry_;
+  const FaceGeometry& g = geometry_;
   ExpressionState s;
   float max_weight = 0.f;
   for (int i = 0; i < kNumExpressions; ++i) {
@@ -43,8 +43,8 @@ ExpressionState HeadModel::Prepare(const std::vector<float>& expression) const {
   return s;
 }
 
-Vec3f HeadModel::JawDisplacement(const Vec3f& x, float angle, float weight_override) const {
-  const HeadGeometry& g = geometry_;
+Vec3f FaceModel::JawDisplacement(const Vec3f& x, float angle, float weight_override) const {
+  const FaceGeometry& g = geometry_;
   float w = weight_override;
   if (w < 0.f) {
     const float ax = std::max(0.f, std::abs(x.x()) - 0.045f);
@@ -64,8 +64,8 @@ Vec3f HeadModel::JawDisplacement(const Vec3f& x, float angle, float weight_overr
   return rotated - r;
 }
 
-Vec3f HeadModel::BumpDisplacement(const Vec3f& x, const ExpressionState& s) const {
-  const HeadGeometry& g = geometry_;
+Vec3f FaceModel::BumpDisplacement(const Vec3f& x, const ExpressionState& s) const {
+  const FaceGeometry& g = geometry_;
   Vec3f forward = Vec3f::Zero();  // forward motion at x; the backward displacement is its negative
   auto inv = [](float a, float b, float c) { return Vec3f(1.f / a, 1.f / b, 1.f / c); };
   for (int side = 0; side < 2; ++side) {
@@ -102,12 +102,12 @@ Vec3f HeadModel::BumpDisplacement(const Vec3f& x, const ExpressionState& s) cons
   return -forward;
 }
 
-Vec3f HeadModel::Warp(const Vec3f& x, const ExpressionState& s) const {
+Vec3f FaceModel::Warp(const Vec3f& x, const ExpressionState& s) const {
   if (s.neutral) return x;
   return x + JawDisplacement(x, s.jaw_angle, -1.f) + BumpDisplacement(x, s);
 }
 
-Vec3f HeadModel::InverseWarp(const Vec3f& x_c, const ExpressionState& s, float jaw_weight_override) const {
+Vec3f FaceModel::InverseWarp(const Vec3f& x_c, const ExpressionState& s, float jaw_weight_override) const {
   if (s.neutral) return x_c;
   // x_c = x + D(x)  =>  x = x_c - D(x), iterated from x = x_c.
   Vec3f x = x_c;
@@ -120,4 +120,4 @@ Vec3f HeadModel::InverseWarp(const Vec3f& x_c, const ExpressionState& s, float j
   return x;
 }
 
-}  // namespace icef::synth
+}  // namespace icef::face

@@ -1,17 +1,16 @@
-// The 68 iBUG-68 landmarks of the head. Neutral positions are defined per identity by projecting
+// The 68 iBUG-68 landmarks of the face model. Neutral positions are defined per shape by projecting
 // anchor points onto the neutral surface (jaw contour: outwards from inside the head; brows, nose
 // and lips: along -z from the front); eye landmarks lie on the eyelid edges and follow the lid
 // angle; every landmark is then carried to the expression by the inverse warp. The inner lower-lip
 // landmarks (65-67) follow the full jaw rotation, so they stay on the lower lip when the mouth opens.
 #include <cmath>
 
-#include "icef/core/rng.h"
 #include "icef/core/status.h"
-#include "icef/synth/head_model.h"
+#include "icef/face/face_model.h"
 
-namespace icef::synth {
+namespace icef::face {
 
-Vec3f HeadModel::ProjectNeutral(const Vec3f& origin, const Vec3f& dir) const {
+Vec3f FaceModel::ProjectNeutral(const Vec3f& origin, const Vec3f& dir) const {
   const Vec3f d = dir.normalized();
   // March until the sign changes (outside -> inside or inside -> outside), then bisect.
   const bool start_inside = CanonicalDistance(origin, neutral_state_, nullptr) < 0.f;
@@ -40,8 +39,8 @@ Vec3f LidPoint(const Vec3f& centre, float radius, float phi, float a) {
 }
 }  // namespace
 
-void HeadModel::BuildLandmarksAndMoles() {
-  const HeadGeometry& g = geometry_;
+void FaceModel::BuildNeutralLandmarks() {
+  const FaceGeometry& g = geometry_;
   std::array<Vec3f, 68>& lm = neutral_landmarks_;
   const Vec3f back(0.f, 0.f, -1.f);
   auto front = [&](float x, float y) { return ProjectNeutral(Vec3f(x, y, 0.6f), back); };
@@ -69,12 +68,12 @@ void HeadModel::BuildLandmarksAndMoles() {
     lm[27 + j] = front(0.f, y);
   }
   for (int j = 0; j < 5; ++j) {
-    const float x = (j - 2) / 2.f * 0.03f * identity_.nose_width;
+    const float x = (j - 2) / 2.f * 0.03f * shape_.nose_width;
     lm[31 + j] = front(x, g.nose_tip.y() - 0.026f + 0.006f * std::abs(j - 2) / 2.f);
   }
   // 36-47 eyes: placeholders on the neutral lids (recomputed per expression in Landmarks()).
   // 48-59 outer lip contour, 60-67 inner contour.
-  const float mw = g.mouth_half_width, lt = identity_.lip_thickness, my = g.mouth_y;
+  const float mw = g.mouth_half_width, lt = shape_.lip_thickness, my = g.mouth_y;
   const float upper_top = my + 0.017f * lt, lower_bottom = my - 0.019f * lt;
   lm[48] = front(-mw, my);
   lm[49] = front(-0.6f * mw, my + 0.8f * (upper_top - my));
@@ -99,24 +98,10 @@ void HeadModel::BuildLandmarksAndMoles() {
   const std::array<Vec3f, 68> with_eyes = Landmarks(neutral_state_);
   for (int i = 36; i <= 47; ++i) lm[i] = with_eyes[i];
 
-  // Moles: points on the face away from the eyes and the lips.
-  Rng rng(identity_.detail_seed, StreamId("synth.moles"));
-  for (int attempt = 0; attempt < 200 && static_cast<int>(moles_.size()) < identity_.num_moles; ++attempt) {
-    const float x = static_cast<float>(rng.Uniform(-0.17, 0.17));
-    const float y = static_cast<float>(rng.Uniform(-0.27, 0.16));
-    const float radius = static_cast<float>(rng.Uniform(0.004, 0.008));
-    bool ok = std::abs(y - g.mouth_y) > 0.035f || std::abs(x) > g.mouth_half_width + 0.02f;
-    for (int side = 0; side < 2; ++side)
-      ok = ok && Vec2f(x - g.eye_c[side].x(), y - g.eye_c[side].y()).norm() > 0.06f;
-    ok = ok && std::abs(x) > 0.035f;  // keep the nose clean
-    if (!ok) continue;
-    moles_.push_back(front(x, y));
-    mole_radii_.push_back(radius);
-  }
 }
 
-std::array<Vec3f, 68> HeadModel::Landmarks(const ExpressionState& s) const {
-  const HeadGeometry& g = geometry_;
+std::array<Vec3f, 68> FaceModel::Landmarks(const ExpressionState& s) const {
+  const FaceGeometry& g = geometry_;
   std::array<Vec3f, 68> canonical = neutral_landmarks_;
   // Eyes, on the lid edges at the state's lid angles. iBUG order per eye: outer corner, two upper,
   // inner corner, two lower (right eye 36-41 starts at the outer corner, left eye 42-47 at the inner).
@@ -146,4 +131,4 @@ std::array<Vec3f, 68> HeadModel::Landmarks(const ExpressionState& s) const {
   return out;
 }
 
-}  // namespace icef::synth
+}  // namespace icef::face

@@ -1,0 +1,124 @@
+// The face model: a procedural parametric head given as an implicit surface (signed distance
+// bound) in the head frame (+y up, the face looks down +z, the subject's left is +x; the head is
+// ~0.75 tall, centred near the origin, inside [-1, 1]^3 with the neck cut at y = -0.8). Its shape
+// comes from ShapeParams, its expressions from the named weights of face/expression.h; it knows
+// nothing of albedo or rendering. See docs/face_model.md.
+//
+// Expressions are a smooth, compactly supported space warp from the observed point x to the
+// canonical (neutral) point x_c = Warp(x), so the neutral surface (and anything attached to it,
+// such as a texture) moves with the expression:
+//   distance(x, beta) = carve(neutral_with_eyelids(Warp(x), beta), mouth_cavity(x, beta)).
+// Eyelids are SDF caps over the eyeballs whose edge angle follows eye_close_*; jaw_open rotates
+// the lower face about a hinge and carves a mouth cavity between the lips.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "icef/face/expression.h"
+#include "icef/face/shape_params.h"
+#include "icef/math/ray.h"
+#include "icef/math/types.h"
+
+namespace icef::face {
+
+// The part of the head closest to a point.
+enum class Material : uint8_t { kSkin, kEyeball, kEyelid, kMouthCavity };
+
+// Anchor positions of the face parts derived from the shape (head frame, canonical space).
+// Index 0 of the paired arrays is the subject's right side (x < 0), index 1 the left (x > 0).
+struct FaceGeometry {
+  Vec3f cranium_c, cranium_r, face_c, face_r, chin_c, chin_r;
+  std::array<Vec3f, 2> cheek_c, ear_c, eye_c, brow_ridge_c, nostril_c;
+  Vec3f cheek_r, ear_r, brow_ridge_r, nostril_r;
+  float eye_r = 0, lid_thickness = 0, brow_y = 0;
+  Vec3f nose_top, nose_tip;
+  float nose_top_r = 0, nose_tip_r = 0;
+  float mouth_y = 0, mouth_half_width = 0, lip_z = 0;
+  Vec3f upper_lip_c, upper_lip_r, lower_lip_c, lower_lip_r;
+  Vec3f neck_a, neck_b;
+  float neck_r = 0, neck_cut_y = 0;
+  Vec3f jaw_hinge;
+  float lid_upper_neutral = 0, lid_lower = 0;  // eyelid edge elevations (radians)
+
+  static FaceGeometry FromShape(const ShapeParams& p);
+};
+
+// An expression vector prepared for fast evaluation (derived angles, cavity, active terms).
+struct ExpressionState {
+  std::array<float, kNumExpressions> beta{};
+  float jaw_angle = 0;                     // radians about the hinge's x axis
+  std::array<float, 2> lid_upper{};        // upper-lid edge elevation per eye (radians)
+  bool cavity = false;                     // mouth cavity carved
+  Vec3f cavity_c = Vec3f::Zero(), cavity_r = Vec3f::Ones();  // observation space
+  float step_scale = 0.8f;                 // sphere-tracing step factor (smaller for larger warps)
+  bool neutral = true;                     // all weights zero
+};
+
+class FaceModel {
+ public:
+  explicit FaceModel(const ShapeParams& shape);
+
+  const ShapeParams& shape() const { return shape_; }
+  const FaceGeometry& geometry() const { return geometry_; }
+  // A box holding the surface for expression weights up to ~2 (for ray bounds).
+  Aabb Bounds() const;
+
+  // Checks the weights with ICEF_CHECK (kNumExpressions values, finite, >= 0; use
+  // ValidateExpression for user input) and precomputes the expression terms.
+  ExpressionState Prepare(std::span<const float> expression) const;
+  ExpressionState Prepare(const std::vector<float>& expression) const {
+    return Prepare(std::span<const float>(expression));
+  }
+
+  // Observation -> canonical point for the expression (identity where no term is active).
+  Vec3f Warp(const Vec3f& x, const ExpressionState& state) const;
+  // Canonical -> observation point: the inverse of Warp by fixed-point iteration (the warp is a
+  // small smooth displacement). jaw_weight_override >= 0 forces the jaw-rotation weight.
+  Vec3f InverseWarp(const Vec3f& x_c, const ExpressionState& state, float jaw_weight_override = -1.f) const;
+
+  // Signed distance bound at observation point x.
+  float Distance(const Vec3f& x, const ExpressionState& state) const;
+  // Distance plus the material of the closest part and the canonical point.
+  struct Sample {
+    float distance;
+    Material material;
+    Vec3f canonical;
+  };
+  Sample Evaluate(const Vec3f& x, const ExpressionState& state) const;
+  // Surface normal (unit, observation space) by central differences of Distance.
+  Vec3f Normal(const Vec3f& x, const ExpressionState& state) const;
+
+  // Sphere-traces the ray in [t_near, t_far]; returns the hit distance t or a negative value.
+  float Trace(const Ray& ray, float t_near, float t_far, const ExpressionState& state, int max_steps = 192,
+              float epsilon = 2.5e-4f) const;
+
+  // The 68 iBUG-68 landmarks in the head frame for the expression (observation space).
+  std::array<Vec3f, 68> Landmarks(const ExpressionState& state) const;
+  // Canonical (neutral) landmarks.
+  const std::array<Vec3f, 68>& NeutralLandmarks() const { return neutral_landmarks_; }
+  // The first crossing of the neutral surface (outside -> inside, or inside -> outside when the
+  // origin is inside) along origin + t * normalised(dir), t in [0, 2]: a 0.002 march, then 30
+  // bisection steps. Canonical space. ICEF_CHECK fails when nothing is crossed.
+  Vec3f ProjectNeutral(const Vec3f& origin, const Vec3f& dir) const;
+
+  std::string ToString() const;
+
+ private:
+  // Neutral surface with eyelids at the state's lid angles (canonical space); material optional.
+  float CanonicalDistance(const Vec3f& x_c, const ExpressionState& state, Material* material) const;
+  // Backward displacement (x_c - x) of the jaw rotation and of every bump term.
+  Vec3f JawDisplacement(const Vec3f& x, float angle, float weight_override) const;
+  Vec3f BumpDisplacement(const Vec3f& x, const ExpressionState& state) const;
+  void BuildNeutralLandmarks();
+
+  ShapeParams shape_;
+  FaceGeometry geometry_;
+  ExpressionState neutral_state_;
+  std::array<Vec3f, 68> neutral_landmarks_;
+};
+
+}  // namespace icef::face

@@ -1,0 +1,1 @@
+icef_module(face DEPS icef_math)
