@@ -8,6 +8,7 @@ PACKAGES=(
   libeigen3-dev nlohmann-json3-dev libcli11-dev libstb-dev libgif-dev
   libpng-dev libjpeg62-turbo-dev zlib1g-dev  # image reading (libpng, libjpeg-turbo)
   libgtest-dev libgmock-dev libbenchmark-dev
+  libceres-dev  # the face-model fit (Ceres)
   libdlib-dev libdlib-data opencv-doc python3-skimage python-matplotlib-data  # eval: face alignment, test photos
   gnuplot-nox  # bench: report plots (PNG + SVG)
 )

@@ -86,6 +86,12 @@ Result<TrainSummary> RunTrain(const TrainAppOptions& o, std::ostream& out) {
       << " training frames), " << config.train.steps << " steps";
   if (config.train.time_budget_seconds > 0) out << " or " << config.train.time_budget_seconds << " s";
   out << (o.resume ? ", resuming at step " + std::to_string(trainer->step()) : "") << "\n";
+  if (const std::optional<face::FaceFit>& fit = trainer->model().setup().face_fit) {
+    out << fit->BriefReport() << "\n";
+    if (fit->Poor())
+      out << "warning: the face model fits the landmarks poorly (RMS above 0.1 inter-ocular distances): the prior "
+             "will pull expressions to the wrong places; check the dataset's landmarks and expression vectors\n";
+  }
   if (config.train.lambda_symmetry > 0) {
     const std::optional<SymmetryPlane>& plane = trainer->model().symmetry_plane();
     if (!plane) {

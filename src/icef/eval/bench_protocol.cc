@@ -23,7 +23,7 @@ namespace icef::eval {
 void BenchOptions::ApplyQuick() {
   identities = 1;
   ks = {3};
-  methods = {"icef", "icef-no-conf", "icef-uniform", "warp", "nerface"};
+  methods = {"icef-prior", "warp-prior", "icef", "icef-no-conf", "icef-uniform", "warp", "nerface"};
   resolution = 32;
   test_views = 1;
   novel_per_tier = 1;

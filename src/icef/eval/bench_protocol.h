@@ -43,7 +43,7 @@ struct BenchOptions {
   std::vector<int> ks = {3, 5, 10};
   // Methods (names of model/method.h).
   // (icef-no-id is left out: it trains the same model as warp, see model/method.h.)
-  std::vector<std::string> methods = {"icef", "icef-no-conf", "icef-uniform", "warp", "nerface"};
+  std::vector<std::string> methods = {"icef-prior", "warp-prior", "icef", "icef-no-conf", "icef-uniform", "warp", "nerface"};
   // Image width = height in pixels.
   int resolution = 128;
   // Held-out test views per dataset.

@@ -76,6 +76,16 @@ class FaceModel {
 
   // Observation -> canonical point for the expression (identity where no term is active).
   Vec3f Warp(const Vec3f& x, const ExpressionState& state) const;
+  // The face model's whole observation -> canonical map for a deformation model (DESIGN.md §2.1):
+  // Warp, then the eyelid slide. In the surface itself a closing eye is a lid cap whose edge angle
+  // changes (not a warp); the slide stands for it as a warp: a point on the closing upper lid, at
+  // elevation theta about the eye centre's x axis between the state's lid edge and the top of the
+  // eye, maps to the neutral lid by rotating [edge, top] onto [neutral edge, top], so a canonical
+  // (neutral) head with open eyes renders closed eyes. Exposed eyeball and skin are unchanged.
+  Vec3f PriorWarp(const Vec3f& x, const ExpressionState& state) const;
+  // The eyelid slide alone, on a canonical point of Warp.
+  Vec3f LidSlide(const Vec3f& x_c, const ExpressionState& state) const;
+
   // Canonical -> observation point: the inverse of Warp by fixed-point iteration (the warp is a
   // small smooth displacement). jaw_weight_override >= 0 forces the jaw-rotation weight.
   Vec3f InverseWarp(const Vec3f& x_c, const ExpressionState& state, float jaw_weight_override = -1.f) const;

@@ -1,1 +1,2 @@
-icef_module(face DEPS icef_math)
+find_package(Ceres REQUIRED)  # the face-model fit (face_fit.cc)
+icef_module(face DEPS icef_math Ceres::ceres)

@@ -3,7 +3,7 @@
 namespace icef {
 
 void ModelConfig::Bind(ConfigSchema& s) {
-  s.String("method", &method, "method: icef, icef-no-id, icef-no-conf, icef-uniform, warp or nerface (DESIGN.md §2)");
+  s.String("method", &method, "method: icef, icef-no-id, icef-no-conf, icef-uniform, warp, nerface, icef-prior or warp-prior (DESIGN.md §2, §2.1)");
   s.Int("grid_levels", &grid_levels, "hash grid levels L");
   s.Int("grid_features", &grid_features, "hash grid features per level F");
   s.Int("grid_log2_table_size", &grid_log2_table_size, "log2 of the hashed table size T per level");

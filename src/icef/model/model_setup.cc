@@ -42,6 +42,24 @@ Json ModelSetup::ToJson() const {
                     {"transform_matrix", m}});
   }
   j["training_cameras"] = cams;
+  if (face_fit) {
+    const face::FaceFit& f = *face_fit;
+    Json shape = Json::object();
+    const auto values = f.shape.ToArray();
+    for (int i = 0; i < face::ShapeParams::kCount; ++i) shape[face::kShapeParamNames[i]] = values[i];
+    const face::Similarity& sim = f.head_from_world;
+    Json rot = Json::array();
+    for (int r = 0; r < 3; ++r) rot.push_back({sim.rotation(r, 0), sim.rotation(r, 1), sim.rotation(r, 2)});
+    j["face_fit"] = {{"shape", shape},
+                     {"head_from_world", {{"scale", sim.scale},
+                                          {"rotation", rot},
+                                          {"translation", {sim.translation.x(), sim.translation.y(), sim.translation.z()}}}},
+                     {"rms_iod", f.rms_iod},
+                     {"max_iod", f.max_iod},
+                     {"landmarks_used", f.landmarks_used},
+                     {"landmarks_total", f.landmarks_total},
+                     {"iterations", f.iterations}};
+  }
   return j;
 }
 
@@ -82,6 +100,35 @@ Result<ModelSetup> ModelSetup::FromJson(const Json& json, const std::string& ori
   }
   if (s.training_cameras.size() != s.training_expressions.size())
     return v.Error("training_cameras", "expected one camera per training expression");
+  if (v.Has("face_fit")) {
+    ICEF_ASSIGN_OR_RETURN(const JsonObjectView fv, v.Object("face_fit"));
+    face::FaceFit f;
+    ICEF_ASSIGN_OR_RETURN(const JsonObjectView shape, fv.Object("shape"));
+    std::array<float, face::ShapeParams::kCount> values;
+    for (int i = 0; i < face::ShapeParams::kCount; ++i) {
+      ICEF_ASSIGN_OR_RETURN(const double x, shape.Number(face::kShapeParamNames[i]));
+      if (!(x > 0)) return shape.Error(face::kShapeParamNames[i], "must be > 0");
+      values[i] = static_cast<float>(x);
+    }
+    f.shape = face::ShapeParams::FromArray(values);
+    ICEF_ASSIGN_OR_RETURN(const JsonObjectView sim, fv.Object("head_from_world"));
+    ICEF_ASSIGN_OR_RETURN(f.head_from_world.scale, sim.Number("scale"));
+    if (!(f.head_from_world.scale > 0)) return sim.Error("scale", "must be > 0");
+    ICEF_ASSIGN_OR_RETURN(const auto rot, sim.NumberMatrix("rotation", 3, 3));
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) f.head_from_world.rotation(r, c) = rot[r][c];
+    const Mat3d& rm = f.head_from_world.rotation;
+    if ((rm * rm.transpose() - Mat3d::Identity()).norm() > 1e-4 || rm.determinant() < 0)
+      return sim.Error("rotation", "must be a rotation matrix");
+    ICEF_ASSIGN_OR_RETURN(const auto t, sim.NumberArray("translation", 3));
+    f.head_from_world.translation = Vec3d(t[0], t[1], t[2]);
+    ICEF_ASSIGN_OR_RETURN(f.rms_iod, fv.Number("rms_iod"));
+    ICEF_ASSIGN_OR_RETURN(f.max_iod, fv.Number("max_iod"));
+    ICEF_ASSIGN_OR_RETURN(f.landmarks_used, fv.Int("landmarks_used"));
+    ICEF_ASSIGN_OR_RETURN(f.landmarks_total, fv.Int("landmarks_total"));
+    ICEF_ASSIGN_OR_RETURN(f.iterations, fv.Int("iterations"));
+    s.face_fit = f;
+  }
   return s;
 }
 

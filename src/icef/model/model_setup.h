@@ -1,14 +1,17 @@
 // What a model takes from its training dataset and keeps for its whole life (saved in every
 // checkpoint, so rendering and evaluation need only the model directory): the aabb, the
 // expression space, the observed training expressions (for the confidence kappa and beta_n), the
-// 68 landmarks the region mask is built from, and the background colour.
+// 68 landmarks the region mask is built from, the background colour, and (for the methods on the
+// face-model prior) the face model fitted to the training frames.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "icef/core/parallel.h"
 #include "icef/data/dataset.h"
+#include "icef/face/face_fit.h"
 #include "icef/io/json_util.h"
 #include "icef/math/camera.h"
 #include "icef/math/ray.h"
@@ -24,6 +27,7 @@ struct ModelSetup {
   std::string mask_source;                            // where the landmarks came from
   Vec3f background = Vec3f::Ones();
   std::vector<Camera> training_cameras;               // [K] (renders default to their intrinsics and views)
+  std::optional<face::FaceFit> face_fit;              // the fitted face model (model/face_prior.h), if any
 
   // From a loaded dataset's training split; the landmarks come from RegionMask::FromDataset's
   // rules (mean landmarks_3d, else triangulated landmarks_2d).

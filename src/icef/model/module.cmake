@@ -1,1 +1,1 @@
-icef_module(model DEPS icef_field icef_render)
+icef_module(model DEPS icef_field icef_render icef_face)

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "icef/io/atomic_file.h"
+#include "icef/model/face_prior.h"
 #include "icef/model/render_image.h"
 #include "icef/train/visual_hull.h"
 
@@ -79,7 +80,10 @@ Result<std::unique_ptr<Trainer>> Trainer::Create(const Dataset& dataset, const f
   ICEF_RETURN_IF_ERROR(config.Validate());
   const Executor executor(config.train.threads);
   ICEF_ASSIGN_OR_RETURN(TrainingData data, TrainingData::Load(dataset));
-  ICEF_ASSIGN_OR_RETURN(const ModelSetup setup, ModelSetup::FromDataset(dataset, executor));
+  ICEF_ASSIGN_OR_RETURN(ModelSetup setup, ModelSetup::FromDataset(dataset, executor));
+  if (UsesFacePrior(config.model.ParsedMethod())) {
+    ICEF_ASSIGN_OR_RETURN(setup.face_fit, FitFaceModelToDataset(dataset));
+  }
   ICEF_ASSIGN_OR_RETURN(std::unique_ptr<AvatarModel> model, AvatarModel::Create(config.model, setup, executor));
   model->Initialize(static_cast<uint64_t>(config.train.seed));
   if (config.model.visual_hull && data.has_alpha()) {

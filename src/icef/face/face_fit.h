@@ -1,0 +1,72 @@
+// Fitting the face model to a subject (DESIGN.md §2.1): shape parameters shared by all frames and
+// one similarity transform head_from_world (dataset world frame -> head frame), from the 68
+// landmarks of frames whose expressions are known (weights in the face model's expression order).
+// Landmarks are 3D (world frame) when a frame has them, else 2D (pixels) reprojected through the
+// frame's calibrated camera. Robust nonlinear least squares (Ceres, Levenberg-Marquardt): residuals
+// in inter-ocular distances (IOD), a Gaussian plausibility prior on the shape scales around the
+// average head, and a second pass without the landmarks the first pass left far off (outliers).
+#pragma once
+
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "icef/core/status.h"
+#include "icef/face/shape_params.h"
+#include "icef/math/camera.h"
+#include "icef/math/types.h"
+
+namespace icef::face {
+
+// x_head = scale * rotation * x_world + translation.
+struct Similarity {
+  double scale = 1.0;
+  Mat3d rotation = Mat3d::Identity();
+  Vec3d translation = Vec3d::Zero();
+
+  Vec3d Apply(const Vec3d& x_world) const { return scale * (rotation * x_world) + translation; }
+  Vec3d ApplyInverse(const Vec3d& x_head) const { return rotation.transpose() * (x_head - translation) / scale; }
+  std::string ToString() const;
+};
+
+// One frame of the fit: its expression and its landmarks (3D, else 2D with the camera).
+struct FitFrame {
+  std::vector<float> expression;                   // [kNumExpressions], face-model order
+  std::optional<std::vector<Vec3f>> landmarks_3d;  // [68] world frame
+  std::optional<std::vector<Vec2f>> landmarks_2d;  // [68] pixels
+  std::optional<Camera> camera;                    // needed with landmarks_2d only
+};
+
+struct FaceFitOptions {
+  double shape_prior_sigma = 0.15;  // std of each shape scale around 1 (the plausibility prior)
+  bool fit_shape = true;            // false: the average head, similarity only
+  int max_iterations = 60;          // Levenberg-Marquardt iterations per pass
+  double outlier_iod = 0.08;        // second pass: drop landmarks farther than this (IOD) and 3x the median
+
+  Status Validate() const;
+  std::string ToString() const;
+};
+
+struct FaceFit {
+  ShapeParams shape;
+  Similarity head_from_world;
+  double rms_iod = 0;       // RMS landmark residual of the final pass (inter-ocular distances)
+  double max_iod = 0;       // largest landmark residual
+  int landmarks_used = 0;   // after outlier removal
+  int landmarks_total = 0;
+  int iterations = 0;
+
+  // A fit worth warning about: RMS above 0.1 IOD.
+  bool Poor() const { return rms_iod > 0.1; }
+  std::string BriefReport() const;
+};
+
+// The inter-ocular distance of landmarks (distance between the centres of 36-41 and 42-47).
+double InterOcularDistance(std::span<const Vec3f> landmarks);
+
+// Errors: no frames, a frame with a wrong expression size or negative/non-finite weights, no
+// landmarks, a 2D frame without a camera, invalid options, a solve that fails.
+Result<FaceFit> FitFaceModel(std::span<const FitFrame> frames, const FaceFitOptions& options = {});
+
+}  // namespace icef::face
