@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # icef synth end to end: a tiny dataset, read back by `icef info`, rendered twice to the same
-# bytes, a contact sheet from `icef sheet`, and a bad option rejected with exit code 1.
+# bytes, the face model fitted to it (icef mask), a contact sheet from `icef sheet`, and a bad
+# option rejected with exit code 1.
 set -euo pipefail
 ICEF="$1"
 WORK="$(mktemp -d)"
@@ -16,6 +17,13 @@ grep -q "observed 6 near 2 moderate 2 far 2" "$WORK/info.txt"
 
 "$ICEF" synth --out "$WORK/b" --identity-seed 3 --k 3 --res 32 --test-views 2 --novel-per-tier 1 --threads 1 > /dev/null
 diff -r "$WORK/a" "$WORK/b"  # deterministic: same seed, same bytes (any thread count)
+
+# The face model fitted to the synthetic subject's landmarks, outlined by icef mask.
+"$ICEF" mask "$WORK/a" --out "$WORK/mask" --threads 2 > "$WORK/mask.txt"
+test -s "$WORK/mask/fit_frame0.png"
+rms=$(sed -n 's/^face fit: landmark RMS \([0-9.e-]*\) IOD.*/\1/p' "$WORK/mask.txt")
+test -n "$rms"
+awk -v r="$rms" 'BEGIN { exit !(r < 0.02) }' || { echo "face fit RMS $rms IOD, expected < 0.02"; exit 1; }
 
 "$ICEF" sheet "$WORK/a" --out "$WORK/sheet.png" --tile 32 > /dev/null
 test -s "$WORK/sheet.png"

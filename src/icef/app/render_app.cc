@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <sstream>
 
+#include "icef/app/face_outline.h"
 #include "icef/data/dataset.h"
 #include "icef/io/atomic_file.h"
 #include "icef/io/gif_writer.h"
@@ -204,6 +205,12 @@ Result<std::vector<RenderedFrameInfo>> RunRender(const RenderAppOptions& o, std:
     ICEF_RETURN_IF_ERROR(WritePng(o.out / (std::string("mask_") + name + ".png"), mask_rgb));
     ICEF_RETURN_IF_ERROR(WritePng(o.out / (std::string("deformation_") + name + ".png"), deform_rgb));
     const std::vector<float>& beta = betas[std::min(i, betas.size() - 1)];
+    if (setup.face_fit) {  // the fitted face model at this expression, over the render
+      Image outline = r.color;
+      DrawFaceOutline(&outline, cameras[std::min(i, cameras.size() - 1)], FittedLandmarks(*setup.face_fit, beta),
+                      Vec3f(1.f, 0.85f, 0.1f));
+      ICEF_RETURN_IF_ERROR(WritePng(o.out / (std::string("fit_") + name + ".png"), outline));
+    }
     infos.push_back({color_path.string(), beta, r.nearest});
     Json f;
     f["index"] = i;

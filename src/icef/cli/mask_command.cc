@@ -6,6 +6,9 @@
 //    through a mouth, eye or brow region. Landmarks are drawn on top: green for the 36 expression
 //    landmarks (brows, eyes, mouth), blue for the others.
 //  - mask_projection_frame<I>.png: the same projection as a grey image (white = 1).
+//  - fit_frame<I>.png: when the dataset is in the face model's expression space, the face model
+//    fitted to the training landmarks (what the *-prior methods stand on), outlined in yellow over
+//    training image I; the fit's residual is printed.
 //  - mask_slice_{xy,xz,yz}.png: M on axis-aligned planes through the landmark centroid, covering
 //    the aabb (xy: x right, y up; xz: x right, z up; yz: z right, y up), heat-coloured.
 #include <algorithm>
@@ -15,11 +18,13 @@
 #include <memory>
 #include <string>
 
+#include "icef/app/face_outline.h"
 #include "icef/cli/commands.h"
 #include "icef/core/parallel.h"
 #include "icef/data/dataset.h"
 #include "icef/field/region_mask.h"
 #include "icef/io/image.h"
+#include "icef/model/face_prior.h"
 
 namespace icef::cli {
 namespace {
@@ -131,6 +136,19 @@ Status RunMask(const MaskArgs& args) {
   std::cout << "mask: " << mask.source() << "; inter-ocular distance " << mask.inter_ocular_distance()
             << "; landmark centroid [" << centre.x() << ", " << centre.y() << ", " << centre.z() << "]\n";
   std::cout << overlay_path.string() << "\n" << projection_path.string() << "\n";
+  if (CheckFaceModelExpressions(dataset.expression_names, args.dataset).ok()) {
+    const Result<face::FaceFit> fit = FitFaceModelToDataset(dataset);
+    if (fit.ok()) {
+      Image outlined = rgb;
+      DrawFaceOutline(&outlined, camera, FittedLandmarks(*fit, frame.expression), Vec3f(1.f, 0.85f, 0.1f));
+      const fs::path fit_path = out / ("fit" + suffix);
+      ICEF_RETURN_IF_ERROR(WritePng(fit_path, outlined));
+      std::cout << fit->BriefReport() << (fit->Poor() ? " (poor: check the landmarks and expressions)" : "") << "\n"
+                << fit_path.string() << "\n";
+    } else {
+      std::cout << "face model: not fitted (" << fit.status().message() << ")\n";
+    }
+  }
   for (const auto& plane : planes) {
     const fs::path path = out / (std::string("mask_slice_") + plane.name + ".png");
     ICEF_RETURN_IF_ERROR(WritePng(path, Slice(mask, dataset.aabb, centre, plane.u, plane.v, 256)));

@@ -10,7 +10,8 @@ CommandFn RegisterRender(CLI::App& app) {
   app.description(
       "Render a trained model: colour, depth, region mask M and deformation magnitude as PNGs per frame, "
       "animated GIFs for sequences, and frames.json with delta, kappa and the nearest observed expression of "
-      "every frame (also printed).");
+      "every frame (also printed). Models on the face-model prior (icef-prior, warp-prior) also get fit_NNN.png: "
+      "the fitted face model's outline at the frame's expression over the colour render.");
   auto o = std::make_shared<RenderAppOptions>();
   auto frame = std::make_shared<std::string>();
   auto dataset = std::make_shared<std::string>();
