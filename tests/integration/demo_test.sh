@@ -8,7 +8,8 @@ trap 'rm -rf "$TMP"' EXIT
 "$ICEF" demo --quick --out "$TMP/demo" --threads 2 > "$TMP/log"
 for f in data/transforms_train.json model/checkpoint.icef model/summary.json model/train_log.jsonl \
          turntable/color.gif turntable/color_000.png turntable/depth_000.png turntable/frames.json \
-         sweep_jaw_open/color.gif sweep_smile_left/frames.json sweep_brow_raise_right/mask_000.png; do
+         sweep_jaw_open/color.gif sweep_smile_left/frames.json sweep_brow_raise_right/mask_000.png \
+         sweep_jaw_open/compare.gif sweep_smile_left/compare_002.png; do
   [ -s "$TMP/demo/$f" ] || { echo "demo did not write $f" >&2; cat "$TMP/log" >&2; exit 1; }
 done
 grep -q "ICEF demo finished" "$TMP/log"

@@ -5,11 +5,43 @@
 #include "icef/app/render_app.h"
 #include "icef/app/train_app.h"
 #include "icef/core/progress.h"
+#include "icef/data/dataset.h"
+#include "icef/io/gif_writer.h"
+#include "icef/io/image.h"
+#include "icef/synth/ground_truth_renderer.h"
 #include "icef/synth/synthesize.h"
 
 namespace icef {
 
 namespace fs = std::filesystem;
+
+namespace {
+
+// The sweep's renders beside the ground truth of the same expressions and view: compare_NNN.png
+// and compare.gif (model left, truth right) in the sweep's directory.
+Status WriteSweepComparison(const synth::HeadModel& head, const Camera& camera, const Vec3f& background,
+                            const std::vector<RenderedFrameInfo>& frames, const fs::path& dir, int delay_cs,
+                            const Executor& executor) {
+  std::vector<Image> pairs;
+  for (size_t i = 0; i < frames.size(); ++i) {
+    ICEF_ASSIGN_OR_RETURN(const Image render, ReadImage(frames[i].color_path));
+    const Image truth = CompositeOver(synth::RenderGroundTruth(head, camera, frames[i].beta, executor), background);
+    Image pair(render.width + truth.width, std::max(render.height, truth.height), 3, 1.f);
+    for (int y = 0; y < render.height; ++y)
+      for (int x = 0; x < render.width; ++x)
+        for (int c = 0; c < 3; ++c) pair.At(x, y, c) = render.At(x, y, std::min(c, render.channels - 1));
+    for (int y = 0; y < truth.height; ++y)
+      for (int x = 0; x < truth.width; ++x)
+        for (int c = 0; c < 3; ++c) pair.At(render.width + x, y, c) = truth.At(x, y, c);
+    char name[32];
+    std::snprintf(name, sizeof name, "compare_%03zu.png", i);
+    ICEF_RETURN_IF_ERROR(WritePng(dir / name, pair));
+    pairs.push_back(std::move(pair));
+  }
+  return WriteGif(dir / "compare.gif", pairs, delay_cs);
+}
+
+}  // namespace
 
 Status RunDemo(const DemoOptions& given, std::ostream& out) {
   DemoOptions o = given;
@@ -53,6 +85,9 @@ Status RunDemo(const DemoOptions& given, std::ostream& out) {
   std::ostringstream quiet;
   ICEF_RETURN_IF_ERROR(RunRender(turntable, quiet).status());
 
+  ICEF_ASSIGN_OR_RETURN(const Dataset dataset, LoadDataset(data_dir));
+  if (dataset.test.empty()) return Status::Error(data_dir.string() + ": the demo dataset has no test frames");
+  const synth::HeadModel head(synth::IdentityParams::FromSeed(o.identity_seed));
   out << "== 4/4 rendering expression sweeps (neutral -> 1.5 x target: past every training expression)\n";
   std::vector<fs::path> sweeps;
   for (const char* target : {"jaw_open=1.0", "smile_left=1.0", "brow_raise_right=1.0"}) {
@@ -63,7 +98,11 @@ Status RunDemo(const DemoOptions& given, std::ostream& out) {
     sweep.sweep = target;
     sweep.sweep_frames = o.sweep_frames;
     sweep.threads = o.threads;
+    sweep.dataset = data_dir;
+    sweep.frame = "test:0";  // a held-out view, where the ground truth can be rendered beside it
     ICEF_ASSIGN_OR_RETURN(const auto frames, RunRender(sweep, quiet));
+    ICEF_RETURN_IF_ERROR(WriteSweepComparison(head, dataset.test[0].camera, dataset.background, frames, sweep.out,
+                                              sweep.gif_delay_cs, executor));
     out << "  " << name << ": kappa " << frames.front().nearest.kappa << " -> " << frames.back().nearest.kappa
         << " (delta " << frames.back().nearest.delta << " at the end)\n";
     sweeps.push_back(sweep.out);
@@ -74,7 +113,9 @@ Status RunDemo(const DemoOptions& given, std::ostream& out) {
   out << "  dataset:    " << data_dir.string() << "   (inspect with: build/icef info " << data_dir.string() << ")\n";
   out << "  model:      " << model_dir.string() << "   (summary.json, train_log.jsonl, checkpoint.icef)\n";
   out << "  turntable:  " << (o.out / "turntable" / "color.gif").string() << "  (+ depth, mask, deformation)\n";
-  for (const fs::path& s : sweeps) out << "  sweep:      " << (s / "color.gif").string() << "\n";
+  for (const fs::path& s : sweeps)
+    out << "  sweep:      " << (s / "color.gif").string() << "  (beside the ground truth: " << (s / "compare.gif").string()
+        << ")\n";
   return Status::Ok();
 }
 

@@ -87,8 +87,7 @@ Status CheckFaceModelExpressions(const std::vector<std::string>& expression_name
   return Status::Error(origin + ": the face-model prior needs the face model's " + std::to_string(want.size()) +
                        " expressions (jaw_open, smile_left, ...; docs/face_model.md), but expression_names are [" +
                        (got.empty() ? std::string("none") : got) +
-                       "]: re-express the dataset with `icef track DATASET --keep-cameras --out NEW`, or use a "
-                       "method without the prior (icef, warp, nerface)");
+                       "]: train this dataset with a method without the prior (icef, warp, nerface)");
 }
 
 Result<face::FaceFit> FitFaceModelToDataset(const Dataset& dataset, const face::FaceFitOptions& options) {
