@@ -6,6 +6,7 @@
 #include "icef/app/train_app.h"
 #include "icef/core/progress.h"
 #include "icef/data/dataset.h"
+#include "icef/model/model_config.h"
 #include "icef/io/gif_writer.h"
 #include "icef/io/image.h"
 #include "icef/synth/ground_truth_renderer.h"
@@ -65,11 +66,12 @@ Status RunDemo(const DemoOptions& given, std::ostream& out) {
     bar.Finish();
   }
 
-  out << "== 2/4 training ICEF into " << model_dir.string() << "\n";
+  const std::string method = ModelConfig().method;  // the default method (README: which, and why)
+  out << "== 2/4 training " << method << " into " << model_dir.string() << "\n";
   TrainAppOptions to;
   to.dataset = data_dir;
   to.out = model_dir;
-  to.method = "icef";
+  to.method = method;
   to.steps = o.steps;
   to.time_budget = o.time_budget;
   to.threads = o.threads;
