@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # icef synth end to end: a tiny dataset, read back by `icef info`, rendered twice to the same
-# bytes, a contact sheet from `icef sheet`, and a bad option rejected with exit code 1.
+# bytes, the expression style (style.json, --generic-style), a contact sheet from `icef sheet`, and
+# a bad option rejected with exit code 1.
 set -euo pipefail
 ICEF="$1"
 WORK="$(mktemp -d)"
@@ -9,6 +10,8 @@ trap 'rm -rf "$WORK"' EXIT
 "$ICEF" synth --out "$WORK/a" --identity-seed 3 --k 3 --res 32 --test-views 2 --novel-per-tier 1 \
   --threads 2 --contact-sheet "$WORK/sheet_a.png" > "$WORK/log.txt"
 grep -q "wrote $WORK/a: 3 train + 12 test frames" "$WORK/log.txt"
+grep -q "expression style: the identity's own; style gap 0\.[0-9]" "$WORK/log.txt"
+grep -q '"generic_style": false' "$WORK/a/style.json"
 test -s "$WORK/sheet_a.png"
 "$ICEF" info "$WORK/a" > "$WORK/info.txt"
 grep -q "train 3, test 12" "$WORK/info.txt"
@@ -16,6 +19,17 @@ grep -q "observed 6 near 2 moderate 2 far 2" "$WORK/info.txt"
 
 "$ICEF" synth --out "$WORK/b" --identity-seed 3 --k 3 --res 32 --test-views 2 --novel-per-tier 1 --threads 1 > /dev/null
 diff -r "$WORK/a" "$WORK/b"  # deterministic: same seed, same bytes (any thread count)
+
+# --generic-style: the face model's own expressions (gap 0); same shape, so neutral frames agree.
+"$ICEF" synth --out "$WORK/g" --identity-seed 3 --k 3 --res 32 --test-views 2 --novel-per-tier 1 --threads 2 \
+  --generic-style > "$WORK/log_g.txt"
+grep -q "style gap 0.000" "$WORK/log_g.txt"
+grep -q '"generic_style": true' "$WORK/g/style.json"
+cmp "$WORK/a/images/test_neutral_000.png" "$WORK/g/images/test_neutral_000.png"
+if cmp -s "$WORK/a/images/train_000.png" "$WORK/g/images/train_000.png"; then
+  echo "the identity's style and the generic style rendered the same training frame" >&2
+  exit 1
+fi
 
 "$ICEF" sheet "$WORK/a" --out "$WORK/sheet.png" --tile 32 > /dev/null
 test -s "$WORK/sheet.png"
