@@ -1,6 +1,8 @@
 // The expression warp: backward displacements x_c - x of the jaw rotation and of compact bump
 // terms (smile, pucker, press, brows, furrow, cheek puff). Every term is exactly zero outside its
-// window, so each parameter moves only its own region.
+// window, so each parameter moves only its own region. The model's ExpressionStyle scales the
+// weights (ExpressionState::styled), the jaw hinge, the smile's motion and window, and the brow
+// windows; the generic style multiplies by 1 and adds 0, so it reproduces the generic warp exactly.
 #include <cmath>
 
 #include "icef/core/status.h"
@@ -18,22 +20,23 @@ ExpressionState FaceModel::Prepare(std::span<const float> expression) const {
   ICEF_CHECK(valid.ok(), valid.message());
   const FaceGeometry& g = geometry_;
   ExpressionState s;
-  float max_weight = 0.f;
+  float max_weight = 0.f;  // of the styled weights (every gain is > 0: zero exactly when beta is)
   for (int i = 0; i < kNumExpressions; ++i) {
     s.beta[i] = expression[i];
-    max_weight = std::max(max_weight, expression[i]);
+    s.styled[i] = expression[i] * style_.WeightGain(i);
+    max_weight = std::max(max_weight, s.styled[i]);
   }
   s.neutral = max_weight == 0.f;
-  s.jaw_angle = kJawAnglePerUnit * s.beta[kJawOpen];
+  s.jaw_angle = kJawAnglePerUnit * s.styled[kJawOpen];
   for (int side = 0; side < 2; ++side) {
-    const float close = std::min(1.f, s.beta[side == 1 ? kEyeCloseLeft : kEyeCloseRight]);
+    const float close = std::min(1.f, s.styled[side == 1 ? kEyeCloseLeft : kEyeCloseRight]);
     s.lid_upper[side] = g.lid_upper_neutral - close * (g.lid_upper_neutral - g.lid_lower);
   }
-  const float jaw = s.beta[kJawOpen];
+  const float jaw = s.styled[kJawOpen];
   if (jaw > 0.f) {
-    const float open_y = s.jaw_angle * (g.lip_z - g.jaw_hinge.z());
+    const float open_y = s.jaw_angle * (g.lip_z - jaw_hinge_.z());
     const float ramp = std::min(1.f, jaw * 10.f);
-    const float pucker = std::min(1.5f, s.beta[kLipPucker]);
+    const float pucker = std::min(1.5f, s.styled[kLipPucker]);
     s.cavity = true;
     s.cavity_r = Vec3f(g.mouth_half_width * 0.9f * (1.f - 0.3f * pucker) * ramp + 1e-4f,
                        0.5f * open_y + 0.004f * ramp + 1e-4f, 0.075f);
@@ -59,43 +62,48 @@ Vec3f FaceModel::JawDisplacement(const Vec3f& x, float angle, float weight_overr
   // the chin goes down and back).
   const float a = -angle * w;
   const float c = std::cos(a), sn = std::sin(a);
-  const Vec3f r = x - g.jaw_hinge;
+  const Vec3f r = x - jaw_hinge_;
   const Vec3f rotated(r.x(), r.y() * c - r.z() * sn, r.y() * sn + r.z() * c);
   return rotated - r;
 }
 
 Vec3f FaceModel::BumpDisplacement(const Vec3f& x, const ExpressionState& s) const {
   const FaceGeometry& g = geometry_;
+  const ExpressionStyle& st = style_;
   Vec3f forward = Vec3f::Zero();  // forward motion at x; the backward displacement is its negative
   auto inv = [](float a, float b, float c) { return Vec3f(1.f / a, 1.f / b, 1.f / c); };
   for (int side = 0; side < 2; ++side) {
     const float sg = side == 0 ? -1.f : 1.f;
-    const float smile = s.beta[side == 1 ? kSmileLeft : kSmileRight];
+    const float smile = s.styled[side == 1 ? kSmileLeft : kSmileRight];
     if (smile > 0.f) {
-      const Vec3f corner(sg * (g.mouth_half_width + 0.012f), g.mouth_y + 0.012f, g.lip_z - 0.03f);
-      forward += smile * EllipsoidBump(x, corner, inv(0.09f, 0.085f, 0.09f)) * Vec3f(sg * 0.018f, 0.022f, -0.01f);
+      const Vec3f corner(sg * (g.mouth_half_width + 0.012f + st.smile_corner_shift), g.mouth_y + 0.012f,
+                         g.lip_z - 0.03f);
+      forward += smile * EllipsoidBump(x, corner, inv(0.09f, 0.085f, 0.09f)) *
+                 Vec3f(sg * 0.018f * st.smile_width, 0.022f * st.smile_lift, -0.01f);
       forward += smile * EllipsoidBump(x, Vec3f(sg * 0.11f, -0.06f, 0.2f), inv(0.075f, 0.075f, 0.075f)) *
-                 Vec3f(0.f, 0.012f, 0.008f);
+                 Vec3f(0.f, 0.012f * st.smile_lift, 0.008f);
     }
-    const float raise = s.beta[side == 1 ? kBrowRaiseLeft : kBrowRaiseRight];
+    const float raise = s.styled[side == 1 ? kBrowRaiseLeft : kBrowRaiseRight];
     if (raise > 0.f)
-      forward += raise * EllipsoidBump(x, Vec3f(g.eye_c[side].x(), g.brow_y, 0.25f), inv(0.09f, 0.075f, 0.09f)) *
+      forward += raise *
+                 EllipsoidBump(x, Vec3f(g.eye_c[side].x() + sg * st.brow_raise_shift, g.brow_y, 0.25f),
+                               inv(0.09f, 0.075f, 0.09f)) *
                  Vec3f(0.f, 0.022f, 0.002f);
-    const float furrow = s.beta[kBrowFurrow];
+    const float furrow = s.styled[kBrowFurrow];
     if (furrow > 0.f)
       forward += furrow * EllipsoidBump(x, Vec3f(sg * 0.035f, g.brow_y - 0.005f, 0.27f), inv(0.055f, 0.05f, 0.07f)) *
                  Vec3f(-sg * 0.01f, -0.012f, 0.003f);
-    const float puff = s.beta[kCheekPuff];
+    const float puff = s.styled[kCheekPuff];
     if (puff > 0.f)
       forward += puff * EllipsoidBump(x, Vec3f(sg * 0.115f, g.mouth_y + 0.03f, 0.18f), inv(0.085f, 0.085f, 0.09f)) *
                  Vec3f(sg * 0.02f, 0.f, 0.014f);
   }
   const Vec3f mouth(0.f, g.mouth_y, g.lip_z - 0.02f);
-  const float pucker = s.beta[kLipPucker];
+  const float pucker = s.styled[kLipPucker];
   if (pucker > 0.f)
     forward += pucker * EllipsoidBump(x, mouth, inv(0.085f, 0.06f, 0.08f)) *
                Vec3f(-0.3f * x.x(), -0.15f * (x.y() - g.mouth_y), 0.022f);
-  const float press = s.beta[kLipPress];
+  const float press = s.styled[kLipPress];
   if (press > 0.f)
     forward += press * EllipsoidBump(x, mouth, inv(0.08f, 0.05f, 0.08f)) *
                Vec3f(0.f, -0.4f * (x.y() - g.mouth_y), -0.006f);

@@ -9,7 +9,9 @@
 // such as a texture) moves with the expression:
 //   distance(x, beta) = carve(neutral_with_eyelids(Warp(x), beta), mouth_cavity(x, beta)).
 // Eyelids are SDF caps over the eyeballs whose edge angle follows eye_close_*; jaw_open rotates
-// the lower face about a hinge and carves a mouth cavity between the lips.
+// the lower face about a hinge and carves a mouth cavity between the lips. How strongly, where and
+// how asymmetrically each expression acts is the model's ExpressionStyle (generic by default;
+// synthetic subjects have their own).
 #pragma once
 
 #include <array>
@@ -19,6 +21,7 @@
 #include <vector>
 
 #include "icef/face/expression.h"
+#include "icef/face/expression_style.h"
 #include "icef/face/shape_params.h"
 #include "icef/math/ray.h"
 #include "icef/math/types.h"
@@ -41,7 +44,7 @@ struct FaceGeometry {
   Vec3f upper_lip_c, upper_lip_r, lower_lip_c, lower_lip_r;
   Vec3f neck_a, neck_b;
   float neck_r = 0, neck_cut_y = 0;
-  Vec3f jaw_hinge;
+  Vec3f jaw_hinge;  // the generic hinge (FaceModel moves it by the style's jaw_hinge_dy/dz)
   float lid_upper_neutral = 0, lid_lower = 0;  // eyelid edge elevations (radians)
 
   static FaceGeometry FromShape(const ShapeParams& p);
@@ -50,6 +53,7 @@ struct FaceGeometry {
 // An expression vector prepared for fast evaluation (derived angles, cavity, active terms).
 struct ExpressionState {
   std::array<float, kNumExpressions> beta{};
+  std::array<float, kNumExpressions> styled{};  // beta[i] * style.WeightGain(i): what the warp uses
   float jaw_angle = 0;                     // radians about the hinge's x axis
   std::array<float, 2> lid_upper{};        // upper-lid edge elevation per eye (radians)
   bool cavity = false;                     // mouth cavity carved
@@ -60,9 +64,11 @@ struct ExpressionState {
 
 class FaceModel {
  public:
-  explicit FaceModel(const ShapeParams& shape);
+  // ICEF_CHECK fails unless style.Validate() is OK.
+  explicit FaceModel(const ShapeParams& shape, const ExpressionStyle& style = ExpressionStyle::Generic());
 
   const ShapeParams& shape() const { return shape_; }
+  const ExpressionStyle& style() const { return style_; }
   const FaceGeometry& geometry() const { return geometry_; }
   // A box holding the surface for expression weights up to ~2 (for ray bounds).
   Aabb Bounds() const;
@@ -106,7 +112,8 @@ class FaceModel {
   float Trace(const Ray& ray, float t_near, float t_far, const ExpressionState& state, int max_steps = 192,
               float epsilon = 2.5e-4f) const;
 
-  // The 68 iBUG-68 landmarks in the head frame for the expression (observation space).
+  // The 68 iBUG-68 landmarks in the head frame for the expression (observation space). The
+  // neutral landmarks do not depend on the style.
   std::array<Vec3f, 68> Landmarks(const ExpressionState& state) const;
   // Canonical (neutral) landmarks.
   const std::array<Vec3f, 68>& NeutralLandmarks() const { return neutral_landmarks_; }
@@ -126,7 +133,9 @@ class FaceModel {
   void BuildNeutralLandmarks();
 
   ShapeParams shape_;
+  ExpressionStyle style_;
   FaceGeometry geometry_;
+  Vec3f jaw_hinge_;  // geometry_.jaw_hinge moved by the style's hinge offset
   ExpressionState neutral_state_;
   std::array<Vec3f, 68> neutral_landmarks_;
 };

@@ -4,12 +4,17 @@
 #include <cmath>
 #include <sstream>
 
+#include "icef/core/status.h"
 #include "icef/face/face_model.h"
 #include "icef/face/sdf_primitives.h"
 
 namespace icef::face {
 
-FaceModel::FaceModel(const ShapeParams& shape) : shape_(shape), geometry_(FaceGeometry::FromShape(shape)) {
+FaceModel::FaceModel(const ShapeParams& shape, const ExpressionStyle& style)
+    : shape_(shape), style_(style), geometry_(FaceGeometry::FromShape(shape)) {
+  const Status valid = style.Validate();
+  ICEF_CHECK(valid.ok(), valid.message());
+  jaw_hinge_ = geometry_.jaw_hinge + Vec3f(0.f, style.jaw_hinge_dy, style.jaw_hinge_dz);
   neutral_state_ = Prepare(std::vector<float>(kNumExpressions, 0.f));
   BuildNeutralLandmarks();
 }
@@ -106,6 +111,8 @@ float FaceModel::Trace(const Ray& ray, float t_near, float t_far, const Expressi
   return -1.f;
 }
 
-std::string FaceModel::ToString() const { return "FaceModel(" + shape_.ToString() + ")"; }
+std::string FaceModel::ToString() const {
+  return "FaceModel(" + shape_.ToString() + ", " + style_.ToString() + ")";
+}
 
 }  // namespace icef::face

@@ -117,9 +117,11 @@ TEST(GroundTruthRendererTest, VisibleLandmarksProjectOntoTheFace) {
       ++visible;
       const int x = static_cast<int>(lm.landmarks_2d[i].x()), y = static_cast<int>(lm.landmarks_2d[i].y());
       ASSERT_TRUE(x >= 0 && y >= 0 && x < kRes && y < kRes);
-      on_face += img.At(x, y, 3) >= 0.5f;
+      // Covered at least partly: jaw-contour landmarks lie on the silhouette, so their pixel may
+      // straddle the edge (1 of the 2x2 samples hits; the style moves which ones do).
+      on_face += img.At(x, y, 3) > 0.f;
     }
-    EXPECT_GE(on_face, visible - 1) << "yaw " << yaw;  // one silhouette landmark may straddle the edge
+    EXPECT_EQ(on_face, visible) << "yaw " << yaw;
     if (yaw == 0.0) {
       EXPECT_GE(visible, 64);
     }

@@ -6,7 +6,7 @@
 
 namespace icef::synth {
 
-HeadModel::HeadModel(const IdentityParams& identity) : identity_(identity), face_(identity.shape) {
+HeadModel::HeadModel(const IdentityParams& identity) : identity_(identity), face_(identity.shape, identity.style) {
   BuildMoles();
 }
 

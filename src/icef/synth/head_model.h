@@ -18,7 +18,7 @@ class HeadModel {
   explicit HeadModel(const IdentityParams& identity);
 
   const IdentityParams& identity() const { return identity_; }
-  // The subject's face model (built from identity().shape).
+  // The subject's face model (built from identity().shape and identity().style).
   const face::FaceModel& face() const { return face_; }
 
   // Albedo (RGB in [0, 1]) of the surface point: canonical point sample.canonical for

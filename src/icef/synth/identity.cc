@@ -1,5 +1,6 @@
 #include "icef/synth/identity.h"
 
+#include <algorithm>
 #include <sstream>
 
 #include "icef/core/rng.h"
@@ -9,6 +10,41 @@ namespace icef::synth {
 namespace {
 Vec3f Mix(const Vec3f& a, const Vec3f& b, float t) { return a + t * (b - a); }
 }  // namespace
+
+face::ExpressionStyle DrawExpressionStyle(uint64_t seed) {
+  Rng rng(seed, StreamId("synth.expression_style"));
+  auto u = [&](double lo, double hi) { return static_cast<float>(rng.Uniform(lo, hi)); };
+  // A gain clearly off the generic 1: weaker in [0.65, 0.82] or stronger in [1.18, up_max].
+  auto gain = [&](double up_max) { return rng.Below(2) == 0 ? u(0.65, 0.82) : u(1.18, up_max); };
+  // A per-side pair [right, left]: a common gain, and one side (either) weaker by up to 25 %.
+  auto sides = [&](double up_max) {
+    const float g = gain(up_max), weaker = g * (1.f - u(0.0, 0.25));
+    return rng.Below(2) == 0 ? std::array<float, 2>{weaker, g} : std::array<float, 2>{g, weaker};
+  };
+  // Stronger-than-generic terms stop at 1.3 (1.2 for the smile and the brows, whose generic warps
+  // fold first): at the far tier's weight 1.5 no term then moves more than the generic one does
+  // at weight 2, where the generic model is still valid (docs/face_model.md).
+  face::ExpressionStyle st;
+  st.jaw_gain = gain(1.30);
+  st.jaw_hinge_dy = u(-0.03, 0.03);
+  st.jaw_hinge_dz = u(-0.04, 0.04);
+  st.smile_gain = sides(1.20);
+  st.smile_width = gain(1.30);
+  st.smile_lift = gain(1.30);
+  st.smile_corner_shift = u(-0.012, 0.02);
+  // The corner's motion is gain x width (x) and gain x lift (y): keep the product at most 1.3.
+  const float corner = std::max(st.smile_gain[0], st.smile_gain[1]) * std::max(st.smile_width, st.smile_lift);
+  if (corner > 1.3f)
+    for (float& g : st.smile_gain) g *= 1.3f / corner;
+  st.lip_pucker_gain = gain(1.30);
+  st.lip_press_gain = gain(1.30);
+  st.brow_raise_gain = sides(1.20);
+  st.brow_raise_shift = u(-0.025, 0.025);
+  st.brow_furrow_gain = gain(1.30);
+  st.eye_close_gain = sides(1.45);
+  st.cheek_puff_gain = gain(1.30);
+  return st;
+}
 
 IdentityParams IdentityParams::FromSeed(uint64_t seed) {
   Rng rng(seed, StreamId("synth.identity"));
@@ -49,6 +85,7 @@ IdentityParams IdentityParams::FromSeed(uint64_t seed) {
   p.num_moles = 2 + static_cast<int>(rng.Below(5));
   p.hairline = u(-0.03, 0.05);
   p.detail_seed = static_cast<uint32_t>(Mix64(seed ^ 0x5eedULL));
+  p.style = DrawExpressionStyle(seed);
   return p;
 }
 
@@ -59,7 +96,7 @@ std::string IdentityParams::ToString() const {
      << ", chin=" << s.chin_length << ", nose=" << s.nose_length << "/" << s.nose_width << "/" << s.nose_bridge
      << ", eyes=" << s.eye_spacing << ", lips=" << s.lip_thickness << ", brows=" << s.brow_height
      << ", cheeks=" << s.cheek_fullness << ", mouth=" << s.mouth_width << ", skin=[" << skin_tone.transpose()
-     << "], freckles=" << freckle_density << ", moles=" << num_moles << ")";
+     << "], freckles=" << freckle_density << ", moles=" << num_moles << ", " << style.ToString() << ")";
   return os.str();
 }
 

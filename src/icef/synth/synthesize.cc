@@ -7,6 +7,7 @@
 
 #include "icef/core/rng.h"
 #include "icef/face/expression.h"
+#include "icef/io/atomic_file.h"
 #include "icef/synth/head_model.h"
 
 namespace icef::synth {
@@ -32,12 +33,56 @@ Status SynthOptions::Validate() const {
 
 std::string SynthOptions::ToString() const {
   std::ostringstream os;
-  os << "SynthOptions(out=" << out_dir.string() << ", identity_seed=" << identity_seed << ", k=" << num_train
+  os << "SynthOptions(out=" << out_dir.string() << ", identity_seed=" << identity_seed
+     << ", generic_style=" << (generic_style ? "true" : "false") << ", k=" << num_train
      << ", res=" << resolution << ", test_views=" << test_views << ", novel_per_tier=" << novel_per_tier
      << ", thresholds=[" << near_threshold << ", " << far_threshold << "], distance=" << camera_distance
      << ", focal_scale=" << focal_scale << ", yaw<=" << max_yaw_deg << ", pitch<=" << max_pitch_deg << ", "
      << render.ToString() << ")";
   return os.str();
+}
+
+IdentityParams SynthIdentity(const SynthOptions& options) {
+  IdentityParams identity = IdentityParams::FromSeed(options.identity_seed);
+  if (options.generic_style) identity.style = face::ExpressionStyle::Generic();
+  return identity;
+}
+
+Json StyleInfoJson(const SynthOptions& options, const IdentityParams& identity, const face::StyleGap& gap) {
+  const face::ExpressionStyle& st = identity.style;
+  auto pair = [](const std::array<float, 2>& v) { return Json::array({JsonFloat(v[0]), JsonFloat(v[1])}); };
+  Json style = Json::object();
+  style["jaw_gain"] = JsonFloat(st.jaw_gain);
+  style["jaw_hinge_dy"] = JsonFloat(st.jaw_hinge_dy);
+  style["jaw_hinge_dz"] = JsonFloat(st.jaw_hinge_dz);
+  style["smile_gain"] = pair(st.smile_gain);
+  style["smile_width"] = JsonFloat(st.smile_width);
+  style["smile_lift"] = JsonFloat(st.smile_lift);
+  style["smile_corner_shift"] = JsonFloat(st.smile_corner_shift);
+  style["lip_pucker_gain"] = JsonFloat(st.lip_pucker_gain);
+  style["lip_press_gain"] = JsonFloat(st.lip_press_gain);
+  style["brow_raise_gain"] = pair(st.brow_raise_gain);
+  style["brow_raise_shift"] = JsonFloat(st.brow_raise_shift);
+  style["brow_furrow_gain"] = JsonFloat(st.brow_furrow_gain);
+  style["eye_close_gain"] = pair(st.eye_close_gain);
+  style["cheek_puff_gain"] = JsonFloat(st.cheek_puff_gain);
+  Json per_expression = Json::object();
+  for (int e = 0; e < face::kNumExpressions; ++e)
+    per_expression[face::kExpressionNames[e]] =
+        std::isnan(gap.per_expression[e]) ? Json(nullptr) : Json(gap.per_expression[e]);
+  Json doc = Json::object();
+  doc["note"] =
+      "The ground truth's expression style and its landmark gap to the generic face model "
+      "(docs/face_model.md). Not part of the dataset: training and evaluation never read it. "
+      "Paired values are [right, left] (the subject's own sides).";
+  doc["identity_seed"] = options.identity_seed;
+  doc["generic_style"] = identity.style.IsGeneric();
+  doc["style"] = std::move(style);
+  doc["style_gap"] = Json{{"weight", 1.0},
+                          {"mean", gap.mean},
+                          {"num_measured", gap.num_measured},
+                          {"per_expression", std::move(per_expression)}};
+  return doc;
 }
 
 double ExpressionDelta(const std::vector<float>& beta, const std::vector<std::vector<float>>& train) {
@@ -195,12 +240,14 @@ int64_t SynthImageCount(const SynthOptions& o) {
 }
 
 Status SynthesizeDataset(const SynthOptions& options, const Executor& executor, ProgressBar* progress,
-                         Dataset* written) {
+                         Dataset* written, face::StyleGap* style_gap) {
   ICEF_ASSIGN_OR_RETURN(const SynthPlan plan, PlanSynthesis(options));
   std::error_code ec;
   fs::create_directories(options.out_dir / "images", ec);
   if (ec) return Status::Error((options.out_dir / "images").string() + ": cannot create directory: " + ec.message());
-  const HeadModel head(IdentityParams::FromSeed(options.identity_seed));
+  const IdentityParams identity = SynthIdentity(options);
+  const HeadModel head(identity);
+  const face::StyleGap gap = face::MeasureStyleGap(identity.shape, identity.style);
 
   Dataset ds;
   ds.root = options.out_dir;
@@ -243,6 +290,9 @@ Status SynthesizeDataset(const SynthOptions& options, const Executor& executor, 
     }
   }
   ICEF_RETURN_IF_ERROR(SaveDataset(ds));
+  ICEF_RETURN_IF_ERROR(
+      WriteFileAtomic(options.out_dir / kStyleInfoFile, FormatJson(StyleInfoJson(options, identity, gap))));
+  if (style_gap) *style_gap = gap;
   if (progress) progress->Finish(std::to_string(ds.train.size()) + " train, " + std::to_string(ds.test.size()) + " test frames");
   if (written) *written = std::move(ds);
   return Status::Ok();

@@ -4,7 +4,10 @@
 // expression (tier "observed", delta = 0) and at novel expressions in the near, moderate and far
 // tiers (delta = min_k ||beta - beta_k||_2 is computed and the tier derived from it), plus the
 // neutral render of every test view (neutral_file_path). Every frame carries 68 landmarks (2D with
-// visibility, 3D). The output is a pure function of the options (same seed, same bytes).
+// visibility, 3D). The subject performs the expressions in its own style (IdentityParams::style);
+// style.json beside the transforms records that style and its gap to the generic one (it is not
+// part of the dataset format, and nothing that trains or evaluates reads it). The output is a
+// pure function of the options (same seed, same bytes).
 #pragma once
 
 #include <filesystem>
@@ -15,6 +18,8 @@
 #include "icef/core/progress.h"
 #include "icef/core/status.h"
 #include "icef/data/dataset.h"
+#include "icef/face/style_gap.h"
+#include "icef/io/json_util.h"
 #include "icef/math/camera.h"
 #include "icef/synth/ground_truth_renderer.h"
 
@@ -23,8 +28,11 @@ namespace icef::synth {
 struct SynthOptions {
   // Output directory (created; existing files of the same names are replaced).
   std::filesystem::path out_dir;
-  // Identity seed: face shape, albedo, and the views and expressions drawn.
+  // Identity seed: face shape, expression style, albedo, and the views and expressions drawn.
   uint64_t identity_seed = 1;
+  // Render with the generic expression style instead of the identity's own (the face model's
+  // expressions exactly, as before styles existed).
+  bool generic_style = false;
   // Number of training frames K.
   int num_train = 5;
   // Image width and height in pixels.
@@ -57,6 +65,15 @@ struct TestExpression {
   Tier tier = Tier::kObserved;
 };
 
+// The subject a dataset is rendered with: IdentityParams::FromSeed(identity_seed), with the
+// generic expression style when generic_style is set.
+IdentityParams SynthIdentity(const SynthOptions& options);
+
+// The file SynthesizeDataset writes beside the transforms, and its contents: the seed, the
+// identity's expression style (every ExpressionStyle field) and its StyleGap at weight 1.
+inline constexpr char kStyleInfoFile[] = "style.json";
+Json StyleInfoJson(const SynthOptions& options, const IdentityParams& identity, const face::StyleGap& gap);
+
 // Everything drawn for a dataset before rendering (cheap; used by the tests and the writer).
 struct SynthPlan {
   Intrinsics intrinsics;
@@ -79,9 +96,10 @@ Camera OrbitCamera(const Intrinsics& intrinsics, double distance, double yaw_deg
 // Number of images SynthesizeDataset writes (the progress total): K + V + (K + 3 n) V.
 int64_t SynthImageCount(const SynthOptions& options);
 
-// Renders and writes the dataset (images/ + transforms_{train,test}.json via SaveDataset). The
-// written Dataset is returned through `written` when non-null. progress may be null.
+// Renders and writes the dataset (images/ + transforms_{train,test}.json via SaveDataset, and
+// kStyleInfoFile). The written Dataset is returned through `written` and the subject's style gap
+// (face::MeasureStyleGap at weight 1) through `style_gap` when non-null. progress may be null.
 Status SynthesizeDataset(const SynthOptions& options, const Executor& executor, ProgressBar* progress = nullptr,
-                         Dataset* written = nullptr);
+                         Dataset* written = nullptr, face::StyleGap* style_gap = nullptr);
 
 }  // namespace icef::synth

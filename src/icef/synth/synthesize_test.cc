@@ -105,7 +105,7 @@ TEST(SynthesizeTest, WritesALoadableDeterministicDataset) {
     if (rel.extension() == ".png") differing += *ReadFile(entry.path()) != *ReadFile(c / rel);
   }
   const int images = static_cast<int>(SynthImageCount(Tiny(a, 5)));
-  EXPECT_EQ(files, images + 2);  // + transforms_train.json, transforms_test.json
+  EXPECT_EQ(files, images + 3);  // + transforms_train.json, transforms_test.json, style.json
   EXPECT_EQ(differing, images);
 
   const Result<Dataset> loaded = LoadDataset(a);
@@ -140,6 +140,53 @@ TEST(SynthesizeTest, WritesALoadableDeterministicDataset) {
   ASSERT_TRUE(sheet.ok()) << sheet.status().message();
   EXPECT_GT(sheet->width, 3 * 96);
   fs::remove_all(a), fs::remove_all(b), fs::remove_all(c);
+}
+
+TEST(SynthesizeTest, RendersTheIdentitysStyleUnlessGenericIsAsked) {
+  const fs::path a = TempDir("styled"), b = TempDir("generic");
+  SynthOptions styled = Tiny(a, 2), generic = Tiny(b, 2);
+  generic.generic_style = true;
+  EXPECT_NE(styled.ToString(), generic.ToString());  // a cached dataset of the other kind is not reused
+  EXPECT_EQ(SynthIdentity(styled).style, IdentityParams::FromSeed(2).style);
+  EXPECT_TRUE(SynthIdentity(generic).style.IsGeneric());
+  EXPECT_EQ(SynthIdentity(generic).shape.ToArray(), SynthIdentity(styled).shape.ToArray());
+  Dataset ds_a, ds_b;
+  face::StyleGap gap_a, gap_b;
+  ASSERT_TRUE(SynthesizeDataset(styled, Executor(2), nullptr, &ds_a, &gap_a).ok());
+  ASSERT_TRUE(SynthesizeDataset(generic, Executor(2), nullptr, &ds_b, &gap_b).ok());
+  EXPECT_GT(gap_a.mean, 0.1);
+  EXPECT_EQ(gap_b.mean, 0.0);
+  // Landmarks are the styled (or generic) face model's, at the frame's expression.
+  const IdentityParams id = IdentityParams::FromSeed(2);
+  const face::FaceModel styled_face(id.shape, id.style), generic_face(id.shape);
+  for (size_t k = 0; k < ds_a.train.size(); ++k) {
+    const auto want_a = styled_face.Landmarks(styled_face.Prepare(ds_a.train[k].expression));
+    const auto want_b = generic_face.Landmarks(generic_face.Prepare(ds_b.train[k].expression));
+    float diff = 0.f;
+    for (int i = 0; i < 68; ++i) {
+      EXPECT_EQ((*ds_a.train[k].landmarks_3d)[i], want_a[i]);
+      EXPECT_EQ((*ds_b.train[k].landmarks_3d)[i], want_b[i]);
+      diff = std::max(diff, (want_a[i] - want_b[i]).norm());
+    }
+    EXPECT_GT(diff, 1e-3f) << "train frame " << k;  // every training expression shows the style
+  }
+  // Neutral frames do not depend on the style; expressive ones do.
+  EXPECT_EQ(*ReadFile(a / "images" / "test_neutral_000.png"), *ReadFile(b / "images" / "test_neutral_000.png"));
+  EXPECT_NE(*ReadFile(a / "images" / "train_000.png"), *ReadFile(b / "images" / "train_000.png"));
+  // style.json records the style and the gap; the dataset loader ignores it.
+  const Result<Json> info = ReadJsonFile(a / kStyleInfoFile);
+  ASSERT_TRUE(info.ok()) << info.status().message();
+  EXPECT_EQ((*info)["identity_seed"], 2);
+  EXPECT_EQ((*info)["generic_style"], false);
+  EXPECT_EQ((*info)["style"]["jaw_gain"].get<float>(), id.style.jaw_gain);
+  EXPECT_EQ((*info)["style"]["smile_gain"][1].get<float>(), id.style.smile_gain[1]);
+  EXPECT_DOUBLE_EQ((*info)["style_gap"]["mean"].get<double>(), gap_a.mean);
+  EXPECT_EQ((*info)["style_gap"]["per_expression"].size(), static_cast<size_t>(face::kNumExpressions));
+  const Result<Json> generic_info = ReadJsonFile(b / kStyleInfoFile);
+  ASSERT_TRUE(generic_info.ok());
+  EXPECT_EQ((*generic_info)["generic_style"], true);
+  EXPECT_TRUE(LoadDataset(a).ok());
+  fs::remove_all(a), fs::remove_all(b);
 }
 
 }  // namespace
