@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# icef bench --quick end to end (tiny settings: 1 identity, K = 3, all five methods, 32x32, a tiny
+# icef bench --quick end to end (tiny settings: 1 identity, K = 3, all seven methods, 32x32, a tiny
 # model for 20 steps), run as two shards and merged: checks the per-run metrics, the report
 # (verdict computed, stand-in caveat, tables), report.json, the plots (when gnuplot is installed),
 # that finished runs are skipped, and that the unsharded bench over all runs gives the same verdict.
@@ -8,23 +8,23 @@ ICEF="$1"
 WORK="$(mktemp -d)"
 trap 'rm -rf "$WORK"' EXIT
 fail() { echo "FAIL: $*" >&2; exit 1; }
-RUNS=(id1_k3_icef id1_k3_icef-no-conf id1_k3_icef-uniform id1_k3_warp id1_k3_nerface)
+RUNS=(id1_k3_icef-prior id1_k3_warp-prior id1_k3_icef id1_k3_icef-no-conf id1_k3_icef-uniform id1_k3_warp id1_k3_nerface)
 
 start=$SECONDS
 "$ICEF" bench --quick --out "$WORK/a" --shard 0/2 --threads 2 > "$WORK/a.txt" || fail "shard 0/2 exited $?"
 "$ICEF" bench --quick --out "$WORK/b" --shard 1/2 --threads 2 > "$WORK/b.txt" || fail "shard 1/2 exited $?"
 echo "two shards: $((SECONDS - start)) s"
-grep -q "bench: 3 runs in shard 0/2 (0 already done)" "$WORK/a.txt" || fail "shard 0/2 plan: $(head -1 "$WORK/a.txt")"
-grep -q "bench: 2 runs in shard 1/2 (0 already done)" "$WORK/b.txt" || fail "shard 1/2 plan: $(head -1 "$WORK/b.txt")"
-for r in id1_k3_icef id1_k3_icef-uniform id1_k3_nerface; do test -s "$WORK/a/runs/$r/metrics.json" || fail "a: $r"; done
-for r in id1_k3_icef-no-conf id1_k3_warp; do test -s "$WORK/b/runs/$r/metrics.json" || fail "b: $r"; done
+grep -q "bench: 4 runs in shard 0/2 (0 already done)" "$WORK/a.txt" || fail "shard 0/2 plan: $(head -1 "$WORK/a.txt")"
+grep -q "bench: 3 runs in shard 1/2 (0 already done)" "$WORK/b.txt" || fail "shard 1/2 plan: $(head -1 "$WORK/b.txt")"
+for r in id1_k3_icef-prior id1_k3_icef id1_k3_icef-uniform id1_k3_nerface; do test -s "$WORK/a/runs/$r/metrics.json" || fail "a: $r"; done
+for r in id1_k3_warp-prior id1_k3_icef-no-conf id1_k3_warp; do test -s "$WORK/b/runs/$r/metrics.json" || fail "b: $r"; done
 test ! -e "$WORK/a/runs/id1_k3_icef/model" || fail "model kept without --keep-models"
 grep -q "Shard 0/2 only" "$WORK/a/report.md" || fail "shard report lacks the shard note"
 
 "$ICEF" bench merge "$WORK/a" "$WORK/b" --out "$WORK/m" > "$WORK/m.txt" || fail "merge exited $?"
 cat "$WORK/m.txt"
 for r in "${RUNS[@]}"; do test -s "$WORK/m/runs/$r/metrics.json" || fail "merged: $r"; done
-grep -q "bench merge: 5 runs" "$WORK/m.txt" || fail "merge count"
+grep -q "bench merge: 7 runs" "$WORK/m.txt" || fail "merge count"
 R="$WORK/m/report.md"
 grep -q "## Verdict (computed)" "$R" || fail "no verdict"
 grep -q "a method is better than another in a tier only where it reproduces at least 10% of the expression" "$R" \
@@ -32,24 +32,29 @@ grep -q "a method is better than another in a tier only where it reproduces at l
 outcome="(better|under-expresses|not better on identity|not better on PSNR)"
 grep -Eq "\*\*far tier, icef vs the baselines\*\*: .*K=3 vs warp: $outcome" "$R" || fail "no far-tier verdict vs warp"
 grep -Eq "\*\*far tier, icef vs the baselines\*\*: .*K=3 vs nerface: $outcome" "$R" || fail "no far-tier verdict vs nerface"
+grep -Eq "\*\*far tier, icef-prior vs every other method\*\*: .*K=3 vs icef: $outcome" "$R" \
+  || fail "no far-tier verdict of icef-prior vs icef"
 grep -q "\*\*Expression reproduced, K=3\*\*" "$R" || fail "no expression line"
 grep -q "tiers by delta: observed = 0, near (0, 0.35]" "$R" || fail "no tier thresholds"
 grep -q "identities (seeds): 1 (test identities" "$R" || fail "identities not named as test identities"
 grep -q "FDNeRF and NeRFFaceEditing proper are not available" "$R" || fail "no stand-in caveat"
 grep -q "^| far | \`icef\` | 1 |" "$R" || fail "no far-tier icef row"
-[ "$(grep -c '^| observed | ' "$R")" = 10 ] || fail "expected 10 observed rows (5 methods, 2 tables)"
+[ "$(grep -c '^| observed | ' "$R")" = 14 ] || fail "expected 14 observed rows (7 methods, 2 tables)"
 python3 - "$WORK/m/report.json" <<'PY' || fail "report.json"
 import json, sys
 r = json.load(open(sys.argv[1]))
 assert r["ks"] == [3] and r["identities"] == [1], (r["ks"], r["identities"])
-assert r["methods"] == ["icef", "icef-no-conf", "icef-uniform", "warp", "nerface"], r["methods"]
-assert len(r["runs"]) == 5 and len(r["aggregate"]) == 5 * 4
+assert r["methods"] == ["icef", "icef-no-conf", "icef-uniform", "warp", "nerface", "icef-prior", "warp-prior"], r["methods"]
+assert len(r["runs"]) == 7 and len(r["aggregate"]) == 7 * 4
 for c in r["aggregate"]:
     if c["runs"] > 0:
         assert c["psnr"]["n"] == 1 and c["psnr"]["std"] == 0
 assert any(c["metric"] == "id_distance" and c["other"] == "warp" for c in r["far_comparisons"])
 assert len(r["verdict"]) >= 3, r["verdict"]
-assert {v["other"] for v in r["pair_verdicts"]} == {"icef-no-conf", "icef-uniform", "warp", "nerface"}
+assert {v["other"] for v in r["pair_verdicts"] if v["method"] == "icef"} == {
+    "icef-prior", "warp-prior", "icef-no-conf", "icef-uniform", "warp", "nerface"}
+assert {v["other"] for v in r["pair_verdicts"] if v["method"] == "icef-prior"} == {
+    "warp-prior", "icef", "icef-no-conf", "icef-uniform", "warp", "nerface"}
 assert r["tier_thresholds"] == [0.35, 0.8]
 far = [c for c in r["aggregate"] if c["tier"] == "far" and c["method"] == "icef"][0]
 for k in ["expr_gain", "expr_corr", "region_psnr", "psnr_neutral_floor", "id_distance_gt"]:
@@ -65,13 +70,13 @@ fi
 
 # Resume: a finished run is skipped (nothing is trained again).
 "$ICEF" bench --quick --out "$WORK/a" --shard 0/2 --threads 2 > "$WORK/a2.txt" || fail "resume exited $?"
-grep -q "bench: 3 runs in shard 0/2 (3 already done)" "$WORK/a2.txt" || fail "resume plan: $(head -1 "$WORK/a2.txt")"
+grep -q "bench: 4 runs in shard 0/2 (4 already done)" "$WORK/a2.txt" || fail "resume plan: $(head -1 "$WORK/a2.txt")"
 if grep -q "^train " "$WORK/a2.txt"; then fail "a finished run was trained again"; fi
 # The unsharded bench over a directory holding every run only writes the report, and its verdict
 # is the merged one.
 mkdir -p "$WORK/c" && cp -r "$WORK/m/runs" "$WORK/c/"
 "$ICEF" bench --quick --out "$WORK/c" --threads 2 > "$WORK/c.txt" || fail "unsharded bench exited $?"
-grep -q "bench: 5 runs in shard 0/1 (5 already done)" "$WORK/c.txt" || fail "unsharded plan: $(head -1 "$WORK/c.txt")"
+grep -q "bench: 7 runs in shard 0/1 (7 already done)" "$WORK/c.txt" || fail "unsharded plan: $(head -1 "$WORK/c.txt")"
 diff <(grep -A4 "^## Verdict" "$WORK/c/report.md") <(grep -A4 "^## Verdict" "$R") || fail "verdicts differ"
 
 # Bad options exit 1 with a message.

@@ -22,7 +22,7 @@ grep -Eq "^symmetry prior: landmark pairs mirror onto each other within 0\.0[0-9
 "$ICEF" eval "$WORK/model" "$WORK/data" --out "$WORK/eval" --threads 2 > "$WORK/out.txt" 2> "$WORK/err.txt" \
   || fail "icef eval exited $?: $(cat "$WORK/err.txt")"
 cat "$WORK/out.txt"
-grep -q "^method icef, 6 test frames" "$WORK/out.txt" || fail "no summary line"
+grep -q "^method icef-prior, 6 test frames" "$WORK/out.txt" || fail "no summary line"
 grep -Eq "^observed +3 " "$WORK/out.txt" || fail "table lacks the observed tier with 3 frames"
 grep -Eq "^far +1 " "$WORK/out.txt" || fail "table lacks the far tier"
 grep -q "lpips: unavailable" "$WORK/out.txt" || fail "LPIPS not reported as unavailable"
@@ -35,7 +35,7 @@ test -s "$WORK/eval/renders/neutral_000.png" || fail "no neutral render"
 python3 - "$WORK/eval/metrics.json" <<'PY' || fail "metrics.json schema"
 import json, math, os, sys
 m = json.load(open(sys.argv[1]))
-assert m["method"] == "icef"
+assert m["method"] == "icef-prior"
 assert len(m["frames"]) == 6
 for f in m["frames"]:
     for k in ["file_path", "tier", "delta", "psnr", "ssim", "lpips", "id_cosine", "id_distance", "id_distance_gt",

@@ -59,7 +59,7 @@ TEST(ResumeConfig, OtherChangesAreRefusedNamingEachKey) {
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.message().find("m/checkpoint.icef: cannot resume with a different run config"), std::string::npos)
       << s.message();
-  EXPECT_NE(s.message().find("model.method (checkpoint \"icef\", given \"warp\")"), std::string::npos) << s.message();
+  EXPECT_NE(s.message().find("model.method (checkpoint \"icef-prior\", given \"warp\")"), std::string::npos) << s.message();
   EXPECT_NE(s.message().find("train.lambda_id (checkpoint 0.2, given 0.5)"), std::string::npos) << s.message();
   EXPECT_EQ(s.message().find("train.steps ("), std::string::npos) << "steps may change: " << s.message();
 }

@@ -23,12 +23,13 @@ TEST(BenchProtocolTest, PlansRunsInStableOrder) {
   BenchOptions o;
   o.out_dir = "x";
   const std::vector<RunId> runs = PlanRuns(o);
-  ASSERT_EQ(runs.size(), 3u * 3u * 5u);
-  EXPECT_EQ(runs[0].Name(), "id1_k3_icef");
-  EXPECT_EQ(runs[1].Name(), "id1_k3_icef-no-conf");
-  EXPECT_EQ(runs[4].Name(), "id1_k3_nerface");
-  EXPECT_EQ(runs[5].Name(), "id1_k5_icef");
-  EXPECT_EQ(runs[15].Name(), "id2_k3_icef");
+  ASSERT_EQ(runs.size(), 3u * 3u * 7u);
+  EXPECT_EQ(runs[0].Name(), "id1_k3_icef-prior");
+  EXPECT_EQ(runs[1].Name(), "id1_k3_warp-prior");
+  EXPECT_EQ(runs[2].Name(), "id1_k3_icef");
+  EXPECT_EQ(runs[6].Name(), "id1_k3_nerface");
+  EXPECT_EQ(runs[7].Name(), "id1_k5_icef-prior");
+  EXPECT_EQ(runs[21].Name(), "id2_k3_icef-prior");
   EXPECT_EQ(runs.back().Name(), "id3_k10_nerface");
   std::set<std::string> names;
   for (const RunId& r : runs) names.insert(r.Name());
@@ -52,8 +53,8 @@ TEST(BenchProtocolTest, ShardsPartitionTheRuns) {
   }
   const std::vector<RunId> s1 = ShardRuns(runs, 1, 4);
   ASSERT_GE(s1.size(), 2u);
-  EXPECT_EQ(s1[0].Name(), "id1_k3_icef-no-conf");
-  EXPECT_EQ(s1[1].Name(), "id1_k5_icef");
+  EXPECT_EQ(s1[0].Name(), "id1_k3_warp-prior");
+  EXPECT_EQ(s1[1].Name(), "id1_k3_warp");
 }
 
 TEST(BenchProtocolTest, ParsesShardAndLists) {
@@ -90,7 +91,7 @@ TEST(BenchProtocolTest, ValidatesOptions) {
   BenchOptions quick = o;
   quick.ApplyQuick();
   EXPECT_TRUE(quick.Validate().ok());
-  EXPECT_EQ(PlanRuns(quick).size(), 5u);
+  EXPECT_EQ(PlanRuns(quick).size(), 7u);
   EXPECT_EQ(quick.resolution, 32);
 }
 

@@ -205,6 +205,12 @@ const std::vector<std::string>& Baselines() {
   return kBaselines;
 }
 
+// The methods the report judges against all others: the paper's method and ICEF on the face-model prior.
+const std::vector<std::string>& PrimaryMethods() {
+  static const std::vector<std::string> kPrimary = {"icef", "icef-prior"};
+  return kPrimary;
+}
+
 }  // namespace
 
 Aggregate AggregateRuns(const std::vector<RunRecord>& runs) {
@@ -288,12 +294,14 @@ Aggregate AggregateRuns(const std::vector<RunRecord>& runs) {
       }
     }
   }
-  for (Tier tier : {Tier::kNear, Tier::kModerate, Tier::kFar})
-    for (int k : a.ks) {
-      if (!by_cell.count({k, "icef"})) continue;
-      for (const std::string& other : a.methods)
-        if (other != "icef" && by_cell.count({k, other})) a.verdicts.push_back(ComparePair(a, k, tier, "icef", other));
-    }
+  for (const std::string& primary : PrimaryMethods())
+    for (Tier tier : {Tier::kNear, Tier::kModerate, Tier::kFar})
+      for (int k : a.ks) {
+        if (!by_cell.count({k, primary})) continue;
+        for (const std::string& other : a.methods)
+          if (other != primary && by_cell.count({k, other}))
+            a.verdicts.push_back(ComparePair(a, k, tier, primary, other));
+      }
   return a;
 }
 
@@ -320,11 +328,12 @@ std::vector<std::string> Verdict(const Aggregate& a) {
            value(v.k, v.other, v.tier, shown) + ")";
     return d;
   };
-  auto tier_line = [&](Tier tier, const std::vector<std::string>& others, const std::string& label) {
+  auto tier_line = [&](const std::string& primary, Tier tier, const std::vector<std::string>& others,
+                       const std::string& label) {
     int pairs = 0, better = 0;
     std::string detail;
     for (const PairVerdict& v : a.verdicts) {
-      if (v.tier != tier || v.outcome == Outcome::kNoData ||
+      if (v.method != primary || v.tier != tier || v.outcome == Outcome::kNoData ||
           std::find(others.begin(), others.end(), v.other) == others.end())
         continue;
       ++pairs;
@@ -334,19 +343,27 @@ std::vector<std::string> Verdict(const Aggregate& a) {
     if (pairs == 0) return;
     std::string head;
     if (better == pairs)
-      head = "icef is **better** in every comparison";
+      head = primary + " is **better** in every comparison";
     else if (better == 0)
-      head = "icef is **not better** in any comparison";
+      head = primary + " is **not better** in any comparison";
     else
-      head = "icef is better in **" + std::to_string(better) + " of " + std::to_string(pairs) + "** comparisons";
-    lines.push_back("**" + std::string(TierName(tier)) + " tier, icef vs " + label + "**: " + head + ". " + detail + ".");
+      head = primary + " is better in **" + std::to_string(better) + " of " + std::to_string(pairs) + "** comparisons";
+    lines.push_back("**" + std::string(TierName(tier)) + " tier, " + primary + " vs " + label + "**: " + head + ". " +
+                    detail + ".");
   };
   if (has_icef && !baselines.empty()) {
     std::vector<std::string> ablations;
     for (const std::string& m : a.methods)
       if (m != "icef" && std::find(baselines.begin(), baselines.end(), m) == baselines.end()) ablations.push_back(m);
-    for (Tier tier : {Tier::kFar, Tier::kModerate, Tier::kNear}) tier_line(tier, baselines, "the baselines");
-    tier_line(Tier::kFar, ablations, "its ablations and the other methods");
+    for (Tier tier : {Tier::kFar, Tier::kModerate, Tier::kNear}) tier_line("icef", tier, baselines, "the baselines");
+    tier_line("icef", Tier::kFar, ablations, "its ablations and the other methods");
+  }
+  if (std::find(a.methods.begin(), a.methods.end(), "icef-prior") != a.methods.end()) {
+    std::vector<std::string> others;
+    for (const std::string& m : a.methods)
+      if (m != "icef-prior") others.push_back(m);
+    for (Tier tier : {Tier::kFar, Tier::kModerate, Tier::kNear})
+      tier_line("icef-prior", tier, others, "every other method");
   }
   // How much of the expression each method shows, and its identity drift against the truth's own.
   for (int k : a.ks) {

@@ -121,7 +121,7 @@ struct Aggregate {
   std::vector<uint64_t> identities;        // ascending
   std::vector<AggregateCell> cells;        // k-major, then method, then tier
   std::vector<Comparison> far_comparisons;  // icef vs every other method, far tier, per K, per metric
-  std::vector<PairVerdict> verdicts;        // icef vs every other method, per K, near/moderate/far
+  std::vector<PairVerdict> verdicts;        // icef and icef-prior vs every other method, per K, near/moderate/far
   const AggregateCell* Find(int k, const std::string& method, Tier tier) const;
 };
 

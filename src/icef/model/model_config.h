@@ -19,7 +19,7 @@
 namespace icef {
 
 struct ModelConfig {
-  std::string method = "icef";        // icef | icef-no-id | icef-no-conf | icef-uniform | warp | nerface | icef-prior | warp-prior
+  std::string method = "icef-prior";  // icef-prior | warp-prior | icef | icef-no-id | icef-no-conf | icef-uniform | warp | nerface
   int grid_levels = 16;               // hash grid levels L
   int grid_features = 2;              // features per level F
   int grid_log2_table_size = 17;      // log2 of the hashed table size T per level
