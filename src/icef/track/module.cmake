@@ -1,0 +1,1 @@
+icef_module(track DEPS icef_face icef_data)

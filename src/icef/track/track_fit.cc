@@ -1,0 +1,451 @@
+#include "icef/track/track_fit.h"
+
+#include <ceres/ceres.h>
+#include <ceres/rotation.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <memory>
+#include <sstream>
+
+#include "icef/face/expression.h"
+#include "icef/face/face_model.h"
+
+namespace icef::track {
+
+namespace {
+
+constexpr int kNumLandmarks = 68;
+constexpr int kExpr = face::kNumExpressions;
+constexpr int kShape = face::ShapeParams::kCount;
+constexpr int kPhotoPose = 6;   // angle-axis on top of the frame's initial rotation [3], translation [3]
+constexpr int kSharedPose = 7;  // angle-axis on top of the initial rotation [3], translation [3], log scale [1]
+// Landmark noise assumed by the priors' balance (IOD units).
+constexpr double kLandmarkSigma = 0.02;
+// Frames solved jointly with the shape at most; the others get their own pose and expression on
+// the shape found (a long video would make the joint problem slow for nothing).
+constexpr int kMaxJointFrames = 24;
+
+Vec2d EyeCentre2d(const std::vector<Vec2f>& lm, int first) {
+  Vec2d c = Vec2d::Zero();
+  for (int i = first; i < first + 6; ++i) c += lm[i].cast<double>();
+  return c / 6.0;
+}
+double Iod2d(const std::vector<Vec2f>& lm) { return (EyeCentre2d(lm, 36) - EyeCentre2d(lm, 42)).norm(); }
+
+Mat3d AngleAxisMatrix(const double* aa) {
+  double r[9];
+  ceres::AngleAxisToRotationMatrix(aa, r);  // column major
+  Mat3d m;
+  for (int c = 0; c < 3; ++c)
+    for (int row = 0; row < 3; ++row) m(row, c) = r[3 * c + row];
+  return m;
+}
+
+// Face models by shape: Ceres perturbs the shape block the same way for every frame, so a small
+// cache of recent shapes saves rebuilding the head (its landmarks come from marching its SDF).
+class ModelCache {
+ public:
+  const face::FaceModel& For(const double* shape) {
+    std::array<float, kShape> key;
+    for (int i = 0; i < kShape; ++i) key[i] = static_cast<float>(shape[i]);
+    for (const auto& [k, model] : entries_)
+      if (k == key) return *model;
+    if (entries_.size() >= 64) entries_.pop_front();
+    entries_.emplace_back(key, std::make_unique<face::FaceModel>(face::ShapeParams::FromArray(key)));
+    return *entries_.back().second;
+  }
+
+ private:
+  std::deque<std::pair<std::array<float, kShape>, std::unique_ptr<face::FaceModel>>> entries_;
+};
+
+std::vector<float> ClampedExpression(const double* e, double max_expression) {
+  std::vector<float> beta(kExpr);
+  for (int i = 0; i < kExpr; ++i) beta[i] = static_cast<float>(std::clamp(e[i], 0.0, max_expression));
+  return beta;
+}
+
+// Everything a frame's residual needs besides the parameters.
+struct FrameProblem {
+  const TrackFrame* frame = nullptr;
+  double iod_px = 1;
+  Mat3d base_rotation = Mat3d::Identity();  // photos: the initial head rotation
+  std::array<double, kNumLandmarks> weight{};
+};
+
+struct Shared {
+  ModelCache cache;
+  face::Similarity base;  // known cameras: the initial head_from_world
+  double max_expression = 1.5;
+  bool known_cameras = false;
+};
+
+// The camera seeing the head frame (photos) or the dataset world (known cameras) for a pose.
+Camera FrameCamera(const FrameProblem& fp, const Shared& shared, const double* pose) {
+  if (shared.known_cameras) return Camera(fp.frame->intrinsics, *fp.frame->world_from_cam);
+  Mat4d cam_from_head = Mat4d::Identity();
+  cam_from_head.block<3, 3>(0, 0) = AngleAxisMatrix(pose) * fp.base_rotation;
+  cam_from_head.block<3, 1>(0, 3) = Vec3d(pose[3], pose[4], pose[5]);
+  return Camera(fp.frame->intrinsics, cam_from_head.inverse());
+}
+
+face::Similarity SharedSimilarity(const Shared& shared, const double* pose) {
+  face::Similarity s;
+  s.rotation = AngleAxisMatrix(pose) * shared.base.rotation;
+  s.translation = Vec3d(pose[3], pose[4], pose[5]);
+  s.scale = shared.base.scale * std::exp(pose[6]);
+  return s;
+}
+
+// Projected model landmarks of a frame; nullopt entries are behind the camera.
+std::vector<std::optional<Vec2d>> Project(const FrameProblem& fp, Shared& shared, const double* shape,
+                                          const double* expression, const double* pose,
+                                          std::array<Vec3f, 68>* head_landmarks = nullptr) {
+  const face::FaceModel& model = shared.cache.For(shape);
+  const std::array<Vec3f, 68> lm = model.Landmarks(model.Prepare(ClampedExpression(expression, shared.max_expression)));
+  if (head_landmarks) *head_landmarks = lm;
+  const Camera camera = FrameCamera(fp, shared, pose);
+  std::optional<face::Similarity> sim;
+  if (shared.known_cameras) sim = SharedSimilarity(shared, pose);
+  std::vector<std::optional<Vec2d>> out(kNumLandmarks);
+  for (int i = 0; i < kNumLandmarks; ++i) {
+    const Vec3d x = sim ? sim->ApplyInverse(lm[i].cast<double>()) : lm[i].cast<double>();
+    if (const auto p = camera.Project(x)) out[i] = p->uv;
+  }
+  return out;
+}
+
+// Per-landmark errors in IOD (unweighted).
+std::vector<double> Errors(const FrameProblem& fp, Shared& shared, const double* shape, const double* expression,
+                           const double* pose) {
+  const auto proj = Project(fp, shared, shape, expression, pose);
+  std::vector<double> e(kNumLandmarks);
+  for (int i = 0; i < kNumLandmarks; ++i)
+    e[i] = proj[i] ? (*proj[i] - fp.frame->landmarks_2d[i].cast<double>()).norm() / fp.iod_px : 10.0;
+  return e;
+}
+
+// The landmark residuals of one frame with a Jacobian by finite differences whose steps suit each
+// block (Ceres' relative steps vanish for weights at 0 and drown in the SDF's float noise): central
+// differences, forward ones for an expression weight at its lower bound.
+class LandmarkCost : public ceres::DynamicCostFunction {
+ public:
+  LandmarkCost(const FrameProblem* fp, Shared* shared) : fp_(fp), shared_(shared) {
+    AddParameterBlock(kShape);
+    AddParameterBlock(kExpr);
+    AddParameterBlock(shared->known_cameras ? kSharedPose : kPhotoPose);
+    SetNumResiduals(2 * kNumLandmarks);
+  }
+
+  bool Evaluate(double const* const* params, double* residuals, double** jacobians) const override {
+    Residuals(params, residuals);
+    if (!jacobians) return true;
+    const int sizes[3] = {kShape, kExpr, shared_->known_cameras ? kSharedPose : kPhotoPose};
+    std::vector<double> a(2 * kNumLandmarks), b(2 * kNumLandmarks);
+    for (int block = 0; block < 3; ++block) {
+      if (!jacobians[block]) continue;
+      std::vector<double> x(params[block], params[block] + sizes[block]);
+      double const* p[3] = {params[0], params[1], params[2]};
+      p[block] = x.data();
+      for (int j = 0; j < sizes[block]; ++j) {
+        const double h = Step(block, j);
+        const double x0 = x[j];
+        const bool forward = block == 1 && x0 < h;
+        x[j] = x0 + h;
+        Residuals(p, a.data());
+        if (forward) {
+          std::copy(residuals, residuals + a.size(), b.begin());
+        } else {
+          x[j] = x0 - h;
+          Residuals(p, b.data());
+        }
+        x[j] = x0;
+        const double span = forward ? h : 2 * h;
+        for (size_t r = 0; r < a.size(); ++r) jacobians[block][r * sizes[block] + j] = (a[r] - b[r]) / span;
+      }
+    }
+    return true;
+  }
+
+ private:
+  static double Step(int block, int j) {
+    if (block == 0) return 2e-3;   // shape scales (~1)
+    if (block == 1) return 1e-2;   // expression weights ([0, ~1])
+    return j < 3 ? 1e-3 : 1e-3;    // angle-axis (radians), translation (head or world units), log scale
+  }
+  void Residuals(double const* const* params, double* residuals) const {
+    const auto proj = Project(*fp_, *shared_, params[0], params[1], params[2]);
+    for (int i = 0; i < kNumLandmarks; ++i) {
+      const double w = fp_->weight[i] / kLandmarkSigma;
+      Vec2d d(1.0, 1.0);  // behind the camera: a large, constant error
+      if (proj[i]) d = (*proj[i] - fp_->frame->landmarks_2d[i].cast<double>()) / fp_->iod_px;
+      residuals[2 * i] = w * d.x();
+      residuals[2 * i + 1] = w * d.y();
+    }
+  }
+
+  const FrameProblem* fp_;
+  Shared* shared_;
+};
+
+template <int N>
+struct GaussianPrior {
+  double mean;
+  double inv_sigma;
+  template <typename T>
+  bool operator()(const T* x, T* residuals) const {
+    for (int i = 0; i < N; ++i) residuals[i] = (x[i] - T(mean)) * T(inv_sigma);
+    return true;
+  }
+};
+
+Status CheckFrames(std::span<const TrackFrame> frames) {
+  if (frames.empty()) return Status::Error("track fit: no frames");
+  const bool known = frames[0].world_from_cam.has_value();
+  for (size_t k = 0; k < frames.size(); ++k) {
+    const TrackFrame& f = frames[k];
+    const std::string where = "track fit: frame " + std::to_string(k) + ": ";
+    if (f.landmarks_2d.size() != kNumLandmarks) return Status::Error(where + "landmarks_2d must have 68 points");
+    for (const Vec2f& p : f.landmarks_2d)
+      if (!p.allFinite()) return Status::Error(where + "landmarks_2d has a non-finite value");
+    if (!(Iod2d(f.landmarks_2d) > 1e-6)) return Status::Error(where + "landmarks_2d: the eyes coincide");
+    if (Status s = f.intrinsics.Validate(); !s.ok()) return Status::Error(where + "intrinsics: " + s.message());
+    if (f.world_from_cam.has_value() != known)
+      return Status::Error(where + "camera poses must be known for every frame or for none");
+    if (f.world_from_cam) {
+      if (Status s = ValidateRigid(*f.world_from_cam); !s.ok()) return Status::Error(where + "camera pose: " + s.message());
+    }
+  }
+  return Status::Ok();
+}
+
+// Photos: the head upright and facing the camera, turned by the eye line's roll, at the depth where
+// the average head's IOD matches the observed one, its nose tip on the nose tip's ray.
+void InitialPhotoPose(const TrackFrame& f, const face::FaceModel& average, double iod_head, Mat3d* rotation,
+                      double* pose) {
+  const Vec2d e = EyeCentre2d(f.landmarks_2d, 42) - EyeCentre2d(f.landmarks_2d, 36);
+  const double roll = std::atan2(-e.y(), e.x());  // image v points down, camera y up
+  *rotation = Eigen::AngleAxisd(roll, Vec3d::UnitZ()).toRotationMatrix();
+  const Intrinsics& k = f.intrinsics;
+  const double depth = k.fl_x * iod_head / Iod2d(f.landmarks_2d);
+  const Vec2f nose = f.landmarks_2d[30];
+  const Vec3d nose_cam = depth * Vec3d((nose.x() - k.cx) / k.fl_x, -(nose.y() - k.cy) / k.fl_y, -1.0);
+  const Vec3d t = nose_cam - *rotation * average.NeutralLandmarks()[30].cast<double>();
+  for (int i = 0; i < 3; ++i) pose[i] = 0, pose[3 + i] = t[i];
+}
+
+struct Solution {
+  std::array<double, kShape> shape;
+  std::vector<std::array<double, kExpr>> expression;
+  std::vector<std::vector<double>> pose;  // photos: per frame [6]; known cameras: [1][7]
+  int iterations = 0;
+};
+
+// One Levenberg-Marquardt solve over the frames `which` (outlier weights as they stand).
+Status Solve(std::vector<FrameProblem>& problems, const std::vector<int>& which, Shared& shared,
+             const TrackFitOptions& options, bool fit_shape, bool fit_pose, Solution* s) {
+  ceres::Problem cp;
+  for (int k : which) {
+    double* pose = shared.known_cameras ? s->pose[0].data() : s->pose[k].data();
+    cp.AddResidualBlock(new LandmarkCost(&problems[k], &shared), nullptr, s->shape.data(), s->expression[k].data(), pose);
+    cp.AddResidualBlock(new ceres::AutoDiffCostFunction<GaussianPrior<kExpr>, kExpr, kExpr>(
+                            new GaussianPrior<kExpr>{0.0, 1.0 / options.expression_prior_sigma}),
+                        nullptr, s->expression[k].data());
+    for (int i = 0; i < kExpr; ++i) {
+      cp.SetParameterLowerBound(s->expression[k].data(), i, 0.0);
+      cp.SetParameterUpperBound(s->expression[k].data(), i, options.max_expression);
+    }
+    if (!fit_pose) cp.SetParameterBlockConstant(pose);
+  }
+  cp.AddResidualBlock(new ceres::AutoDiffCostFunction<GaussianPrior<kShape>, kShape, kShape>(
+                          new GaussianPrior<kShape>{1.0, 1.0 / options.shape_prior_sigma}),
+                      nullptr, s->shape.data());
+  for (int i = 0; i < kShape; ++i) {  // keep the head buildable
+    cp.SetParameterLowerBound(s->shape.data(), i, 0.5);
+    cp.SetParameterUpperBound(s->shape.data(), i, 1.6);
+  }
+  if (!fit_shape) cp.SetParameterBlockConstant(s->shape.data());
+  ceres::Solver::Options so;
+  so.linear_solver_type = ceres::DENSE_SCHUR;
+  so.max_num_iterations = options.max_iterations;
+  so.num_threads = 1;  // deterministic (and the model cache is not thread-safe)
+  so.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(so, &cp, &summary);
+  if (!summary.IsSolutionUsable()) return Status::Error("track fit: the solver failed: " + summary.message);
+  s->iterations += static_cast<int>(summary.iterations.size());
+  return Status::Ok();
+}
+
+const double* PoseOf(const Solution& s, const Shared& shared, int k) {
+  return shared.known_cameras ? s.pose[0].data() : s.pose[k].data();
+}
+
+// Drops (weight 0) the landmarks of `which` farther than outlier_iod and 3x the median error;
+// returns how many were newly dropped.
+int DropOutliers(std::vector<FrameProblem>& problems, const std::vector<int>& which, Shared& shared,
+                 const TrackFitOptions& options, const Solution& s) {
+  std::vector<std::vector<double>> errors;
+  std::vector<double> all;
+  for (int k : which) {
+    errors.push_back(Errors(problems[k], shared, s.shape.data(), s.expression[k].data(), PoseOf(s, shared, k)));
+    all.insert(all.end(), errors.back().begin(), errors.back().end());
+  }
+  std::nth_element(all.begin(), all.begin() + all.size() / 2, all.end());
+  const double cut = std::max(options.outlier_iod, 3.0 * all[all.size() / 2]);
+  int removed = 0;
+  for (size_t j = 0; j < which.size(); ++j) {
+    FrameProblem& fp = problems[which[j]];
+    for (int i = 0; i < kNumLandmarks; ++i)
+      if (errors[j][i] > cut && fp.weight[i] > 0) fp.weight[i] = 0, ++removed;
+  }
+  return removed;
+}
+
+// Pose-only warm start, then the joint solve with one outlier pass.
+Status SolveFrames(std::vector<FrameProblem>& problems, const std::vector<int>& which, Shared& shared,
+                   const TrackFitOptions& options, bool fit_shape, Solution* s) {
+  ICEF_RETURN_IF_ERROR(Solve(problems, which, shared, options, /*fit_shape=*/false, /*fit_pose=*/true, s));
+  for (int pass = 0; pass < 2; ++pass) {
+    ICEF_RETURN_IF_ERROR(Solve(problems, which, shared, options, fit_shape, /*fit_pose=*/true, s));
+    if (pass == 0 && DropOutliers(problems, which, shared, options, *s) == 0) break;
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+Vec3d TrackedFrame::YawPitchRollDeg() const {
+  // cam_from_head = Rz(roll) Rx(pitch) Ry(yaw) with angles about the camera's axes.
+  const Mat3d r = cam_from_head.block<3, 3>(0, 0);
+  const double pitch = std::asin(std::clamp(-r(1, 2), -1.0, 1.0));
+  const double yaw = std::atan2(r(0, 2), r(2, 2));
+  const double roll = std::atan2(r(1, 0), r(1, 1));
+  return Vec3d(yaw, pitch, roll) * 180.0 / M_PI;
+}
+
+Status TrackFitOptions::Validate() const {
+  if (!(shape_prior_sigma > 0) || !std::isfinite(shape_prior_sigma))
+    return Status::Error("shape_prior_sigma must be a finite number > 0");
+  if (!(expression_prior_sigma > 0) || !std::isfinite(expression_prior_sigma))
+    return Status::Error("expression_prior_sigma must be a finite number > 0");
+  if (!(max_expression > 0) || !std::isfinite(max_expression)) return Status::Error("max_expression must be > 0");
+  if (!(jaw_line_weight >= 0) || jaw_line_weight > 1) return Status::Error("jaw_line_weight must be in [0, 1]");
+  if (max_iterations < 1) return Status::Error("max_iterations must be >= 1");
+  if (!(outlier_iod > 0)) return Status::Error("outlier_iod must be > 0");
+  return Status::Ok();
+}
+
+std::string TrackFitOptions::ToString() const {
+  std::ostringstream os;
+  os << "TrackFitOptions(shape_prior_sigma=" << shape_prior_sigma << ", expression_prior_sigma="
+     << expression_prior_sigma << ", max_expression=" << max_expression << ", jaw_line_weight=" << jaw_line_weight
+     << ", max_iterations=" << max_iterations << ", outlier_iod=" << outlier_iod << ")";
+  return os.str();
+}
+
+std::string TrackFit::BriefReport() const {
+  std::ostringstream os;
+  os.precision(3);
+  os << "track fit: " << frames.size() << " images, landmark RMS " << rms_iod << " IOD (max " << max_iod << "), "
+     << iterations << " iterations";
+  return os.str();
+}
+
+Result<TrackFit> FitTrack(std::span<const TrackFrame> frames, const TrackFitOptions& options) {
+  ICEF_RETURN_IF_ERROR(options.Validate().WithContext("track fit options"));
+  ICEF_RETURN_IF_ERROR(CheckFrames(frames));
+  const int n = static_cast<int>(frames.size());
+  const face::FaceModel average(face::ShapeParams::Average());
+  const double iod_head = face::InterOcularDistance(average.NeutralLandmarks());
+
+  Shared shared;
+  shared.max_expression = options.max_expression;
+  shared.known_cameras = frames[0].world_from_cam.has_value();
+  std::vector<FrameProblem> problems(n);
+  Solution s;
+  s.shape.fill(1.0);
+  s.expression.assign(n, {});
+  for (auto& e : s.expression) e.fill(0.0);
+  for (int k = 0; k < n; ++k) {
+    problems[k].frame = &frames[k];
+    problems[k].iod_px = Iod2d(frames[k].landmarks_2d);
+    problems[k].weight.fill(1.0);
+    for (int i = 0; i <= 16; ++i) problems[k].weight[i] = options.jaw_line_weight;
+  }
+  if (shared.known_cameras) {
+    // The head_from_world of the average neutral head (face/face_fit.h's 2D initialisation).
+    std::vector<face::FitFrame> fit_frames(n);
+    for (int k = 0; k < n; ++k) {
+      fit_frames[k].expression.assign(kExpr, 0.f);
+      fit_frames[k].landmarks_2d = frames[k].landmarks_2d;
+      fit_frames[k].camera = Camera(frames[k].intrinsics, *frames[k].world_from_cam);
+    }
+    face::FaceFitOptions fo;
+    fo.fit_shape = false;
+    ICEF_ASSIGN_OR_RETURN(const face::FaceFit initial, face::FitFaceModel(fit_frames, fo));
+    shared.base = initial.head_from_world;
+    s.pose = {{0, 0, 0, shared.base.translation.x(), shared.base.translation.y(), shared.base.translation.z(), 0}};
+  } else {
+    s.pose.assign(n, std::vector<double>(kPhotoPose));
+    for (int k = 0; k < n; ++k) InitialPhotoPose(frames[k], average, iod_head, &problems[k].base_rotation, s.pose[k].data());
+  }
+
+  // The joint solve over (evenly spaced) frames, then every other frame on the shape found.
+  std::vector<int> joint, rest;
+  const int stride = (n + kMaxJointFrames - 1) / kMaxJointFrames;
+  for (int k = 0; k < n; ++k) (k % stride == 0 ? joint : rest).push_back(k);
+  ICEF_RETURN_IF_ERROR(SolveFrames(problems, joint, shared, options, /*fit_shape=*/true, &s));
+  for (int k : rest) {
+    if (shared.known_cameras) {  // the shared pose stays: expression only
+      ICEF_RETURN_IF_ERROR(Solve(problems, {k}, shared, options, false, false, &s));
+    } else {
+      ICEF_RETURN_IF_ERROR(SolveFrames(problems, {k}, shared, options, /*fit_shape=*/false, &s));
+    }
+  }
+
+  TrackFit fit;
+  fit.iterations = s.iterations;
+  fit.shape = face::ShapeParams::FromArray([&] {
+    std::array<float, kShape> v;
+    for (int i = 0; i < kShape; ++i) v[i] = static_cast<float>(s.shape[i]);
+    return v;
+  }());
+  if (shared.known_cameras) fit.head_from_world = SharedSimilarity(shared, s.pose[0].data());
+  double sum2 = 0;
+  int used_all = 0;
+  for (int k = 0; k < n; ++k) {
+    TrackedFrame tf;
+    const double* pose = PoseOf(s, shared, k);
+    tf.expression = ClampedExpression(s.expression[k].data(), options.max_expression);
+    const auto proj = Project(problems[k], shared, s.shape.data(), s.expression[k].data(), pose, &tf.landmarks_head);
+    const Camera camera = FrameCamera(problems[k], shared, pose);
+    tf.cam_from_head = camera.cam_from_world();
+    if (fit.head_from_world) {  // cam_from_world * world_from_head
+      Mat4d world_from_head = Mat4d::Identity();
+      const face::Similarity& h = *fit.head_from_world;
+      world_from_head.block<3, 3>(0, 0) = h.rotation.transpose() / h.scale;
+      world_from_head.block<3, 1>(0, 3) = -h.rotation.transpose() * h.translation / h.scale;
+      tf.cam_from_head = camera.cam_from_world() * world_from_head;
+    }
+    const std::vector<double> e = Errors(problems[k], shared, s.shape.data(), s.expression[k].data(), pose);
+    double frame_sum2 = 0;
+    for (int i = 0; i < kNumLandmarks; ++i) {
+      tf.projected.push_back(proj[i] ? proj[i]->cast<float>() : Vec2f(NAN, NAN));
+      tf.max_iod = std::max(tf.max_iod, e[i]);
+      if (problems[k].weight[i] > 0) frame_sum2 += e[i] * e[i], ++tf.landmarks_used;
+    }
+    tf.rms_iod = std::sqrt(frame_sum2 / std::max(tf.landmarks_used, 1));
+    sum2 += frame_sum2;
+    used_all += tf.landmarks_used;
+    fit.max_iod = std::max(fit.max_iod, tf.max_iod);
+    fit.frames.push_back(std::move(tf));
+  }
+  fit.rms_iod = std::sqrt(sum2 / std::max(used_all, 1));
+  return fit;
+}
+
+}  // namespace icef::track

@@ -1,0 +1,74 @@
+// The tracker's fit (DESIGN.md §8): the face model fitted to the 2D landmarks of several images of
+// one person at once. Identity (the shape scales) is shared; each image gets its own expression
+// weights (in [0, max_expression]) and either its own head pose (photos: nothing is known of the
+// cameras but their intrinsics) or, with known cameras (`icef track --keep-cameras`), one
+// head_from_world similarity shared by all images. Robust nonlinear least squares (Ceres,
+// Levenberg-Marquardt) on residuals in inter-ocular distances (IOD), with Gaussian priors that keep
+// the shape near the average head and the expression weights small, and a second pass without
+// the landmarks the first left far off (outliers).
+//
+// Conventions: cameras are OpenGL-style (looking down -Z, +Y up), landmarks are pixels with
+// +0.5 centres (data/dataset.h), the head frame is face/face_model.h's.
+#pragma once
+
+#include <array>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "icef/core/status.h"
+#include "icef/face/face_fit.h"
+#include "icef/face/shape_params.h"
+#include "icef/math/camera.h"
+#include "icef/math/types.h"
+
+namespace icef::track {
+
+// One image: its 68 detected landmarks and its camera (intrinsics; the pose only when known).
+struct TrackFrame {
+  std::vector<Vec2f> landmarks_2d;      // [68] pixels
+  Intrinsics intrinsics;
+  std::optional<Mat4d> world_from_cam;  // known camera pose (all frames or none)
+};
+
+struct TrackFitOptions {
+  double shape_prior_sigma = 0.15;      // std of each shape scale around 1
+  double expression_prior_sigma = 0.6;  // std of each expression weight around 0 (neutral)
+  double max_expression = 1.5;          // upper bound of the weights (lower bound 0)
+  double jaw_line_weight = 0.5;         // weight of landmarks 0-16: the detector follows the silhouette there
+  int max_iterations = 80;              // Levenberg-Marquardt iterations per pass
+  double outlier_iod = 0.1;             // second pass: drop landmarks farther than this (IOD) and 3x the median
+
+  Status Validate() const;
+  std::string ToString() const;
+};
+
+struct TrackedFrame {
+  Mat4d cam_from_head = Mat4d::Identity();  // rigid: head frame -> camera frame
+  std::vector<float> expression;            // [face::kNumExpressions], face-model order
+  std::array<Vec3f, 68> landmarks_head{};   // the fitted model's landmarks at that expression (head frame)
+  std::vector<Vec2f> projected;             // [68] those landmarks projected into the image
+  double rms_iod = 0;                       // landmark residual of this frame (inliers)
+  double max_iod = 0;                       // its largest landmark residual (all landmarks)
+  int landmarks_used = 0;                   // inliers
+  // The head's rotation relative to the camera, degrees (yaw about +y, pitch about +x, roll about +z).
+  Vec3d YawPitchRollDeg() const;
+};
+
+struct TrackFit {
+  face::ShapeParams shape;
+  // Known cameras only: dataset world -> head frame (photos: each frame's cam_from_head instead).
+  std::optional<face::Similarity> head_from_world;
+  std::vector<TrackedFrame> frames;
+  double rms_iod = 0;  // over all frames' inliers
+  double max_iod = 0;
+  int iterations = 0;
+  std::string BriefReport() const;
+};
+
+// Errors: no frames; a frame without 68 finite landmarks, with coinciding eyes or invalid
+// intrinsics; known poses on some frames only; invalid options; a solve that fails.
+Result<TrackFit> FitTrack(std::span<const TrackFrame> frames, const TrackFitOptions& options = {});
+
+}  // namespace icef::track
