@@ -9,6 +9,7 @@ PACKAGES=(
   libpng-dev libjpeg62-turbo-dev zlib1g-dev  # image reading (libpng, libjpeg-turbo)
   libgtest-dev libgmock-dev libbenchmark-dev
   libceres-dev  # the face-model fit (Ceres)
+  libopencv-imgproc-dev libexif-dev  # icef track: GrabCut masks, crops (OpenCV); EXIF focal lengths
   libdlib-dev libdlib-data opencv-doc python3-skimage python-matplotlib-data  # eval: face alignment, test photos
   gnuplot-nox  # bench: report plots (PNG + SVG)
 )

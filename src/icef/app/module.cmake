@@ -1,1 +1,1 @@
-icef_module(app DEPS icef_train icef_synth)
+icef_module(app DEPS icef_train icef_synth icef_track)

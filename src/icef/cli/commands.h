@@ -25,5 +25,6 @@ CommandFn RegisterConfig(CLI::App& app);
 CommandFn RegisterSynth(CLI::App& app);
 CommandFn RegisterSheet(CLI::App& app);
 CommandFn RegisterLandmarks(CLI::App& app);
+CommandFn RegisterTrack(CLI::App& app);
 
 }  // namespace icef::cli

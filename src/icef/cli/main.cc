@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
       {"config", {"Print the resolved run config, or document every key (--markdown)", icef::cli::RegisterConfig}},
       {"mask", {"Show the expression-region mask (overlay + volume slices)", icef::cli::RegisterMask}},
       {"landmarks", {"Detect 68 face landmarks (dlib) and write them into a dataset", icef::cli::RegisterLandmarks}},
+      {"track", {"Turn photos of one person into a dataset: landmarks, face-model fit, crops, masks", icef::cli::RegisterTrack}},
       {"faceid", {"Face-identity descriptors of photos and their pairwise distances", icef::cli::RegisterFaceId}},
       {"eval", {"Evaluate a trained model: PSNR, SSIM, LPIPS, identity consistency per tier", icef::cli::RegisterEval}},
       {"bench", {"Run the benchmark (synthesise, train, evaluate every method) and write the report", icef::cli::RegisterBench}},

@@ -2,7 +2,7 @@
 file(GLOB icef_cli_sources CONFIGURE_DEPENDS ${CMAKE_CURRENT_LIST_DIR}/*.cc)
 add_executable(icef ${icef_cli_sources})
 target_link_libraries(icef PRIVATE icef_data)
-foreach(module face landmarks synth nn render field model train eval app)
+foreach(module face landmarks track synth nn render field model train eval app)
   if(TARGET icef_${module})
     target_link_libraries(icef PRIVATE icef_${module})
   endif()

@@ -51,6 +51,24 @@ Status WriteFileAtomic(const fs::path& path, std::string_view bytes) {
   return Status::Ok();
 }
 
+Status CreateDirectoryAtomic(const fs::path& dir, const std::function<Status(const fs::path& tmp)>& fill) {
+  std::error_code ec;
+  if (fs::exists(dir, ec) && !(fs::is_directory(dir, ec) && fs::is_empty(dir, ec)))
+    return Status::Error(dir.string() + ": already exists and is not an empty directory");
+  const fs::path parent = dir.has_parent_path() ? dir.parent_path() : fs::path(".");
+  const fs::path tmp = parent / (dir.filename().string() + ".tmp-" + std::to_string(getpid()));
+  fs::remove_all(tmp, ec);
+  if (!fs::create_directories(tmp, ec)) return Status::Error(tmp.string() + ": cannot create the directory: " + ec.message());
+  Status status = fill(tmp);
+  if (status.ok()) {
+    if (fs::exists(dir, ec)) fs::remove(dir, ec);  // an empty directory
+    fs::rename(tmp, dir, ec);
+    if (ec) status = Status::Error(dir.string() + ": cannot move the new directory into place: " + ec.message());
+  }
+  if (!status.ok()) fs::remove_all(tmp, ec);
+  return status;
+}
+
 Result<std::string> ReadFile(const fs::path& path) {
   std::error_code ec;
   if (!fs::exists(path, ec)) return Status::Error(path.string() + ": file not found");

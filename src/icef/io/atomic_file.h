@@ -4,6 +4,7 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <string_view>
 
@@ -12,6 +13,12 @@
 namespace icef {
 
 Status WriteFileAtomic(const std::filesystem::path& path, std::string_view bytes);
+
+// A new directory, all or nothing: `fill` writes its contents into a temporary sibling directory,
+// which is then renamed to `dir`. `dir` must not exist or be an empty directory (nothing already
+// there is touched otherwise); on any error the temporary is removed and `dir` is left as it was.
+Status CreateDirectoryAtomic(const std::filesystem::path& dir,
+                             const std::function<Status(const std::filesystem::path& tmp)>& fill);
 
 // Reads a whole file; the error names the file.
 Result<std::string> ReadFile(const std::filesystem::path& path);

@@ -1,0 +1,138 @@
+#include "icef/app/track_app.h"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+
+#include "icef/app/face_outline.h"
+#include "icef/core/parallel.h"
+#include "icef/face/expression.h"
+#include "icef/landmarks/face_landmark_detector.h"
+
+namespace icef {
+
+namespace {
+
+constexpr int kOverlayHeight = 384;
+
+void Dot(Image* image, const Vec2f& p, const Vec3f& colour) {
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) {
+      const int x = static_cast<int>(std::floor(p.x())) + dx, y = static_cast<int>(std::floor(p.y())) + dy;
+      if (x < 0 || y < 0 || x >= image->width || y >= image->height) continue;
+      for (int c = 0; c < 3; ++c) image->At(x, y, c) = colour[c];
+    }
+}
+
+// RGBA over a grey checkerboard (RGB).
+Image OverChecker(const Image& rgba) {
+  Image out(rgba.width, rgba.height, 3);
+  for (int y = 0; y < rgba.height; ++y)
+    for (int x = 0; x < rgba.width; ++x) {
+      const float a = rgba.At(x, y, 3);
+      const float bg = ((x / 16 + y / 16) % 2) ? 0.55f : 0.8f;
+      for (int c = 0; c < 3; ++c) out.At(x, y, c) = a * rgba.At(x, y, c) + (1 - a) * bg;
+    }
+  return out;
+}
+
+std::string ExpressionText(const std::vector<float>& beta) {
+  std::ostringstream os;
+  os << std::fixed << std::setprecision(2);
+  bool any = false;
+  for (int e = 0; e < face::kNumExpressions; ++e)
+    if (beta[e] >= 0.05f) os << (any ? " " : "") << face::kExpressionNames[e] << "=" << beta[e], any = true;
+  return any ? os.str() : "neutral";
+}
+
+}  // namespace
+
+Image TrackOverlay(const track::TrackResult& result, int photo_index) {
+  const track::TrackedPhoto& p = result.photos[photo_index];
+  const track::TrackedFrame& f = result.fit.frames[photo_index];
+  const Vec3f green(0.1f, 0.95f, 0.2f), red(1.f, 0.15f, 0.1f);
+  const std::vector<Vec3f> model(f.landmarks_head.begin(), f.landmarks_head.end());
+
+  const int w = std::max(1, static_cast<int>(std::lround(double(p.photo.width) * kOverlayHeight / p.photo.height)));
+  Image left = track::ResizeImage(p.photo, w, kOverlayHeight);
+  const double s = double(kOverlayHeight) / p.photo.height;
+  DrawFaceOutline(&left, Camera(p.photo_intrinsics, f.cam_from_head.inverse()), model, red);
+  for (const Vec2f& l : p.detection.landmarks) Dot(&left, (l.cast<double>() * s).cast<float>(), green);
+
+  const Frame& frame = (p.test ? result.dataset.test : result.dataset.train)[p.frame_index];
+  Image right = track::ResizeImage(OverChecker(p.image), kOverlayHeight, kOverlayHeight);
+  DrawFaceOutline(&right, frame.camera, model, red);
+
+  Image out(left.width + right.width, kOverlayHeight, 3);
+  for (int y = 0; y < kOverlayHeight; ++y) {
+    for (int x = 0; x < left.width; ++x)
+      for (int c = 0; c < 3; ++c) out.At(x, y, c) = left.Rgb(x, y)[c];
+    for (int x = 0; x < right.width; ++x)
+      for (int c = 0; c < 3; ++c) out.At(left.width + x, y, c) = right.At(x, y, c);
+  }
+  return out;
+}
+
+namespace {
+
+Status RunRetrack(const TrackAppOptions& options, std::ostream& out) {
+  if (options.photos.size() != 1) return Status::Error("icef track --keep-cameras takes one dataset directory");
+  ICEF_ASSIGN_OR_RETURN(const Dataset source, LoadDataset(options.photos[0]));
+  track::RetrackOptions ro;
+  ro.skip_bad = options.track.skip_bad;
+  ro.predictor_path = options.predictor;
+  ro.fit = options.track.fit;
+  out << "icef track --keep-cameras: " << options.photos[0].string() << " (" << source.train.size() << " training, "
+      << source.test.size() << " test frames, expression_dim " << source.expression_dim << ")\n";
+  ICEF_ASSIGN_OR_RETURN(const track::RetrackResult result,
+                        track::RetrackDataset(source, ro, Executor(options.threads),
+                                              [&](const std::string& line) { out << line << "\n"; }));
+  for (size_t k = 0; k < result.fit.frames.size(); ++k)
+    if (result.fit.frames[k].rms_iod > 0.05)
+      out << "warning: " << result.frame_names[k] << ": the face model fits its landmarks poorly (RMS "
+          << result.fit.frames[k].rms_iod << " IOD > 0.05)\n";
+  out << "head_from_world: " << result.fit.head_from_world->ToString() << "\n";
+  ICEF_RETURN_IF_ERROR(track::WriteRetrackedDataset(result, options.out));
+  out << "wrote " << options.out.string() << ": the same cameras and images, expressions in the face model's "
+      << face::kNumExpressions << " weights; per-frame fit in " << (options.out / "track" / "report.json").string()
+      << "\n";
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status RunTrack(const TrackAppOptions& options, std::ostream& out) {
+  if (options.keep_cameras) return RunRetrack(options, out);
+  ICEF_ASSIGN_OR_RETURN(const std::vector<std::filesystem::path> photos, track::ExpandPhotoArguments(options.photos));
+  ICEF_ASSIGN_OR_RETURN(const FaceLandmarkDetector detector, FaceLandmarkDetector::Load(options.predictor));
+  out << "icef track: " << photos.size() << " photo" << (photos.size() == 1 ? "" : "s") << "\n";
+  ICEF_ASSIGN_OR_RETURN(track::TrackResult result,
+                        track::TrackPhotos(photos, options.track, detector, Executor(options.threads),
+                                           [&](const std::string& line) { out << line << "\n"; }));
+  std::vector<std::pair<std::string, Image>> overlays;
+  for (size_t i = 0; i < result.photos.size(); ++i) {
+    const track::TrackedPhoto& p = result.photos[i];
+    const track::TrackedFrame& f = result.fit.frames[i];
+    const Vec3d ypr = f.YawPitchRollDeg();
+    out << std::fixed << std::setprecision(3) << "  " << p.source.filename().string() << " -> "
+        << (p.test ? "test" : "train") << "[" << p.frame_index << "]: landmark RMS " << f.rms_iod << " IOD, yaw "
+        << std::setprecision(1) << ypr.x() << " pitch " << ypr.y() << " roll " << ypr.z() << ", focal "
+        << p.photo_intrinsics.fl_x << " px (" << track::FocalSourceName(p.focal_source) << "), "
+        << ExpressionText(f.expression) << "\n";
+    out << std::setprecision(3);
+    if (f.rms_iod > 0.05)
+      out << "  warning: " << p.source.string() << ": the face model fits its landmarks poorly (RMS " << f.rms_iod
+          << " IOD > 0.05); check track/overlay_" << i << ".png\n";
+    char name[64];
+    std::snprintf(name, sizeof(name), "track/overlay_%03zu.png", i);
+    overlays.emplace_back(name, TrackOverlay(result, static_cast<int>(i)));
+  }
+  out.unsetf(std::ios::fixed);
+  ICEF_RETURN_IF_ERROR(track::WriteTrackedDataset(result, options.out, overlays));
+  out << "wrote " << options.out.string() << ": " << result.dataset.train.size() << " training and "
+      << result.dataset.test.size() << " test frames at " << options.track.resolution << "x"
+      << options.track.resolution << "; overlays and report.json in " << (options.out / "track").string() << "\n";
+  return Status::Ok();
+}
+
+}  // namespace icef

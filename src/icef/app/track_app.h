@@ -1,0 +1,35 @@
+// `icef track PHOTOS... --out DATASET`: track/photo_track.h's pipeline with what a user sees: the
+// log, an overlay per photo (track/overlay_NNN.png: the photo with the detected landmarks in green
+// and the fitted face model's outline in red, beside the dataset image over a checkerboard, which
+// shows the mask), and the summary. With --keep-cameras, an existing dataset re-expressed in the face
+// model's expression space instead.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <ostream>
+#include <vector>
+
+#include "icef/core/status.h"
+#include "icef/track/dataset_retrack.h"
+#include "icef/track/photo_track.h"
+
+namespace icef {
+
+struct TrackAppOptions {
+  std::vector<std::filesystem::path> photos;  // files or directories
+  std::filesystem::path out;
+  track::TrackOptions track;
+  std::filesystem::path predictor;  // dlib's 68-point shape predictor; empty: the Debian default
+  int threads = 0;
+  // photos is one dataset directory, re-expressed with its cameras kept (track/dataset_retrack.h).
+  bool keep_cameras = false;
+};
+
+// The overlay of one tracked photo (see above), 384 pixels high.
+Image TrackOverlay(const track::TrackResult& result, int photo_index);
+
+// Photos -> dataset (or, with keep_cameras, dataset -> re-expressed dataset).
+Status RunTrack(const TrackAppOptions& options, std::ostream& out);
+
+}  // namespace icef

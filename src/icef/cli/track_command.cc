@@ -1,0 +1,47 @@
+// icef track PHOTOS... --out DATASET [--res N] [--focal PX] [--test N] [--skip-bad] [--threads N]
+// icef track DATASET --keep-cameras --out NEW
+// From a handful of photos of one person to a dataset (DESIGN.md §8): app/track_app.h does the work.
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "icef/app/track_app.h"
+#include "icef/cli/commands.h"
+#include "icef/landmarks/face_landmark_detector.h"
+
+namespace icef::cli {
+
+CommandFn RegisterTrack(CLI::App& app) {
+  auto options = std::make_shared<TrackAppOptions>();
+  auto focal = std::make_shared<double>(0);
+  app.description(
+      "Turn photos of one person into a dataset: detects the face and its 68 landmarks in each photo (exactly one "
+      "face per photo), fits the face model to all photos at once (shared identity; per photo a head pose and "
+      "expression weights), crops a square around the head, masks the person (GrabCut seeded by the fitted head) "
+      "and writes the dataset in the fitted head's frame, with track/overlay_NNN.png to check the fit and "
+      "track/report.json. Then: icef train DATASET, icef render --sweep.\n"
+      "With --keep-cameras, re-express an existing dataset (NerFace, instant-ngp, any expression space) in the face "
+      "model's expressions: same cameras and images, the face model fitted to every frame's landmarks.");
+  app.add_option("photos", options->photos, "Photos (PNG/JPEG) or directories of photos")->required();
+  app.add_option("--out", options->out, "Dataset directory to create (must not exist, or be empty)")->required();
+  app.add_option("--res", options->track.resolution, "Side of the square dataset images in pixels (default 256)");
+  app.add_option("--focal", *focal,
+                 "Focal length in pixels of the photos (default: the EXIF 35 mm-equivalent focal length, else a "
+                 "35 mm-equivalent lens: 0.81 x the photo's diagonal)");
+  app.add_option("--test", options->track.num_test, "Hold out the last N photos as test frames (default 0)");
+  app.add_flag("--skip-bad", options->track.skip_bad,
+               "Skip photos without exactly one face (default: stop, naming the photo, and write nothing)");
+  app.add_flag("--keep-cameras", options->keep_cameras,
+               "PHOTOS is one dataset: keep its cameras and images, re-express its expressions in the face model's");
+  app.add_option("--threads", options->threads, "Worker threads (0 = all cores)");
+  app.add_option("--predictor", options->predictor,
+                 "dlib 68-point shape predictor (default " + std::string(kDefaultShapePredictorPath) + ")");
+  return [options, focal, &app]() -> Status {
+    if (app.count("--focal")) options->track.focal = *focal;
+    return RunTrack(*options, std::cout);
+  };
+}
+
+}  // namespace icef::cli

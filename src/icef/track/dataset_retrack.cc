@@ -1,0 +1,145 @@
+#include "icef/track/dataset_retrack.h"
+
+#include <set>
+#include <system_error>
+
+#include "icef/face/expression.h"
+#include "icef/face/shape_params.h"
+#include "icef/io/atomic_file.h"
+#include "icef/landmarks/landmark_detection.h"
+
+namespace icef::track {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+std::vector<Frame>* Split(Dataset& d, const std::string& name) {
+  return name == "train" ? &d.train : name == "test" ? &d.test : &d.val;
+}
+
+std::string FrameName(const std::string& split, int index, const Frame& f) {
+  return split + "[" + std::to_string(index) + "] " + f.file_path;
+}
+
+}  // namespace
+
+Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions& options, const Executor& executor,
+                                     const std::function<void(const std::string&)>& log) {
+  ICEF_RETURN_IF_ERROR(options.fit.Validate().WithContext("track fit options"));
+  RetrackResult result;
+  result.dataset = source;
+  Dataset& d = result.dataset;
+
+  // Landmarks: the dataset's own, else dlib's.
+  bool missing = false;
+  for (const auto* frames : {&d.train, &d.test, &d.val})
+    for (const Frame& f : *frames) missing = missing || !f.landmarks_2d;
+  if (missing) {
+    LandmarkDetectionOptions lo;
+    lo.predictor_path = options.predictor_path;
+    if (log) log("detecting the landmarks of the frames without landmarks_2d");
+    ICEF_ASSIGN_OR_RETURN(const LandmarkDetectionReport report, DetectDatasetLandmarks(source, lo, executor));
+    for (const FrameLandmarks& fl : report.frames)
+      if (fl.outcome == LandmarkOutcome::kDetected) (*Split(d, fl.split))[fl.index].landmarks_2d = fl.detection.landmarks;
+  }
+  // Frames without landmarks: an error, or dropped.
+  for (const std::string split : {"train", "test", "val"}) {
+    std::vector<Frame>* frames = Split(d, split);
+    std::vector<Frame> kept;
+    for (size_t i = 0; i < frames->size(); ++i) {
+      if ((*frames)[i].landmarks_2d) {
+        kept.push_back((*frames)[i]);
+        continue;
+      }
+      const std::string name = FrameName(split, static_cast<int>(i), (*frames)[i]);
+      if (!options.skip_bad) return Status::Error(source.root.string() + ": " + name + ": no face found (--skip-bad drops such frames)");
+      result.skipped.push_back(name + ": no face found");
+      if (log) log("skipped " + name + ": no face found");
+    }
+    *frames = std::move(kept);
+  }
+  if (d.train.empty()) return Status::Error(source.root.string() + ": no training frame with a face");
+
+  std::vector<TrackFrame> track_frames;
+  std::vector<Frame*> order;
+  for (const std::string split : {"train", "test", "val"}) {
+    std::vector<Frame>* frames = Split(d, split);
+    for (size_t i = 0; i < frames->size(); ++i) {
+      Frame& f = (*frames)[i];
+      track_frames.push_back(TrackFrame{*f.landmarks_2d, f.camera.intrinsics(), f.camera.world_from_cam()});
+      order.push_back(&f);
+      result.frame_names.push_back(FrameName(split, static_cast<int>(i), f));
+    }
+  }
+  ICEF_ASSIGN_OR_RETURN(result.fit, FitTrack(track_frames, options.fit));
+  if (log) log(result.fit.BriefReport());
+  const face::Similarity& sim = *result.fit.head_from_world;
+  for (size_t k = 0; k < order.size(); ++k) {
+    Frame& f = *order[k];
+    f.expression = result.fit.frames[k].expression;
+    std::vector<Vec3f> world;
+    for (const Vec3f& p : result.fit.frames[k].landmarks_head) world.push_back(sim.ApplyInverse(p.cast<double>()).cast<float>());
+    f.landmarks_3d = world;
+    f.neutral_landmarks_2d.reset();  // in the source's terms; the neutral image is kept
+    f.neutral_landmarks_3d.reset();
+  }
+  d.expression_dim = face::kNumExpressions;
+  d.expression_names = face::ExpressionNames();
+  return result;
+}
+
+Json RetrackReportJson(const RetrackResult& result) {
+  Json frames = Json::array();
+  for (size_t k = 0; k < result.fit.frames.size(); ++k) {
+    const TrackedFrame& f = result.fit.frames[k];
+    Json expression = Json::object();
+    for (int e = 0; e < face::kNumExpressions; ++e) expression[face::kExpressionNames[e]] = JsonFloat(f.expression[e]);
+    frames.push_back(Json{{"frame", result.frame_names[k]},
+                          {"landmark_rms_iod", f.rms_iod},
+                          {"landmark_max_iod", f.max_iod},
+                          {"landmarks_used", f.landmarks_used},
+                          {"expression", expression}});
+  }
+  Json shape = Json::object();
+  const auto values = result.fit.shape.ToArray();
+  for (int i = 0; i < face::ShapeParams::kCount; ++i) shape[face::kShapeParamNames[i]] = JsonFloat(values[i]);
+  const face::Similarity& s = *result.fit.head_from_world;
+  Json rotation = Json::array();
+  for (int r = 0; r < 3; ++r) rotation.push_back({s.rotation(r, 0), s.rotation(r, 1), s.rotation(r, 2)});
+  return Json{{"frames", frames},
+              {"skipped", result.skipped},
+              {"landmark_rms_iod", result.fit.rms_iod},
+              {"landmark_max_iod", result.fit.max_iod},
+              {"iterations", result.fit.iterations},
+              {"head_from_world", {{"scale", s.scale},
+                                   {"rotation", rotation},
+                                   {"translation", {s.translation.x(), s.translation.y(), s.translation.z()}}}},
+              {"shape", shape}};
+}
+
+Status WriteRetrackedDataset(const RetrackResult& result, const fs::path& out_dir) {
+  return CreateDirectoryAtomic(out_dir, [&](const fs::path& tmp) -> Status {
+    const Dataset& src = result.dataset;
+    std::set<std::string> files;
+    for (const auto* frames : {&src.train, &src.test, &src.val})
+      for (const Frame& f : *frames) {
+        files.insert(f.file_path);
+        if (f.neutral_file_path) files.insert(*f.neutral_file_path);
+      }
+    if (src.background_file_path) files.insert(*src.background_file_path);
+    std::error_code ec;
+    for (const std::string& rel : files) {
+      fs::create_directories((tmp / rel).parent_path(), ec);
+      if (!fs::copy_file(src.root / rel, tmp / rel, ec))
+        return Status::Error((src.root / rel).string() + ": cannot copy the image: " + ec.message());
+    }
+    Dataset d = src;
+    d.root = tmp;
+    ICEF_RETURN_IF_ERROR(SaveDataset(d));
+    fs::create_directories(tmp / "track", ec);
+    return WriteFileAtomic(tmp / "track" / "report.json", FormatJson(RetrackReportJson(result)) + "\n");
+  });
+}
+
+}  // namespace icef::track

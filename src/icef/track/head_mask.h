@@ -1,0 +1,39 @@
+// The foreground mask of a tracked photo: GrabCut (OpenCV) seeded by the fitted head's silhouette.
+// Well inside the silhouette is sure foreground, the rest of it probable foreground, a band around
+// it probable background, everything farther (and what lies outside the photo) sure background;
+// GrabCut's colour models then move the boundary onto the image's own edges (hair beyond the
+// skull, the neck). The largest connected component, holes filled, is the mask.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "icef/core/parallel.h"
+#include "icef/core/status.h"
+#include "icef/face/face_model.h"
+#include "icef/io/image.h"
+#include "icef/math/camera.h"
+
+namespace icef::track {
+
+struct HeadMaskOptions {
+  double sure_inside = 0.04;   // silhouette pixels deeper than this (fraction of the image width) are sure foreground
+  double band = 0.12;          // outside pixels within this distance of the silhouette are probable background
+  int iterations = 5;          // GrabCut iterations
+
+  Status Validate() const;
+  std::string ToString() const;
+};
+
+// 1-channel image, 1 where the face model at `expression` covers the pixel (world = head frame).
+Image HeadSilhouette(const face::FaceModel& model, const std::vector<float>& expression, const Camera& camera,
+                     const Executor& executor = Executor(1));
+
+// The mask (1-channel, 0 or 1) of `image` (RGB or RGBA; alpha ignored). `outside` (1-channel, may be
+// empty) marks pixels that lie outside the original photo. Deterministic.
+Image HeadMask(const Image& image, const Image& silhouette, const Image& outside, const HeadMaskOptions& options = {});
+
+// Intersection over union of two masks (> 0.5).
+double MaskIou(const Image& a, const Image& b);
+
+}  // namespace icef::track

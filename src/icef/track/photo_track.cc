@@ -1,0 +1,283 @@
+#include "icef/track/photo_track.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <system_error>
+
+#include "icef/face/expression.h"
+#include "icef/face/face_model.h"
+#include "icef/face/shape_params.h"
+#include "icef/io/atomic_file.h"
+
+namespace icef::track {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// Tier thresholds of the held-out photos (as `icef synth`'s defaults).
+constexpr double kNearThreshold = 0.35;
+constexpr double kFarThreshold = 0.8;
+
+std::string Pad3(int i) {
+  std::string s = std::to_string(i);
+  return std::string(s.size() < 3 ? 3 - s.size() : 0, '0') + s;
+}
+
+double ExpressionDistance(const std::vector<float>& beta, const std::vector<Frame>& train) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const Frame& f : train) {
+    double s = 0;
+    for (size_t i = 0; i < beta.size(); ++i) s += (beta[i] - f.expression[i]) * (beta[i] - f.expression[i]);
+    best = std::min(best, std::sqrt(s));
+  }
+  return best;
+}
+
+Mat4d Inverse(const Mat4d& m) { return m.inverse(); }
+
+struct Detected {
+  Image photo;
+  Result<FaceDetection> detection = Status::Error("not run");
+};
+
+// Reads and detects every photo (in parallel, one detector per thread, each photo into its slot).
+Result<std::vector<Detected>> DetectAll(const std::vector<fs::path>& photos, const FaceLandmarkDetector& detector,
+                                        const Executor& executor) {
+  std::vector<Detected> out(photos.size());
+  std::vector<Status> read_errors(photos.size());
+  ParallelFor(executor, static_cast<int64_t>(photos.size()), [&](int64_t begin, int64_t end, int) {
+    const FaceLandmarkDetector local = detector.Clone();
+    for (int64_t i = begin; i < end; ++i) {
+      Result<Image> image = ReadImage(photos[i]);
+      if (!image.ok()) {
+        read_errors[i] = image.status();
+        continue;
+      }
+      out[i].photo = image->HasAlpha() ? CompositeOver(*image, Vec3f::Ones()) : std::move(*image);
+      out[i].detection = local.DetectFace(out[i].photo);
+    }
+  });
+  for (size_t i = 0; i < photos.size(); ++i)
+    if (!read_errors[i].ok())
+      return Status::Error(photos[i].string() + ": cannot read the image: " + read_errors[i].message());
+  return out;
+}
+
+Intrinsics PhotoIntrinsics(const fs::path& path, const Image& photo, const TrackOptions& options, FocalSource* source) {
+  Intrinsics k;
+  k.width = photo.width;
+  k.height = photo.height;
+  k.cx = 0.5 * photo.width;
+  k.cy = 0.5 * photo.height;
+  if (options.focal) {
+    k.fl_x = *options.focal;
+    *source = FocalSource::kFlag;
+  } else if (const auto exif = ExifFocalPixels(path, photo.width, photo.height)) {
+    k.fl_x = *exif;
+    *source = FocalSource::kExif;
+  } else {
+    k.fl_x = DefaultFocalPixels(photo.width, photo.height);
+    *source = FocalSource::kDefault;
+  }
+  k.fl_y = k.fl_x;
+  return k;
+}
+
+// The dataset frame and image of one tracked photo.
+void BuildFrame(const face::FaceModel& model, const TrackedFrame& tracked, const TrackOptions& options,
+                const Executor& executor, TrackedPhoto* photo, Frame* frame) {
+  const Camera photo_camera(photo->photo_intrinsics, Inverse(tracked.cam_from_head));
+  photo->crop = HeadCropBox(photo_camera, options.crop_margin);
+  Image outside;
+  const Image rgb = CropImage(photo->photo, photo->crop, options.resolution, &outside);
+  const Intrinsics k = CropIntrinsics(photo->photo_intrinsics, photo->crop, options.resolution);
+  const Camera camera(k, Inverse(tracked.cam_from_head));
+  const Image silhouette = HeadSilhouette(model, tracked.expression, camera, executor);
+  const Image mask = HeadMask(rgb, silhouette, outside, options.mask);
+  photo->image = Image(options.resolution, options.resolution, 4);
+  for (int y = 0; y < options.resolution; ++y)
+    for (int x = 0; x < options.resolution; ++x) {
+      const Vec3f c = rgb.Rgb(x, y);
+      for (int ch = 0; ch < 3; ++ch) photo->image.At(x, y, ch) = std::clamp(c[ch], 0.f, 1.f);
+      photo->image.At(x, y, 3) = mask.At(x, y, 0);
+    }
+  const std::string split = photo->test ? "test" : "train";
+  frame->file_path = "images/" + split + "_" + Pad3(photo->frame_index) + ".png";
+  frame->camera = camera;
+  frame->expression = tracked.expression;
+  frame->landmarks_2d = CropPoints(photo->detection.landmarks, photo->crop, options.resolution);
+  frame->landmarks_3d = std::vector<Vec3f>(tracked.landmarks_head.begin(), tracked.landmarks_head.end());
+}
+
+}  // namespace
+
+const char* FocalSourceName(FocalSource source) {
+  switch (source) {
+    case FocalSource::kFlag: return "flag";
+    case FocalSource::kExif: return "exif";
+    case FocalSource::kDefault: return "default";
+  }
+  return "?";
+}
+
+Status TrackOptions::Validate() const {
+  if (resolution < 32 || resolution > 4096) return Status::Error("resolution must be in [32, 4096]");
+  if (focal && !(*focal > 0 && std::isfinite(*focal))) return Status::Error("focal must be a finite number > 0");
+  if (num_test < 0) return Status::Error("the number of test photos must be >= 0");
+  if (!(crop_margin >= 1 && crop_margin <= 3)) return Status::Error("crop_margin must be in [1, 3]");
+  ICEF_RETURN_IF_ERROR(fit.Validate());
+  return mask.Validate();
+}
+
+std::string TrackOptions::ToString() const {
+  std::ostringstream os;
+  os << "TrackOptions(resolution=" << resolution << ", focal=" << (focal ? std::to_string(*focal) : "auto")
+     << ", num_test=" << num_test << ", skip_bad=" << skip_bad << ", crop_margin=" << crop_margin << ", "
+     << fit.ToString() << ", " << mask.ToString() << ")";
+  return os.str();
+}
+
+Result<TrackResult> TrackPhotos(const std::vector<fs::path>& photos, const TrackOptions& options,
+                                const FaceLandmarkDetector& detector, const Executor& executor,
+                                const std::function<void(const std::string&)>& log) {
+  ICEF_RETURN_IF_ERROR(options.Validate().WithContext("track options"));
+  if (photos.empty()) return Status::Error("icef track: no photos given");
+  ICEF_ASSIGN_OR_RETURN(std::vector<Detected> detected, DetectAll(photos, detector, executor));
+
+  TrackResult result;
+  for (size_t i = 0; i < photos.size(); ++i) {
+    std::string why;
+    if (!detected[i].detection.ok()) {
+      why = "no face found";
+    } else if (detected[i].detection->num_faces > 1) {
+      why = std::to_string(detected[i].detection->num_faces) + " faces found; icef track needs exactly one per photo";
+    }
+    if (!why.empty()) {
+      if (!options.skip_bad) return Status::Error(photos[i].string() + ": " + why + " (--skip-bad skips such photos)");
+      result.skipped.push_back(photos[i].string() + ": " + why);
+      if (log) log("skipped " + photos[i].string() + ": " + why);
+      continue;
+    }
+    TrackedPhoto p;
+    p.source = photos[i];
+    p.photo = std::move(detected[i].photo);
+    p.detection = std::move(*detected[i].detection);
+    p.photo_intrinsics = PhotoIntrinsics(photos[i], p.photo, options, &p.focal_source);
+    result.photos.push_back(std::move(p));
+  }
+  const int kept = static_cast<int>(result.photos.size());
+  if (kept - options.num_test < 1)
+    return Status::Error("icef track: needs at least one training photo with a face besides the --test ones, got " +
+                         std::to_string(kept) + " photo" + (kept == 1 ? "" : "s") + " with a face and --test " +
+                         std::to_string(options.num_test));
+
+  std::vector<TrackFrame> frames;
+  for (const TrackedPhoto& p : result.photos) frames.push_back(TrackFrame{p.detection.landmarks, p.photo_intrinsics, {}});
+  ICEF_ASSIGN_OR_RETURN(result.fit, FitTrack(frames, options.fit));
+  if (log) log(result.fit.BriefReport());
+
+  Dataset& d = result.dataset;
+  d.expression_dim = face::kNumExpressions;
+  d.expression_names = face::ExpressionNames();
+  const face::FaceModel model(result.fit.shape);
+  d.aabb = model.Bounds();
+  d.aabb.min -= Vec3f::Constant(0.1f);
+  d.aabb.max += Vec3f::Constant(0.1f);
+  d.background = Vec3f::Ones();
+  d.tier_thresholds = std::array<double, 2>{kNearThreshold, kFarThreshold};
+  for (int i = 0; i < kept; ++i) {
+    TrackedPhoto& p = result.photos[i];
+    p.test = i >= kept - options.num_test;
+    p.frame_index = p.test ? i - (kept - options.num_test) : i;
+    Frame frame;
+    BuildFrame(model, result.fit.frames[i], options, executor, &p, &frame);
+    (p.test ? d.test : d.train).push_back(std::move(frame));
+  }
+  for (Frame& f : d.test) {
+    f.delta = ExpressionDistance(f.expression, d.train);
+    f.tier = *f.delta == 0 ? Tier::kObserved : *f.delta <= kNearThreshold ? Tier::kNear
+                                              : *f.delta <= kFarThreshold ? Tier::kModerate
+                                                                          : Tier::kFar;
+  }
+  return result;
+}
+
+Json TrackReportJson(const TrackResult& result) {
+  Json photos = Json::array();
+  for (size_t i = 0; i < result.photos.size(); ++i) {
+    const TrackedPhoto& p = result.photos[i];
+    const TrackedFrame& f = result.fit.frames[i];
+    const Frame& frame = (p.test ? result.dataset.test : result.dataset.train)[p.frame_index];
+    Json expression = Json::object();
+    for (int e = 0; e < face::kNumExpressions; ++e) expression[face::kExpressionNames[e]] = JsonFloat(f.expression[e]);
+    const Vec3d ypr = f.YawPitchRollDeg();
+    const Vec3d t = f.cam_from_head.block<3, 1>(0, 3);
+    photos.push_back(Json{{"photo", p.source.string()},
+                          {"file_path", frame.file_path},
+                          {"split", p.test ? "test" : "train"},
+                          {"focal_px", p.photo_intrinsics.fl_x},
+                          {"focal_source", FocalSourceName(p.focal_source)},
+                          {"crop", {p.crop.x0, p.crop.y0, p.crop.size}},
+                          {"landmark_rms_iod", f.rms_iod},
+                          {"landmark_max_iod", f.max_iod},
+                          {"landmarks_used", f.landmarks_used},
+                          {"yaw_pitch_roll_deg", {ypr.x(), ypr.y(), ypr.z()}},
+                          {"head_in_camera", {t.x(), t.y(), t.z()}},
+                          {"expression", expression}});
+  }
+  Json shape = Json::object();
+  const auto values = result.fit.shape.ToArray();
+  for (int i = 0; i < face::ShapeParams::kCount; ++i) shape[face::kShapeParamNames[i]] = JsonFloat(values[i]);
+  return Json{{"photos", photos},
+              {"skipped", result.skipped},
+              {"landmark_rms_iod", result.fit.rms_iod},
+              {"landmark_max_iod", result.fit.max_iod},
+              {"iterations", result.fit.iterations},
+              {"shape", shape}};
+}
+
+Status WriteTrackedDataset(const TrackResult& result, const fs::path& out_dir,
+                           const std::vector<std::pair<std::string, Image>>& extra) {
+  return CreateDirectoryAtomic(out_dir, [&](const fs::path& tmp) -> Status {
+    std::error_code ec;
+    fs::create_directories(tmp / "images", ec);
+    fs::create_directories(tmp / "track", ec);
+    Dataset d = result.dataset;
+    d.root = tmp;
+    for (const TrackedPhoto& p : result.photos)
+      ICEF_RETURN_IF_ERROR(WritePng(tmp / (p.test ? d.test : d.train)[p.frame_index].file_path, p.image));
+    ICEF_RETURN_IF_ERROR(SaveDataset(d));
+    ICEF_RETURN_IF_ERROR(WriteFileAtomic(tmp / "track" / "report.json", FormatJson(TrackReportJson(result)) + "\n"));
+    for (const auto& [name, image] : extra) ICEF_RETURN_IF_ERROR(WritePng(tmp / name, image));
+    return Status::Ok();
+  });
+}
+
+Result<std::vector<fs::path>> ExpandPhotoArguments(const std::vector<fs::path>& args) {
+  std::vector<fs::path> out;
+  for (const fs::path& a : args) {
+    std::error_code ec;
+    if (fs::is_directory(a, ec)) {
+      std::vector<fs::path> files;
+      for (const auto& entry : fs::directory_iterator(a, ec)) {
+        std::string ext = entry.path().extension().string();
+        std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+        if (entry.is_regular_file() && (ext == ".png" || ext == ".jpg" || ext == ".jpeg")) files.push_back(entry.path());
+      }
+      if (ec) return Status::Error(a.string() + ": cannot list the directory: " + ec.message());
+      std::sort(files.begin(), files.end());
+      if (files.empty()) return Status::Error(a.string() + ": no .png/.jpg/.jpeg photos in the directory");
+      out.insert(out.end(), files.begin(), files.end());
+    } else if (fs::exists(a, ec)) {
+      out.push_back(a);
+    } else {
+      return Status::Error(a.string() + ": no such file or directory");
+    }
+  }
+  return out;
+}
+
+}  // namespace icef::track

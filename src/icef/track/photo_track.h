@@ -1,0 +1,87 @@
+// `icef track PHOTOS... --out DATASET` (DESIGN.md §8): a dataset in the §4 format from a handful of
+// photos of one person. Per photo: exactly one face and its 68 landmarks (dlib); one joint fit of
+// the face model (track_fit.h: shared identity, per-photo head pose and expression); a square crop
+// around the fitted head resampled to the dataset's resolution; a foreground mask (head_mask.h).
+// The dataset's world frame is the fitted head frame: transform_matrix = camera-to-head,
+// expression_names = the face model's, aabb around the head.
+//
+// TrackPhotos works in memory and writes nothing, so bad input (no face, two faces, an unreadable
+// file, too few photos) stops before anything is on disk; WriteTrackedDataset writes the result.
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "icef/core/parallel.h"
+#include "icef/core/status.h"
+#include "icef/data/dataset.h"
+#include "icef/io/image.h"
+#include "icef/io/json_util.h"
+#include "icef/landmarks/face_landmark_detector.h"
+#include "icef/track/head_mask.h"
+#include "icef/track/photo_crop.h"
+#include "icef/track/track_fit.h"
+
+namespace icef::track {
+
+struct TrackOptions {
+  int resolution = 256;             // side of the square dataset images
+  std::optional<double> focal;      // focal length in pixels of the photos (else EXIF, else the default)
+  int num_test = 0;                 // the last num_test photos become test frames
+  bool skip_bad = false;            // skip photos without exactly one face instead of stopping
+  double crop_margin = 1.15;        // crop side / the head box's projected extent
+  TrackFitOptions fit;
+  HeadMaskOptions mask;
+
+  Status Validate() const;
+  std::string ToString() const;
+};
+
+// Where a photo's focal length came from.
+enum class FocalSource { kFlag, kExif, kDefault };
+const char* FocalSourceName(FocalSource source);
+
+struct TrackedPhoto {
+  std::filesystem::path source;  // the photo
+  Image photo;                   // as read (RGB or RGBA)
+  FaceDetection detection;       // in the photo's coordinates
+  Intrinsics photo_intrinsics;
+  FocalSource focal_source = FocalSource::kDefault;
+  CropBox crop;
+  Image image;                   // the dataset image: RGBA crop, alpha = mask
+  bool test = false;
+  int frame_index = 0;           // within its split
+};
+
+struct TrackResult {
+  Dataset dataset;                   // root unset; frames in photo order within each split
+  std::vector<TrackedPhoto> photos;  // the photos kept, in input order
+  std::vector<std::string> skipped;  // "FILE: why" for photos skipped by skip_bad
+  TrackFit fit;                      // frames in the order of `photos`
+};
+
+// Errors name the file: unreadable, no face, more than one face (unless skip_bad); and no training
+// photo left besides the num_test held out. One photo is enough for a fit (the shape prior holds
+// the identity), though a dataset of one view trains a poor avatar.
+Result<TrackResult> TrackPhotos(const std::vector<std::filesystem::path>& photos, const TrackOptions& options,
+                                const FaceLandmarkDetector& detector, const Executor& executor,
+                                const std::function<void(const std::string&)>& log = nullptr);
+
+// The per-photo report (track/report.json): source, split, landmark residual, pose, expression.
+Json TrackReportJson(const TrackResult& result);
+
+// Writes the dataset into out_dir (which must not exist or be empty): images/, the transforms
+// files, track/report.json. Built in a sibling temporary directory and renamed into place, so an
+// interrupted run leaves nothing half-written. `extra` files (relative path -> PNG image) go
+// along (the overlays).
+Status WriteTrackedDataset(const TrackResult& result, const std::filesystem::path& out_dir,
+                           const std::vector<std::pair<std::string, Image>>& extra = {});
+
+// The photo files of the arguments: files as given, directories expanded to their .png/.jpg/.jpeg
+// files (sorted by name). Errors name a path that does not exist.
+Result<std::vector<std::filesystem::path>> ExpandPhotoArguments(const std::vector<std::filesystem::path>& args);
+
+}  // namespace icef::track
