@@ -64,12 +64,14 @@ struct Dataset {
 // accepted in place of fl_x. Errors name the file, the frame index and the field, e.g.
 //   "data/transforms_train.json: frames[3].expression: expected an array of 12 numbers, got 11 values".
 // Also loads NerFace datasets directly: "intrinsics" [fx, fy, cx, cy] (cx, cy as fractions of the
-// image size when <= 1), per-frame "expression" and "bbox", file paths without extension, and the
-// background image bg/00050.png (or the first image in bg/) as background_file_path, its mean
-// colour as `background`. Without "w"/"h" the size comes from each image; without
-// "expression_dim" it is the length of the first training expression (0 when there is none);
-// without "aabb" the box is [-1, 1]^3. A file_path without extension resolves to the existing
-// .png/.jpg/.jpeg file and is stored with the extension. Keys we do not know are ignored.
+// image size when <= 1; focal lengths signed, as NerFace's real_to_nerf.py writes them: a negative
+// one flips that image axis and every frame casts NerFace's rays, see dataset_load.cc), per-frame
+// "expression" and "bbox", file paths without extension, and the background image bg/00050.png
+// (or the first image in bg/) as background_file_path, its mean colour as `background`. Without
+// "w"/"h" the size comes from each image; without "expression_dim" it is the length of the first
+// training expression (0 when there is none); without "aabb" the box is [-1, 1]^3. A file_path
+// without extension resolves to the existing .png/.jpg/.jpeg file and is stored with the extension.
+// Keys we do not know are ignored.
 Result<Dataset> LoadDataset(const std::filesystem::path& dir);
 
 // Writes transforms_{train,test,val}.json (val only when non-empty) into dataset.root, each

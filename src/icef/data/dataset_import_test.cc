@@ -80,6 +80,42 @@ TEST(DatasetImport, ConvertsANerfaceDataset) {
   EXPECT_EQ(report->dataset.root, root / "dst");
 }
 
+TEST(DatasetImport, NerfaceNegativeFocalLengthsKeepTheirRays) {
+  // real_to_nerf.py's fx, fy < 0, and two mirrored train frames (one negative focal each): our
+  // format, reloaded, casts NerFace's rays through every pixel, and projects back onto them.
+  const fs::path root = testing::MakeTempDir("import_signed_focals");
+  testing::TinyNerfaceOptions options;
+  options.signed_focals = true;
+  testing::WriteTinyNerfaceDataset(root / "src", options);
+  const Result<ImportReport> report = ImportDataset(root / "src", root / "dst", ImportOptions{});
+  ASSERT_TRUE(report.ok()) << report.status().message();
+  const Dataset d = LoadDataset(root / "dst").value();
+  EXPECT_FALSE(ReadJsonFile(root / "dst" / "transforms_train.json").value().contains("intrinsics"));
+  for (const auto& [split, frames] :
+       {std::pair{"train", &d.train}, std::pair{"val", &d.val}, std::pair{"test", &d.test}}) {
+    const Json source = ReadJsonFile(root / "src" / ("transforms_" + std::string(split) + ".json")).value();
+    ASSERT_EQ(frames->size(), source["frames"].size());
+    for (size_t f = 0; f < frames->size(); ++f) {
+      const Camera& camera = (*frames)[f].camera;
+      for (int j = 0; j < camera.height(); ++j) {
+        for (int i = 0; i < camera.width(); ++i) {
+          SCOPED_TRACE(std::string(split) + " frame " + std::to_string(f) + " pixel (" + std::to_string(i) +
+                       ", " + std::to_string(j) + ")");
+          const testing::RayD expected =
+              testing::NerfaceRay(source, int(f), camera.width(), camera.height(), i, j);
+          const Ray ray = camera.PixelRay(i, j);
+          EXPECT_LT((ray.origin.cast<double>() - expected.origin).norm(), 1e-6);
+          EXPECT_LT((ray.direction.cast<double>().normalized() - expected.direction).norm(), 1e-6);
+          const auto projection = camera.Project(expected.origin + 1.5 * expected.direction);
+          ASSERT_TRUE(projection.has_value());
+          EXPECT_NEAR(projection->uv.x(), i + 0.5, 1e-9);
+          EXPECT_NEAR(projection->uv.y(), j + 0.5, 1e-9);
+        }
+      }
+    }
+  }
+}
+
 TEST(DatasetImport, HardLinksWhenAsked) {
   const fs::path root = testing::MakeTempDir("import_link");
   testing::WriteTinyNerfaceDataset(root / "src");

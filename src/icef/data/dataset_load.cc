@@ -1,5 +1,18 @@
 // LoadDataset: parse and validate transforms_{train,test,val}.json (our format, instant-ngp's
 // camera_angle_x, NerFace's intrinsics/expression/bbox/background image).
+//
+// Focal lengths are signed, and taken as NerFace takes them: its real_to_nerf.py writes
+// "intrinsics" [fx, fy, cx, cy] with fx = f_x * -w and fy = f_y * -h (some sequences mix signs
+// between frames), and its rays run along ((i - W cx) / fx, -(j - H cy) / fy, -1) in the camera
+// frame, so a negative focal length flips that image axis. Our Camera uses the very same formula
+// (math/camera.h); every frame's camera goes through Camera::Upright, which turns a frame with
+// fl_y < 0 by 180 degrees about its viewing axis and makes both focal lengths change sign, so that
+// NerFace's usual fx, fy < 0 become an ordinary camera (positive focal lengths, camera +Y image-up,
+// which the face fit relies on) with identical rays. A frame with exactly one negative focal
+// length is a mirrored camera; it keeps fl_x < 0 rather than a reflection in transform_matrix, so
+// that poses stay rigid everywhere (ValidateRigid on files, saves and checkpoints) and the images,
+// landmarks and bboxes are used as stored. The same rule applies to fl_x / fl_y in our format,
+// which is how `icef import` writes such a camera. Zero focal lengths are refused.
 #include <algorithm>
 #include <cmath>
 
@@ -33,7 +46,8 @@ Result<CameraSpec> ParseCameraSpec(const JsonObjectView& obj) {
   for (auto [key, out] : {std::pair{"fl_x", &s.fl_x}, std::pair{"fl_y", &s.fl_y}}) {
     if (!obj.Has(key)) continue;
     ICEF_ASSIGN_OR_RETURN(const double v, obj.Number(key));
-    if (v <= 0) return obj.Error(key, "focal length must be positive");
+    if (!(std::isfinite(v) && v != 0))
+      return obj.Error(key, "focal length must be a nonzero finite number (negative flips that image axis)");
     *out = v;
   }
   for (auto [key, out] : {std::pair{"cx", &s.cx}, std::pair{"cy", &s.cy}}) {
@@ -48,7 +62,10 @@ Result<CameraSpec> ParseCameraSpec(const JsonObjectView& obj) {
   }
   if (obj.Has("intrinsics")) {
     ICEF_ASSIGN_OR_RETURN(const std::vector<double> k, obj.NumberArray("intrinsics", 4));
-    if (k[0] <= 0 || k[1] <= 0) return obj.Error("intrinsics", "focal lengths [fx, fy] must be positive");
+    if (!(std::isfinite(k[0]) && k[0] != 0 && std::isfinite(k[1]) && k[1] != 0))
+      return obj.Error(
+          "intrinsics",
+          "focal lengths [fx, fy] must be nonzero finite numbers (negative flips that image axis)");
     s.intrinsics = std::array<double, 4>{k[0], k[1], k[2], k[3]};
   }
   return s;
@@ -79,7 +96,8 @@ PartialIntrinsics Resolve(const CameraSpec& s, int w, int h) {
   }
   // NerFace stores the principal point as a fraction of the image size and casts rays through
   // integer pixel coordinates; with our pixel centres at +0.5, cx = fraction * w + 0.5 gives the
-  // very same rays. Values above 1 are taken as pixels.
+  // very same rays, whatever the focal lengths' signs (NerFace's i - W cx is our
+  // (i + 0.5) - cx). Values above 1 are taken as pixels in our convention, unchanged.
   auto principal = [](double c, int size) { return c <= 1.0 ? c * size + 0.5 : c; };
   if (s.cx) {
     p.cx = s.cx;
@@ -357,7 +375,7 @@ Result<std::vector<Frame>> LoadFrames(const fs::path& root, const SplitHeader& h
     k.cx = local.cx ? *local.cx : global.cx.value_or(0.5 * w);
     k.cy = local.cy ? *local.cy : global.cy.value_or(0.5 * h);
     if (Status valid = k.Validate(); !valid.ok()) return f.ErrorHere("intrinsics: " + valid.message());
-    p.frame.camera = Camera(k, p.world_from_cam);
+    p.frame.camera = Camera::Upright(k, p.world_from_cam);  // same rays; see the top of this file
     p.frame.file_path = c.file_path;
     if (c.neutral_file_path) p.frame.neutral_file_path = c.neutral_file_path;
     frames.push_back(std::move(p.frame));

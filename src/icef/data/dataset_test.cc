@@ -397,5 +397,97 @@ TEST(Dataset, NerfaceRaysMatchTheirConvention) {
   EXPECT_LT((ray.direction.cast<double>() - expected).norm(), 1e-6);
 }
 
+// Our camera of every frame of `split` against NerFace's reading of `file` (testing::NerfaceRay), at
+// every pixel: the same world-frame ray (origin and normalised direction), and Project of a point on
+// it gives back that pixel's centre.
+void ExpectNerfaceRays(const std::vector<Frame>& frames, const fs::path& file) {
+  const Json doc = ReadJsonFile(file).value();
+  ASSERT_EQ(frames.size(), doc["frames"].size());
+  for (size_t f = 0; f < frames.size(); ++f) {
+    const Camera& camera = frames[f].camera;
+    EXPECT_TRUE(ValidateRigid(camera.world_from_cam()).ok()) << camera.ToString();
+    for (int j = 0; j < camera.height(); ++j) {
+      for (int i = 0; i < camera.width(); ++i) {
+        SCOPED_TRACE(file.filename().string() + " frame " + std::to_string(f) + " pixel (" +
+                     std::to_string(i) + ", " + std::to_string(j) + ")");
+        const testing::RayD expected =
+            testing::NerfaceRay(doc, int(f), camera.width(), camera.height(), i, j);
+        const Ray ray = camera.PixelRay(i, j);
+        EXPECT_LT((ray.origin.cast<double>() - expected.origin).norm(), 1e-6);
+        EXPECT_LT((ray.direction.cast<double>().normalized() - expected.direction).norm(), 1e-6);
+        const auto projection = camera.Project(expected.origin + 2.5 * expected.direction);
+        ASSERT_TRUE(projection.has_value());
+        EXPECT_NEAR(projection->uv.x(), i + 0.5, 1e-9);
+        EXPECT_NEAR(projection->uv.y(), j + 0.5, 1e-9);
+        const Vec3d axis = camera.world_from_cam().block<3, 1>(0, 2);  // camera +Z: the view is along -Z
+        EXPECT_NEAR(projection->depth, -2.5 * axis.dot(expected.direction), 1e-9);
+      }
+    }
+  }
+}
+
+TEST(Dataset, NerfaceNegativeFocalLengthsCastNerfacesRays) {
+  // real_to_nerf.py's fx, fy < 0 in the file; train frames 1 and 2 mirrored (one negative focal each).
+  const fs::path dir = MakeTempDir(TestName());
+  testing::TinyNerfaceOptions options;
+  options.signed_focals = true;
+  const testing::TinyNerfaceInfo info = testing::WriteTinyNerfaceDataset(dir, options);
+  ASSERT_LT(info.intrinsics[0], 0);
+  ASSERT_LT(info.intrinsics[1], 0);
+  const Result<Dataset> result = LoadDataset(dir);
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  const Dataset& d = *result;
+  ExpectNerfaceRays(d.train, dir / "transforms_train.json");
+  ExpectNerfaceRays(d.val, dir / "transforms_val.json");
+  ExpectNerfaceRays(d.test, dir / "transforms_test.json");
+  // Both negative: an ordinary camera turned 180 degrees about its axis, with positive focal lengths.
+  const Intrinsics& k0 = d.train[0].camera.intrinsics();
+  EXPECT_EQ(k0.fl_x, -info.intrinsics[0]);
+  EXPECT_EQ(k0.fl_y, -info.intrinsics[1]);
+  EXPECT_DOUBLE_EQ(k0.cx, 0.5 * 8 + 0.5);
+  EXPECT_DOUBLE_EQ(k0.cy, 0.45 * 8 + 0.5);
+  // One negative: a mirrored camera, which keeps fl_x < 0 (and fl_y > 0) with a rigid pose.
+  for (int f : {1, 2}) {
+    EXPECT_LT(d.train[f].camera.intrinsics().fl_x, 0) << f;
+    EXPECT_GT(d.train[f].camera.intrinsics().fl_y, 0) << f;
+  }
+  // Our own format follows the same rule: saved and loaded back, the cameras are unchanged.
+  ASSERT_TRUE(SaveDataset(d).ok());
+  const Dataset again = LoadDataset(dir).value();
+  ExpectSameFrames(d.train, again.train);
+  ExpectSameFrames(d.test, again.test);
+}
+
+TEST(Dataset, ZeroOrNonFiniteFocalLengthIsAnError) {
+  const fs::path dir = MakeTempDir(TestName());
+  testing::WriteTinyNerfaceDataset(dir);
+  EditJson(dir / "transforms_train.json", [](Json& d) { d["intrinsics"][0] = 0.0; });
+  ExpectLoadError(dir,
+                  "transforms_train.json: intrinsics: focal lengths [fx, fy] must be nonzero finite numbers");
+  testing::WriteTinyNerfaceDataset(dir);
+  EditJson(dir / "transforms_test.json", [](Json& d) {
+    d["frames"][0]["intrinsics"] = {-10.0, 0.0, 0.5, 0.5};
+  });
+  ExpectLoadError(dir, "transforms_test.json: frames[0].intrinsics: focal lengths [fx, fy] must be nonzero");
+  testing::WriteTinyNerfaceDataset(dir);
+  EditJson(dir / "transforms_train.json", [](Json& d) { d["intrinsics"][1] = "@INF@"; });
+  std::string text = ReadFile(dir / "transforms_train.json").value();
+  text.replace(text.find("\"@INF@\""), 7, "-Infinity");
+  ASSERT_TRUE(WriteFileAtomic(dir / "transforms_train.json", text).ok());
+  ExpectLoadError(dir, "transforms_train.json: intrinsics: non-finite value -Infinity at [1]");
+
+  const fs::path ours = MakeTempDir(TestName() + "_ours");
+  WriteTinyDataset(ours);
+  EditJson(ours / "transforms_train.json", [](Json& d) { d["frames"][1]["fl_y"] = 0.0; });
+  ExpectLoadError(ours,
+                  "transforms_train.json: frames[1].fl_y: focal length must be a nonzero finite number");
+  WriteTinyDataset(ours);
+  // Negative: accepted, a mirrored camera.
+  EditJson(ours / "transforms_train.json", [](Json& d) { d["fl_x"] = -9.6; });
+  const Result<Dataset> mirrored = LoadDataset(ours);
+  ASSERT_TRUE(mirrored.ok()) << mirrored.status().message();
+  EXPECT_EQ(mirrored->train[0].camera.intrinsics().fl_x, -9.6);
+}
+
 }  // namespace
 }  // namespace icef

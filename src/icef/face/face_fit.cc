@@ -198,13 +198,14 @@ Result<Similarity> InitialSimilarity(std::span<const FitFrame> frames, double io
   } else {  // one view: the depth at which the average head's IOD matches the observed one
     const FitFrame& f = frames[0];
     const Ray ray = f.camera->RayThrough((*f.landmarks_2d)[30].x(), (*f.landmarks_2d)[30].y());
-    const double depth = f.camera->intrinsics().fl_x * iod_head / InterOcular2d(*f.landmarks_2d);
+    // |fl_x|: a mirrored camera has fl_x < 0 (math/camera.h).
+    const double depth = std::abs(f.camera->intrinsics().fl_x) * iod_head / InterOcular2d(*f.landmarks_2d);
     nose_world = ray.origin.cast<double>() + depth * ray.direction.cast<double>().normalized();
   }
   for (const FitFrame& f : frames) {
     const auto proj = f.camera->Project(nose_world);
     if (!proj) return Status::Error("face fit: the landmarks' meeting point lies behind a camera");
-    world_iod += InterOcular2d(*f.landmarks_2d) * proj->depth / f.camera->intrinsics().fl_x;
+    world_iod += InterOcular2d(*f.landmarks_2d) * proj->depth / std::abs(f.camera->intrinsics().fl_x);
   }
   world_iod /= double(frames.size());
   const Vec3d z = toward.normalized();

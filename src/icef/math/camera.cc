@@ -19,8 +19,8 @@ Intrinsics Intrinsics::FromCameraAngle(int width, int height, double camera_angl
 
 Status Intrinsics::Validate() const {
   if (width <= 0 || height <= 0) return Status::Error("image size must be positive");
-  if (!(std::isfinite(fl_x) && fl_x > 0)) return Status::Error("fl_x must be a positive finite number");
-  if (!(std::isfinite(fl_y) && fl_y > 0)) return Status::Error("fl_y must be a positive finite number");
+  if (!(std::isfinite(fl_x) && fl_x != 0)) return Status::Error("fl_x must be a nonzero finite number");
+  if (!(std::isfinite(fl_y) && fl_y != 0)) return Status::Error("fl_y must be a nonzero finite number");
   if (!std::isfinite(cx) || !std::isfinite(cy)) return Status::Error("cx/cy must be finite");
   return Status::Ok();
 }
@@ -50,6 +50,17 @@ Status ValidateRigid(const Mat4d& m, double tolerance) {
 Camera::Camera(const Intrinsics& intrinsics, const Mat4d& world_from_cam)
     : intrinsics_(intrinsics), world_from_cam_(world_from_cam) {
   cam_from_world_rotation_ = world_from_cam_.block<3, 3>(0, 0).transpose();
+}
+
+Camera Camera::Upright(const Intrinsics& intrinsics, const Mat4d& world_from_cam) {
+  if (!(intrinsics.fl_y < 0)) return Camera(intrinsics, world_from_cam);
+  Intrinsics k = intrinsics;
+  k.fl_x = -k.fl_x;
+  k.fl_y = -k.fl_y;
+  Mat4d m = world_from_cam;
+  // Camera X and Y axes in the world frame; 0 - x rather than -x, so that no -0 reaches a file.
+  m.block<3, 2>(0, 0) = Eigen::Matrix<double, 3, 2>::Zero() - m.block<3, 2>(0, 0);
+  return Camera(k, m);
 }
 
 Mat4d Camera::cam_from_world() const {

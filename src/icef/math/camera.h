@@ -1,7 +1,15 @@
 // Pinhole cameras in the NeRF/OpenGL convention: the camera looks down its -Z axis, +Y is up and
 // +X is right. Pixel (i, j) (column i, row j, row 0 at the top) has its centre at image
 // coordinates (i + 0.5, j + 0.5). `world_from_cam` is the dataset's `transform_matrix`
-// (camera-to-world).
+// (camera-to-world) and is always a rigid transform (rotation with determinant +1).
+//
+// Focal lengths are signed, as in NerFace: the camera-frame direction through image coordinates
+// (u, v) is ((u - cx) / fl_x, -(v - cy) / fl_y, -1) whatever the signs, so a negative focal length
+// flips that image axis. Two negative focal lengths are an ordinary camera turned 180 degrees about
+// its viewing axis (Camera::Upright makes them positive); exactly one negative focal length is a
+// mirrored camera, which no rigid pose with positive focal lengths can express, so it is kept in
+// the intrinsics rather than as a reflection in `world_from_cam`. RayThrough and Project are exact
+// inverses for either sign.
 #pragma once
 
 #include <optional>
@@ -16,8 +24,8 @@ namespace icef {
 struct Intrinsics {
   int width = 0;
   int height = 0;
-  double fl_x = 0;  // focal length in pixels
-  double fl_y = 0;
+  double fl_x = 0;  // focal length in pixels; nonzero, negative flips the image's x axis (see above)
+  double fl_y = 0;  // likewise for the y axis
   double cx = 0;  // principal point in image coordinates (pixels)
   double cy = 0;
 
@@ -37,6 +45,13 @@ class Camera {
  public:
   Camera() = default;
   Camera(const Intrinsics& intrinsics, const Mat4d& world_from_cam);
+
+  // The camera that casts the same rays as (intrinsics, world_from_cam) with fl_y > 0: when fl_y
+  // is negative, both focal lengths change sign and the frame turns 180 degrees about its viewing
+  // axis (world_from_cam * diag(-1, -1, 1, 1)); the principal point stays. Every ray and
+  // projection is unchanged (bit for bit: only signs flip), and camera +Y is image-up again. What
+  // remains negative afterwards is fl_x alone, exactly when the camera is mirrored.
+  static Camera Upright(const Intrinsics& intrinsics, const Mat4d& world_from_cam);
 
   const Intrinsics& intrinsics() const { return intrinsics_; }
   const Mat4d& world_from_cam() const { return world_from_cam_; }

@@ -77,7 +77,12 @@ TEST(CameraTest, CameraAngleAndRigidity) {
   EXPECT_NEAR(k.cx, 100.0, 1e-12);
   EXPECT_NEAR(k.cy, 50.0, 1e-12);
   EXPECT_TRUE(k.Validate().ok());
-  k.fl_x = -1;
+  k.fl_x = -1;  // signed: a negative focal length flips that image axis
+  EXPECT_TRUE(k.Validate().ok());
+  k.fl_x = 0;
+  EXPECT_FALSE(k.Validate().ok());
+  k.fl_x = 1;
+  k.fl_y = INFINITY;
   EXPECT_FALSE(k.Validate().ok());
   Mat4d scaled = Mat4d::Identity();
   scaled(0, 0) = 2;
@@ -88,6 +93,54 @@ TEST(CameraTest, CameraAngleAndRigidity) {
   Mat4d nan = Mat4d::Identity();
   nan(1, 3) = NAN;
   EXPECT_FALSE(ValidateRigid(nan).ok());
+}
+
+TEST(CameraTest, SignedFocalLengthsFlipImageAxes) {
+  // Direction through (u, v) = ((u - cx) / fl_x, -(v - cy) / fl_y, -1) whatever the signs (NerFace).
+  Rng rng(11, StreamId("camera_test/signed"));
+  for (const auto& [sx, sy] : {std::pair{1, 1}, std::pair{-1, -1}, std::pair{-1, 1}, std::pair{1, -1}}) {
+    Intrinsics k = TestIntrinsics();
+    k.fl_x *= sx;
+    k.fl_y *= sy;
+    const Vec3d eye(rng.Uniform(-3, 3), rng.Uniform(-3, 3), rng.Uniform(2, 4));
+    const Camera given(k, Camera::LookAt(k, eye, Vec3d::Zero()).world_from_cam());
+    const Camera upright = Camera::Upright(k, given.world_from_cam());
+    EXPECT_TRUE(ValidateRigid(upright.world_from_cam()).ok());
+    EXPECT_GT(upright.intrinsics().fl_y, 0);
+    EXPECT_EQ(upright.intrinsics().fl_x < 0, sx != sy);  // only a mirrored camera keeps a negative focal
+    EXPECT_EQ(upright.intrinsics().cx, k.cx);
+    EXPECT_EQ(upright.intrinsics().cy, k.cy);
+    const Mat3d r = given.world_from_cam().block<3, 3>(0, 0);
+    for (int trial = 0; trial < 20; ++trial) {
+      const double u = rng.Uniform(0, k.width), v = rng.Uniform(0, k.height);
+      const Vec3d expected = (r * Vec3d((u - k.cx) / k.fl_x, -(v - k.cy) / k.fl_y, -1)).normalized();
+      for (const Camera* cam : {&given, &upright}) {
+        const Ray ray = cam->RayThrough(u, v);
+        EXPECT_LT((ray.direction.cast<double>() - expected).norm(), 1e-6) << cam->ToString();
+        EXPECT_EQ(ray.direction, given.RayThrough(u, v).direction);  // Upright: bit for bit
+        const auto p = cam->Project(eye + 2.0 * expected);
+        ASSERT_TRUE(p.has_value());
+        EXPECT_NEAR(p->uv.x(), u, 1e-9);
+        EXPECT_NEAR(p->uv.y(), v, 1e-9);
+        EXPECT_NEAR(p->depth,
+                    2.0 / std::sqrt(1 + std::pow((u - k.cx) / k.fl_x, 2) + std::pow((v - k.cy) / k.fl_y, 2)),
+                    1e-9);
+      }
+    }
+  }
+  // A negative fl_x really mirrors: the pixel left of the principal point looks to camera +X.
+  Intrinsics mirrored = TestIntrinsics();
+  mirrored.fl_x = -mirrored.fl_x;
+  EXPECT_GT(Camera(mirrored, Mat4d::Identity()).PixelRay(0, 48).direction.x(), 0.f);
+  // An upright camera's pose is left as it is, and Upright writes no -0 into the pose.
+  const Camera same = Camera::Upright(TestIntrinsics(), Mat4d::Identity());
+  EXPECT_EQ(same.world_from_cam(), Mat4d::Identity());
+  Intrinsics both = TestIntrinsics();
+  both.fl_x = -both.fl_x;
+  both.fl_y = -both.fl_y;
+  const Mat4d turned = Camera::Upright(both, Mat4d::Identity()).world_from_cam();
+  EXPECT_EQ(turned, Vec4d(-1, -1, 1, 1).asDiagonal().toDenseMatrix());
+  EXPECT_FALSE(std::signbit(turned(1, 0)));
 }
 
 TEST(AabbTest, IntersectsRays) {

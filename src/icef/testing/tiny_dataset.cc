@@ -140,13 +140,15 @@ Dataset WriteTinyDataset(const fs::path& dir, const TinyDatasetOptions& options)
 Status TinyNerfaceOptions::Validate() const {
   if (num_train < 1 || num_val < 0 || num_test < 0) return Status::Error("need num_train >= 1");
   if (size < 1 || expression_dim < 1) return Status::Error("size and expression_dim must be positive");
+  if (signed_focals && num_train < 3) return Status::Error("signed_focals needs num_train >= 3");
   return Status::Ok();
 }
 
 std::string TinyNerfaceOptions::ToString() const {
   std::ostringstream os;
   os << "TinyNerfaceOptions(train=" << num_train << ", val=" << num_val << ", test=" << num_test
-     << ", size=" << size << ", B=" << expression_dim << ", seed=" << seed << ")";
+     << ", size=" << size << ", B=" << expression_dim
+     << ", signed_focals=" << (signed_focals ? "true" : "false") << ", seed=" << seed << ")";
   return os.str();
 }
 
@@ -157,6 +159,11 @@ TinyNerfaceInfo WriteTinyNerfaceDataset(const fs::path& dir, const TinyNerfaceOp
   info.camera_angle_x = 0.5;
   const double focal = 0.5 * options.size / std::tan(0.5 * info.camera_angle_x);
   info.intrinsics = {focal * 1.01, focal * 0.99, 0.5, 0.45};
+  const double fx = info.intrinsics[0], fy = info.intrinsics[1];
+  if (options.signed_focals) {
+    info.intrinsics[0] = -fx;
+    info.intrinsics[1] = -fy;
+  }
 
   fs::create_directories(dir / "bg");
   Rng bg_rng(options.seed, StreamId("tiny_nerface/background"));
@@ -196,11 +203,27 @@ TinyNerfaceInfo WriteTinyNerfaceDataset(const fs::path& dir, const TinyNerfaceOp
                             {"bbox", Json::array({0.1, 0.9, 0.2, 0.8})},
                             {"transform_matrix", m},
                             {"expression", expression}});
+      if (options.signed_focals && std::string(split) == "train" && (i == 1 || i == 2)) {
+        // Mirrored cameras: x flipped in frame 1, y flipped in frame 2.
+        frames.back()["intrinsics"] = i == 1 ? Json::array({-1.2 * fx, 0.9 * fy, 0.48, 0.52})
+                                             : Json::array({0.95 * fx, -1.1 * fy, 0.55, 0.5});
+      }
     }
     doc["frames"] = frames;
     ICEF_CHECK(WriteFileAtomic(dir / ("transforms_" + std::string(split) + ".json"), FormatJson(doc)).ok());
   }
   return info;
+}
+
+RayD NerfaceRay(const Json& transforms, int index, int w, int h, int i, int j) {
+  const Json& frame = transforms.at("frames").at(index);
+  const Json& k = frame.contains("intrinsics") ? frame.at("intrinsics") : transforms.at("intrinsics");
+  const double fx = k.at(0), fy = k.at(1), cx = k.at(2), cy = k.at(3);
+  Mat4d c2w;
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) c2w(r, c) = frame.at("transform_matrix").at(r).at(c).get<double>();
+  const Vec3d dir_cam((i - w * cx) / fx, -(j - h * cy) / fy, -1.0);
+  return RayD{c2w.block<3, 1>(0, 3), (c2w.block<3, 3>(0, 0) * dir_cam).normalized()};
 }
 
 fs::path MakeTempDir(const std::string& name) {

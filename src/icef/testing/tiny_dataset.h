@@ -7,6 +7,7 @@
 #include <string>
 
 #include "icef/data/dataset.h"
+#include "icef/io/json_util.h"
 
 namespace icef::testing {
 
@@ -37,6 +38,9 @@ struct TinyNerfaceOptions {
   int num_test = 1;          // frames in transforms_test.json
   int size = 8;              // square image size in pixels
   int expression_dim = 76;   // NerFace's usual expression length
+  // Focal lengths as NerFace's real_to_nerf.py writes them: the file's fx, fy negative, and train
+  // frames 1 and 2 with their own "intrinsics", one focal length negative each (needs num_train >= 3).
+  bool signed_focals = false;
   uint64_t seed = 2;         // every random value derives from it
   Status Validate() const;
   std::string ToString() const;
@@ -45,7 +49,7 @@ struct TinyNerfaceOptions {
 // What WriteTinyNerfaceDataset wrote, for tests to compare against.
 struct TinyNerfaceInfo {
   double camera_angle_x = 0;
-  std::array<double, 4> intrinsics{};  // [fx, fy, cx, cy], cx/cy as fractions
+  std::array<double, 4> intrinsics{};  // the file's [fx, fy, cx, cy], cx/cy as fractions
   Vec3f background_mean = Vec3f::Zero();
 };
 
@@ -54,6 +58,20 @@ struct TinyNerfaceInfo {
 // per-frame "expression" and "bbox", file paths "./train/f_0000" without extension, images
 // train/f_0000.png ..., and the background image bg/00050.png. No w, h, aabb or expression_dim.
 TinyNerfaceInfo WriteTinyNerfaceDataset(const std::filesystem::path& dir, const TinyNerfaceOptions& options = {});
+
+// A ray in double precision: origin and unit direction, world frame.
+struct RayD {
+  Vec3d origin;
+  Vec3d direction;
+};
+
+// NerFace's ray through integer pixel (column i, row j) of frame `index` of a NerFace transforms
+// file `transforms` whose images are w x h, computed from the JSON as NerFace's get_ray_bundle does:
+// origin the translation of transform_matrix (c2w), direction its rotation times
+// ((i - w cx) / fx, -(j - h cy) / fy, -1), normalised, with the frame's "intrinsics"
+// [fx, fy, cx, cy] (else the file's) taken as they are: signed focal lengths, cx, cy as fractions.
+// The reference that tests hold our cameras to.
+RayD NerfaceRay(const Json& transforms, int index, int w, int h, int i, int j);
 
 // A fresh, empty directory under the system temp directory, named after the running test.
 std::filesystem::path MakeTempDir(const std::string& name);

@@ -43,7 +43,8 @@ std::vector<uint8_t> VisualHullCells(const Aabb& aabb, int resolution, const std
         const Camera& cam = cameras[k];
         const auto proj = cam.Project(centre);
         if (!proj || proj->depth <= radius) continue;
-        const double fl = std::max(cam.intrinsics().fl_x, cam.intrinsics().fl_y);
+        // Focal lengths are signed (a mirrored camera has fl_x < 0, math/camera.h).
+        const double fl = std::max(std::abs(cam.intrinsics().fl_x), std::abs(cam.intrinsics().fl_y));
         const double rad = fl * radius / (proj->depth - radius) + options.margin_px;
         const double u = proj->uv.x(), v = proj->uv.y();
         if (u < 0 || v < 0 || u > cam.width() || v > cam.height()) continue;  // centre not seen
