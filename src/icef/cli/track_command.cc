@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "icef/app/detector_calibration.h"
 #include "icef/app/track_app.h"
 #include "icef/cli/commands.h"
 #include "icef/landmarks/face_landmark_detector.h"
@@ -24,8 +25,8 @@ CommandFn RegisterTrack(CLI::App& app) {
       "track/report.json. Then: icef train DATASET, icef render --sweep.\n"
       "With --keep-cameras, re-express an existing dataset (NerFace, instant-ngp, any expression space) in the face "
       "model's expressions: same cameras and images, the face model fitted to every frame's landmarks.");
-  app.add_option("photos", options->photos, "Photos (PNG/JPEG) or directories of photos")->required();
-  app.add_option("--out", options->out, "Dataset directory to create (must not exist, or be empty)")->required();
+  app.add_option("photos", options->photos, "Photos (PNG/JPEG) or directories of photos");
+  app.add_option("--out", options->out, "Dataset directory to create (must not exist, or be empty)");
   app.add_option("--res", options->track.resolution, "Side of the square dataset images in pixels (default 256)");
   app.add_option("--focal", *focal,
                  "Focal length in pixels of the photos (default: the EXIF 35 mm-equivalent focal length, else a "
@@ -38,7 +39,19 @@ CommandFn RegisterTrack(CLI::App& app) {
   app.add_option("--threads", options->threads, "Worker threads (0 = all cores)");
   app.add_option("--predictor", options->predictor,
                  "dlib 68-point shape predictor (default " + std::string(kDefaultShapePredictorPath) + ")");
-  return [options, focal, &app]() -> Status {
+  auto calibrate = std::make_shared<bool>(false);
+  app.add_flag("--calibrate-detector", *calibrate,
+               "Developer: measure where dlib puts its landmarks on the face model (renders of validation "
+               "identities) and print the table of src/icef/track/detector_landmarks.cc");
+  return [options, focal, calibrate, &app]() -> Status {
+    if (*calibrate) {
+      ICEF_ASSIGN_OR_RETURN(const DetectorCalibration c,
+                            CalibrateDetector({101, 102, 103, 104, 105, 106}, Executor(options->threads), &std::cerr));
+      PrintDetectorTable(c, std::cout);
+      return Status::Ok();
+    }
+    if (options->photos.empty()) return Status::Error("icef track: give the photos (or a dataset with --keep-cameras)");
+    if (options->out.empty()) return Status::Error("icef track: --out DATASET is required");
     if (app.count("--focal")) options->track.focal = *focal;
     return RunTrack(*options, std::cout);
   };

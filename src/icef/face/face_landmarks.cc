@@ -101,6 +101,15 @@ void FaceModel::BuildNeutralLandmarks() {
 }
 
 std::array<Vec3f, 68> FaceModel::Landmarks(const ExpressionState& s) const {
+  static const std::array<Vec3f, 68> kNone = [] {
+    std::array<Vec3f, 68> z;
+    z.fill(Vec3f::Zero());
+    return z;
+  }();
+  return Landmarks(s, kNone);
+}
+
+std::array<Vec3f, 68> FaceModel::Landmarks(const ExpressionState& s, std::span<const Vec3f, 68> canonical_offsets) const {
   const FaceGeometry& g = geometry_;
   std::array<Vec3f, 68> canonical = neutral_landmarks_;
   // Eyes, on the lid edges at the state's lid angles. iBUG order per eye: outer corner, two upper,
@@ -126,7 +135,7 @@ std::array<Vec3f, 68> FaceModel::Landmarks(const ExpressionState& s) const {
   std::array<Vec3f, 68> out;
   for (int i = 0; i < 68; ++i) {
     const bool lower_inner_lip = i >= 65 && i <= 67;
-    out[i] = InverseWarp(canonical[i], s, lower_inner_lip && s.jaw_angle > 0.f ? 1.f : -1.f);
+    out[i] = InverseWarp(canonical[i] + canonical_offsets[i], s, lower_inner_lip && s.jaw_angle > 0.f ? 1.f : -1.f);
   }
   return out;
 }

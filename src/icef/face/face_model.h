@@ -115,6 +115,9 @@ class FaceModel {
   // The 68 iBUG-68 landmarks in the head frame for the expression (observation space). The
   // neutral landmarks do not depend on the style.
   std::array<Vec3f, 68> Landmarks(const ExpressionState& state) const;
+  // The same with each landmark's canonical point moved by canonical_offsets[i] (head units) before
+  // the warp: another detector's convention of where the 68 points lie (track/detector_landmarks.h).
+  std::array<Vec3f, 68> Landmarks(const ExpressionState& state, std::span<const Vec3f, 68> canonical_offsets) const;
   // Canonical (neutral) landmarks.
   const std::array<Vec3f, 68>& NeutralLandmarks() const { return neutral_landmarks_; }
   // The first crossing of the neutral surface (outside -> inside, or inside -> outside when the

@@ -31,17 +31,20 @@ Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions
   result.dataset = source;
   Dataset& d = result.dataset;
 
-  // Landmarks: the dataset's own, else dlib's.
-  bool missing = false;
-  for (const auto* frames : {&d.train, &d.test, &d.val})
-    for (const Frame& f : *frames) missing = missing || !f.landmarks_2d;
-  if (missing) {
+  // Landmarks: dlib's, in every frame (the fit's convention; a dataset's own landmarks_2d may follow
+  // another one, as the synthetic ground truth's do).
+  {
     LandmarkDetectionOptions lo;
     lo.predictor_path = options.predictor_path;
-    if (log) log("detecting the landmarks of the frames without landmarks_2d");
+    lo.overwrite = true;
+    if (log) log("detecting the landmarks of every frame (dlib)");
     ICEF_ASSIGN_OR_RETURN(const LandmarkDetectionReport report, DetectDatasetLandmarks(source, lo, executor));
-    for (const FrameLandmarks& fl : report.frames)
-      if (fl.outcome == LandmarkOutcome::kDetected) (*Split(d, fl.split))[fl.index].landmarks_2d = fl.detection.landmarks;
+    for (const FrameLandmarks& fl : report.frames) {
+      Frame& f = (*Split(d, fl.split))[fl.index];
+      f.landmarks_2d.reset();
+      f.landmarks_2d_visible.reset();
+      if (fl.outcome == LandmarkOutcome::kDetected) f.landmarks_2d = fl.detection.landmarks;
+    }
   }
   // Frames without landmarks: an error, or dropped.
   for (const std::string split : {"train", "test", "val"}) {

@@ -1,9 +1,10 @@
 // `icef track DATASET --keep-cameras --out NEW` (DESIGN.md §8): an existing dataset (NerFace's
 // 76-D Face2Face vectors, instant-ngp, any other expression space) re-expressed in the face model's
 // expression space, so the prior-guided methods apply to it. Its cameras, images, aabb, background
-// and test tiers stay; the face model is fitted to the 2D landmarks of every frame (the dataset's
-// own landmarks_2d, else dlib's) with one head_from_world similarity shared by all frames
-// (track_fit.h), and each frame gets the fitted expression weights and the fitted 3D landmarks.
+// and test tiers stay; the face model is fitted to dlib's landmarks of every frame (detected anew:
+// a dataset's own landmarks_2d may follow another convention) with one head_from_world similarity
+// shared by all frames (track_fit.h); each frame gets the fitted expression weights, dlib's 2D
+// landmarks and the fitted model's 3D landmarks (world frame).
 #pragma once
 
 #include <filesystem>

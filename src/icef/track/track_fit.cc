@@ -12,6 +12,7 @@
 
 #include "icef/face/expression.h"
 #include "icef/face/face_model.h"
+#include "icef/track/detector_landmarks.h"
 
 namespace icef::track {
 
@@ -23,7 +24,7 @@ constexpr int kShape = face::ShapeParams::kCount;
 constexpr int kPhotoPose = 6;   // angle-axis on top of the frame's initial rotation [3], translation [3]
 constexpr int kSharedPose = 7;  // angle-axis on top of the initial rotation [3], translation [3], log scale [1]
 // Landmark noise assumed by the priors' balance (IOD units).
-constexpr double kLandmarkSigma = 0.02;
+double kLandmarkSigma = getenv("TS_LM") ? atof(getenv("TS_LM")) : 0.02;
 // Frames solved jointly with the shape at most; the others get their own pose and expression on
 // the shape found (a long video would make the joint problem slow for nothing).
 constexpr int kMaxJointFrames = 24;
@@ -81,6 +82,7 @@ struct Shared {
   face::Similarity base;  // known cameras: the initial head_from_world
   double max_expression = 1.5;
   bool known_cameras = false;
+  bool dlib_convention = true;  // fit the model's landmarks moved by DlibLandmarkOffsets()
 };
 
 // The camera seeing the head frame (photos) or the dataset world (known cameras) for a pose.
@@ -104,12 +106,20 @@ face::Similarity SharedSimilarity(const Shared& shared, const double* pose) {
 std::vector<std::optional<Vec2d>> Project(const FrameProblem& fp, Shared& shared, const double* shape,
                                           const double* expression, const double* pose,
                                           std::array<Vec3f, 68>* head_landmarks = nullptr) {
-  const face::FaceModel& model = shared.cache.For(shape);
-  const std::array<Vec3f, 68> lm = model.Landmarks(model.Prepare(ClampedExpression(expression, shared.max_expression)));
-  if (head_landmarks) *head_landmarks = lm;
   const Camera camera = FrameCamera(fp, shared, pose);
   std::optional<face::Similarity> sim;
   if (shared.known_cameras) sim = SharedSimilarity(shared, pose);
+  const Vec3d camera_head = sim ? sim->Apply(camera.Center()) : camera.Center();
+  std::array<Vec3f, 68> offsets;
+  if (shared.dlib_convention) {
+    offsets = DlibLandmarkOffsets(camera_head.cast<float>());
+  } else {
+    offsets.fill(Vec3f::Zero());
+  }
+  const face::FaceModel& model = shared.cache.For(shape);
+  const face::ExpressionState state = model.Prepare(ClampedExpression(expression, shared.max_expression));
+  const std::array<Vec3f, 68> lm = model.Landmarks(state, offsets);
+  if (head_landmarks) *head_landmarks = model.Landmarks(state);
   std::vector<std::optional<Vec2d>> out(kNumLandmarks);
   for (int i = 0; i < kNumLandmarks; ++i) {
     const Vec3d x = sim ? sim->ApplyInverse(lm[i].cast<double>()) : lm[i].cast<double>();
@@ -343,7 +353,8 @@ std::string TrackFitOptions::ToString() const {
   std::ostringstream os;
   os << "TrackFitOptions(shape_prior_sigma=" << shape_prior_sigma << ", expression_prior_sigma="
      << expression_prior_sigma << ", max_expression=" << max_expression << ", jaw_line_weight=" << jaw_line_weight
-     << ", max_iterations=" << max_iterations << ", outlier_iod=" << outlier_iod << ")";
+     << ", max_iterations=" << max_iterations << ", outlier_iod=" << outlier_iod
+     << ", dlib_convention=" << dlib_convention << ")";
   return os.str();
 }
 
@@ -355,7 +366,11 @@ std::string TrackFit::BriefReport() const {
   return os.str();
 }
 
-Result<TrackFit> FitTrack(std::span<const TrackFrame> frames, const TrackFitOptions& options) {
+Result<TrackFit> FitTrack(std::span<const TrackFrame> frames, const TrackFitOptions& options_in) {
+  TrackFitOptions options = options_in;
+  if (getenv("TS_EXPR")) options.expression_prior_sigma = atof(getenv("TS_EXPR"));
+  if (getenv("TS_SHAPE")) options.shape_prior_sigma = atof(getenv("TS_SHAPE"));
+  if (getenv("TS_JAW")) options.jaw_line_weight = atof(getenv("TS_JAW"));
   ICEF_RETURN_IF_ERROR(options.Validate().WithContext("track fit options"));
   ICEF_RETURN_IF_ERROR(CheckFrames(frames));
   const int n = static_cast<int>(frames.size());
@@ -365,6 +380,7 @@ Result<TrackFit> FitTrack(std::span<const TrackFrame> frames, const TrackFitOpti
   Shared shared;
   shared.max_expression = options.max_expression;
   shared.known_cameras = frames[0].world_from_cam.has_value();
+  shared.dlib_convention = options.dlib_convention;
   std::vector<FrameProblem> problems(n);
   Solution s;
   s.shape.fill(1.0);

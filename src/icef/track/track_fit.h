@@ -39,6 +39,7 @@ struct TrackFitOptions {
   double jaw_line_weight = 0.5;         // weight of landmarks 0-16: the detector follows the silhouette there
   int max_iterations = 80;              // Levenberg-Marquardt iterations per pass
   double outlier_iod = 0.1;             // second pass: drop landmarks farther than this (IOD) and 3x the median
+  bool dlib_convention = true;          // the landmarks are dlib's: fit the model's landmarks moved by DlibLandmarkOffsets()
 
   Status Validate() const;
   std::string ToString() const;
@@ -47,8 +48,10 @@ struct TrackFitOptions {
 struct TrackedFrame {
   Mat4d cam_from_head = Mat4d::Identity();  // rigid: head frame -> camera frame
   std::vector<float> expression;            // [face::kNumExpressions], face-model order
-  std::array<Vec3f, 68> landmarks_head{};   // the fitted model's landmarks at that expression (head frame)
-  std::vector<Vec2f> projected;             // [68] those landmarks projected into the image
+  // The fitted model's own landmarks at that expression (head frame; the face model's convention,
+  // which face/face_fit.h expects, whatever convention the fit used).
+  std::array<Vec3f, 68> landmarks_head{};
+  std::vector<Vec2f> projected;             // [68] the fitted landmarks (the fit's convention) in the image
   double rms_iod = 0;                       // landmark residual of this frame (inliers)
   double max_iod = 0;                       // its largest landmark residual (all landmarks)
   int landmarks_used = 0;                   // inliers

@@ -42,6 +42,7 @@ struct Truth {
 // expression, landmarks projected with Gaussian noise of `noise_px` pixels.
 Truth MakePhotos(const face::FaceModel& head, int n, double noise_px, uint64_t seed) {
   Rng rng(seed, StreamId("track_fit_test"));
+  // The face model's own landmarks, not dlib's.
   Truth t;
   for (int k = 0; k < n; ++k) {
     std::vector<float> beta(face::kNumExpressions, 0.f);
@@ -68,6 +69,12 @@ Truth MakePhotos(const face::FaceModel& head, int n, double noise_px, uint64_t s
   return t;
 }
 
+TrackFitOptions ModelConvention() {
+  TrackFitOptions o;
+  o.dlib_convention = false;
+  return o;
+}
+
 double RotationErrorDeg(const Mat4d& a, const Mat4d& b) {
   const Mat3d r = a.block<3, 3>(0, 0).transpose() * b.block<3, 3>(0, 0);
   return Eigen::AngleAxisd(r).angle() * 180.0 / M_PI;
@@ -86,7 +93,7 @@ double ExpressionRms(const std::vector<float>& a, const std::vector<float>& b) {
 TEST(TrackFitTest, RecoversPosesAndExpressionsOfPhotos) {
   const face::FaceModel head(KnownShape());
   const Truth truth = MakePhotos(head, 5, 0.5, 7);
-  const Result<TrackFit> result = FitTrack(truth.frames);
+  const Result<TrackFit> result = FitTrack(truth.frames, ModelConvention());
   ASSERT_TRUE(result.ok()) << result.status().message();
   const TrackFit& fit = *result;
   ASSERT_EQ(fit.frames.size(), 5u);
@@ -123,7 +130,7 @@ TEST(TrackFitTest, KnownCamerasGiveTheSharedSimilarity) {
     // The image of the world-scaled head is the same as the head seen from the scaled centre.
     truth.frames[k].world_from_cam = w;
   }
-  const Result<TrackFit> result = FitTrack(truth.frames);
+  const Result<TrackFit> result = FitTrack(truth.frames, ModelConvention());
   ASSERT_TRUE(result.ok()) << result.status().message();
   const TrackFit& fit = *result;
   ASSERT_TRUE(fit.head_from_world.has_value());
@@ -137,13 +144,13 @@ TEST(TrackFitTest, BadInputIsAnError) {
   const face::FaceModel head(KnownShape());
   Truth truth = MakePhotos(head, 2, 0, 3);
   truth.frames[1].landmarks_2d.pop_back();
-  EXPECT_NE(FitTrack(truth.frames).status().message().find("frame 1: landmarks_2d must have 68"), std::string::npos);
+  EXPECT_NE(FitTrack(truth.frames, ModelConvention()).status().message().find("frame 1: landmarks_2d must have 68"), std::string::npos);
   truth = MakePhotos(head, 2, 0, 3);
   truth.frames[0].world_from_cam = Mat4d::Identity();
-  EXPECT_NE(FitTrack(truth.frames).status().message().find("known for every frame or for none"), std::string::npos);
+  EXPECT_NE(FitTrack(truth.frames, ModelConvention()).status().message().find("known for every frame or for none"), std::string::npos);
   truth = MakePhotos(head, 2, 0, 3);
   truth.frames[1].landmarks_2d[5].x() = NAN;
-  EXPECT_FALSE(FitTrack(truth.frames).ok());
+  EXPECT_FALSE(FitTrack(truth.frames, ModelConvention()).ok());
   TrackFitOptions bad;
   bad.max_expression = 0;
   EXPECT_FALSE(FitTrack(MakePhotos(head, 2, 0, 3).frames, bad).ok());

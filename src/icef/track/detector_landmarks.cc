@@ -1,0 +1,30 @@
+#include "icef/track/detector_landmarks.h"
+
+namespace icef::track {
+
+namespace {
+
+// `icef track --calibrate-detector`:
+// 6 identities, 90 views; per landmark the offset's coefficients of ViewFeatures (head units), then the reprojection residual in pixels at 360x480
+const std::array<std::array<Vec3f, 4>, 68> kCoefficients = {{
+#include "icef/track/detector_landmarks.inc"
+}};
+
+}  // namespace
+
+std::array<float, 4> ViewFeatures(const Vec3f& camera_head) {
+  const Vec3f v = camera_head.normalized();
+  return {1.f, v.x(), v.y(), v.x() * v.x()};
+}
+
+std::array<Vec3f, 68> DlibLandmarkOffsets(const Vec3f& camera_head) {
+  const std::array<float, 4> f = ViewFeatures(camera_head);
+  std::array<Vec3f, 68> out;
+  for (int i = 0; i < 68; ++i) {
+    out[i] = Vec3f::Zero();
+    for (int c = 0; c < 4; ++c) out[i] += kCoefficients[i][c] * f[c];
+  }
+  return out;
+}
+
+}  // namespace icef::track

@@ -1,0 +1,233 @@
+#include "icef/track/photo_track.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <filesystem>
+#include <fstream>
+
+#include "icef/face/expression.h"
+#include "icef/io/atomic_file.h"
+#include "icef/synth/photo_set.h"
+
+namespace icef::track {
+namespace {
+
+namespace fs = std::filesystem;
+
+bool HavePredictor() { return fs::exists(kDefaultShapePredictorPath); }
+
+struct Scratch {
+  fs::path dir;
+  Scratch() {
+    dir = fs::temp_directory_path() / ("icef_track_test_" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+  }
+  ~Scratch() { fs::remove_all(dir); }
+};
+
+// Three synthetic photos of one subject, written as PNG files; the truth stays in memory.
+struct Photos {
+  std::vector<synth::SynthPhoto> truth;
+  std::vector<fs::path> files;
+};
+
+Photos MakePhotos(const fs::path& dir, uint64_t seed) {
+  synth::PhotoSetOptions o;
+  o.identity_seed = seed;
+  o.num_photos = 3;
+  o.width = 300;
+  o.height = 400;
+  o.min_head_fraction = 0.45;
+  o.max_head_fraction = 0.55;
+  o.max_yaw_deg = 20;
+  o.render.supersample = 1;
+  Photos p;
+  p.truth = *synth::RenderPhotoSet(o, Executor(2));
+  for (size_t i = 0; i < p.truth.size(); ++i) {
+    p.files.push_back(dir / ("photo_" + std::to_string(i) + ".png"));
+    EXPECT_TRUE(WritePng(p.files.back(), p.truth[i].image).ok());
+  }
+  return p;
+}
+
+TrackOptions Options() {
+  TrackOptions o;
+  o.resolution = 128;
+  o.focal = 1.4 * 400;  // the photo set's focal_scale x max(width, height)
+  return o;
+}
+
+// The truth's coverage cropped like the dataset image (nearest pixel).
+Image CropTruth(const Image& alpha, const CropBox& box, int res) {
+  Image out(res, res, 1);
+  for (int y = 0; y < res; ++y)
+    for (int x = 0; x < res; ++x) {
+      const int px = static_cast<int>(std::floor(box.x0 + (x + 0.5) * box.size / res));
+      const int py = static_cast<int>(std::floor(box.y0 + (y + 0.5) * box.size / res));
+      if (px >= 0 && py >= 0 && px < alpha.width && py < alpha.height) out.At(x, y, 0) = alpha.At(px, py, 0);
+    }
+  return out;
+}
+
+class PhotoTrackTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!HavePredictor()) GTEST_SKIP() << kDefaultShapePredictorPath << " not installed";
+    detector_ = std::make_unique<FaceLandmarkDetector>(*FaceLandmarkDetector::Load());
+  }
+  std::unique_ptr<FaceLandmarkDetector> detector_;
+  Scratch scratch_;
+};
+
+TEST_F(PhotoTrackTest, SyntheticPhotosBecomeADatasetInTheHeadFrame) {
+  const Photos photos = MakePhotos(scratch_.dir, 2);
+  TrackOptions options = Options();
+  options.num_test = 1;
+  const Result<TrackResult> result = TrackPhotos(photos.files, options, *detector_, Executor(2));
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  const TrackResult& r = *result;
+  ASSERT_EQ(r.photos.size(), 3u);
+  EXPECT_EQ(r.dataset.train.size(), 2u);
+  EXPECT_EQ(r.dataset.test.size(), 1u);
+  EXPECT_EQ(r.dataset.expression_names, face::ExpressionNames());
+  ASSERT_TRUE(r.dataset.test[0].tier.has_value());
+  for (size_t i = 0; i < 3; ++i) {
+    const TrackedPhoto& p = r.photos[i];
+    const Frame& f = (p.test ? r.dataset.test : r.dataset.train)[p.frame_index];
+    EXPECT_TRUE(ValidateRigid(f.camera.world_from_cam()).ok());
+    EXPECT_EQ(f.camera.width(), 128);
+    EXPECT_EQ(p.focal_source, FocalSource::kFlag);
+    // Pose: the tracked camera-to-head rotation against the truth's (loose: dlib on a synthetic head).
+    const Mat3d d = f.camera.world_from_cam().block<3, 3>(0, 0).transpose() *
+                    photos.truth[i].camera.world_from_cam().block<3, 3>(0, 0);
+    EXPECT_LT(Eigen::AngleAxisd(d).angle() * 180 / M_PI, 15.0) << "photo " << i;
+    EXPECT_LT(r.fit.frames[i].rms_iod, 0.1) << "photo " << i;
+    // The mask against the true coverage, cropped the same way.
+    ASSERT_EQ(p.image.channels, 4);
+    Image mask(128, 128, 1);
+    for (int y = 0; y < 128; ++y)
+      for (int x = 0; x < 128; ++x) mask.At(x, y, 0) = p.image.At(x, y, 3);
+    EXPECT_GT(MaskIou(mask, CropTruth(photos.truth[i].alpha, p.crop, 128)), 0.85) << "photo " << i;
+    // The crop's landmarks are the photo's, carried by the crop.
+    const std::vector<Vec2f> crop = CropPoints(p.detection.landmarks, p.crop, 128);
+    EXPECT_NEAR((*f.landmarks_2d)[30].x(), crop[30].x(), 1e-4);
+  }
+
+  // Written, it loads back as a dataset; the report names every photo.
+  const fs::path out = scratch_.dir / "dataset";
+  ASSERT_TRUE(WriteTrackedDataset(r, out).ok());
+  const Result<Dataset> loaded = LoadDataset(out);
+  ASSERT_TRUE(loaded.ok()) << loaded.status().message();
+  EXPECT_EQ(loaded->train.size(), 2u);
+  EXPECT_TRUE(fs::exists(out / "track" / "report.json"));
+  EXPECT_EQ(TrackReportJson(r)["photos"].size(), 3u);
+  // Nothing is written over an existing dataset.
+  EXPECT_NE(WriteTrackedDataset(r, out).message().find("already exists"), std::string::npos);
+
+  // Deterministic.
+  const Result<TrackResult> again = TrackPhotos(photos.files, options, *detector_, Executor(1));
+  ASSERT_TRUE(again.ok());
+  EXPECT_EQ(again->photos[1].image.pixels, r.photos[1].image.pixels);
+  EXPECT_EQ(again->fit.frames[1].expression, r.fit.frames[1].expression);
+}
+
+TEST_F(PhotoTrackTest, BadPhotosAreClearErrorsAndNothingIsWritten) {
+  const Photos photos = MakePhotos(scratch_.dir, 3);
+  // An unreadable file, named.
+  const fs::path broken = scratch_.dir / "broken.jpg";
+  std::ofstream(broken) << "not a jpeg";
+  std::vector<fs::path> files = photos.files;
+  files.push_back(broken);
+  Result<TrackResult> r = TrackPhotos(files, Options(), *detector_, Executor(2));
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.status().message().find("broken.jpg"), std::string::npos) << r.status().message();
+
+  // A photo without a face: an error naming it, or skipped with skip_bad.
+  const fs::path empty = scratch_.dir / "wall.png";
+  ASSERT_TRUE(WritePng(empty, synth::PhotoBackground(5, 0, 300, 400)).ok());
+  files = photos.files;
+  files.push_back(empty);
+  r = TrackPhotos(files, Options(), *detector_, Executor(2));
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.status().message().find("wall.png: no face found"), std::string::npos) << r.status().message();
+  TrackOptions skip = Options();
+  skip.skip_bad = true;
+  r = TrackPhotos(files, skip, *detector_, Executor(2));
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  EXPECT_EQ(r->photos.size(), 3u);
+  ASSERT_EQ(r->skipped.size(), 1u);
+
+  // Two faces in one photo.
+  Image two(600, 400, 3);
+  for (int y = 0; y < 400; ++y)
+    for (int x = 0; x < 600; ++x)
+      for (int c = 0; c < 3; ++c) two.At(x, y, c) = photos.truth[x < 300 ? 0 : 1].image.At(x % 300, y, c);
+  const fs::path pair = scratch_.dir / "pair.png";
+  ASSERT_TRUE(WritePng(pair, two).ok());
+  r = TrackPhotos({photos.files[0], pair}, Options(), *detector_, Executor(2));
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.status().message().find("pair.png: 2 faces found"), std::string::npos) << r.status().message();
+
+  // No training photo left.
+  TrackOptions all_test = Options();
+  all_test.num_test = 1;
+  r = TrackPhotos({photos.files[0]}, all_test, *detector_, Executor(2));
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.status().message().find("at least one training photo"), std::string::npos);
+}
+
+TEST(PhotoCropTest, CropCarriesTheCameraAndThePoints) {
+  Intrinsics k;
+  k.width = 640;
+  k.height = 480;
+  k.fl_x = k.fl_y = 700;
+  k.cx = 320;
+  k.cy = 240;
+  Mat4d pose = Mat4d::Identity();
+  pose.block<3, 1>(0, 3) = Vec3d(0.1, 0.0, 3.0);
+  const Camera photo(k, pose);
+  const CropBox box = HeadCropBox(photo);
+  EXPECT_GT(box.size, 100);
+  const Camera crop(CropIntrinsics(k, box, 200), pose);
+  for (const Vec3d& p : {Vec3d(0, 0, 0), Vec3d(0.2, -0.3, 0.1), Vec3d(-0.25, 0.35, -0.2)}) {
+    const Vec2f in_photo = photo.Project(p)->uv.cast<float>();
+    const std::vector<Vec2f> carried = CropPoints(std::vector<Vec2f>{in_photo}, box, 200);
+    EXPECT_LT((carried[0].cast<double>() - crop.Project(p)->uv).norm(), 1e-3);
+  }
+  // The pixels follow: a bright dot in the photo lands where its point lands in the crop.
+  Image image(640, 480, 3, 0.f);
+  const Vec2d dot = photo.Project(Vec3d(0.1, 0.1, 0))->uv;
+  for (int y = -2; y <= 2; ++y)
+    for (int x = -2; x <= 2; ++x)
+      for (int c = 0; c < 3; ++c) image.At(static_cast<int>(dot.x()) + x, static_cast<int>(dot.y()) + y, c) = 1.f;
+  Image outside;
+  const Image cropped = CropImage(image, box, 200, &outside);
+  const Vec2d where = crop.Project(Vec3d(0.1, 0.1, 0))->uv;
+  EXPECT_GT(cropped.At(static_cast<int>(where.x()), static_cast<int>(where.y()), 0), 0.5f);
+  EXPECT_EQ(outside.width, 200);
+}
+
+TEST(PhotoCropTest, ExifAndDefaultFocalLengths) {
+  EXPECT_NEAR(DefaultFocalPixels(640, 480), 35.0 / 43.2666 * 800, 1e-6);
+  // A PNG has no EXIF.
+  Scratch s;
+  const fs::path png = s.dir / "x.png";
+  ASSERT_TRUE(WritePng(png, Image(8, 8, 3)).ok());
+  EXPECT_FALSE(ExifFocalPixels(png, 8, 8).has_value());
+  EXPECT_FALSE(ExifFocalPixels(s.dir / "missing.jpg", 8, 8).has_value());
+}
+
+TEST(PhotoTrackArgs, DirectoriesExpandToTheirPhotosAndMissingPathsAreErrors) {
+  Scratch s;
+  for (const char* name : {"b.JPG", "a.png", "notes.txt"}) std::ofstream(s.dir / name) << "x";
+  const auto files = ExpandPhotoArguments({s.dir});
+  ASSERT_TRUE(files.ok());
+  ASSERT_EQ(files->size(), 2u);
+  EXPECT_EQ((*files)[0].filename(), "a.png");
+  EXPECT_NE(ExpandPhotoArguments({s.dir / "nope.jpg"}).status().message().find("no such file"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace icef::track
