@@ -15,8 +15,8 @@ namespace icef {
 
 namespace {
 
-constexpr double kYaws[] = {-30, -15, 0, 15, 30};
-constexpr double kPitches[] = {-10, 0, 10};
+constexpr double kYaws[] = {-35, -20, -8, 0, 8, 20, 35};
+constexpr double kPitches[] = {-15, -6, 0, 6, 15};
 constexpr int kWidth = 360, kHeight = 480;
 constexpr double kDistance = 3.0;
 

@@ -23,8 +23,6 @@ constexpr int kExpr = face::kNumExpressions;
 constexpr int kShape = face::ShapeParams::kCount;
 constexpr int kPhotoPose = 6;   // angle-axis on top of the frame's initial rotation [3], translation [3]
 constexpr int kSharedPose = 7;  // angle-axis on top of the initial rotation [3], translation [3], log scale [1]
-// Landmark noise assumed by the priors' balance (IOD units).
-double kLandmarkSigma = getenv("TS_LM") ? atof(getenv("TS_LM")) : 0.02;
 // Frames solved jointly with the shape at most; the others get their own pose and expression on
 // the shape found (a long video would make the joint problem slow for nothing).
 constexpr int kMaxJointFrames = 24;
@@ -83,6 +81,7 @@ struct Shared {
   double max_expression = 1.5;
   bool known_cameras = false;
   bool dlib_convention = true;  // fit the model's landmarks moved by DlibLandmarkOffsets()
+  double landmark_sigma = 0.06;  // TrackFitOptions::landmark_sigma_iod
 };
 
 // The camera seeing the head frame (photos) or the dataset world (known cameras) for a pose.
@@ -189,7 +188,7 @@ class LandmarkCost : public ceres::DynamicCostFunction {
   void Residuals(double const* const* params, double* residuals) const {
     const auto proj = Project(*fp_, *shared_, params[0], params[1], params[2]);
     for (int i = 0; i < kNumLandmarks; ++i) {
-      const double w = fp_->weight[i] / kLandmarkSigma;
+      const double w = fp_->weight[i] / shared_->landmark_sigma;
       Vec2d d(1.0, 1.0);  // behind the camera: a large, constant error
       if (proj[i]) d = (*proj[i] - fp_->frame->landmarks_2d[i].cast<double>()) / fp_->iod_px;
       residuals[2 * i] = w * d.x();
@@ -346,6 +345,8 @@ Status TrackFitOptions::Validate() const {
   if (!(jaw_line_weight >= 0) || jaw_line_weight > 1) return Status::Error("jaw_line_weight must be in [0, 1]");
   if (max_iterations < 1) return Status::Error("max_iterations must be >= 1");
   if (!(outlier_iod > 0)) return Status::Error("outlier_iod must be > 0");
+  if (!(landmark_sigma_iod > 0) || !std::isfinite(landmark_sigma_iod))
+    return Status::Error("landmark_sigma_iod must be a finite number > 0");
   return Status::Ok();
 }
 
@@ -354,7 +355,7 @@ std::string TrackFitOptions::ToString() const {
   os << "TrackFitOptions(shape_prior_sigma=" << shape_prior_sigma << ", expression_prior_sigma="
      << expression_prior_sigma << ", max_expression=" << max_expression << ", jaw_line_weight=" << jaw_line_weight
      << ", max_iterations=" << max_iterations << ", outlier_iod=" << outlier_iod
-     << ", dlib_convention=" << dlib_convention << ")";
+     << ", dlib_convention=" << dlib_convention << ", landmark_sigma_iod=" << landmark_sigma_iod << ")";
   return os.str();
 }
 
@@ -366,11 +367,7 @@ std::string TrackFit::BriefReport() const {
   return os.str();
 }
 
-Result<TrackFit> FitTrack(std::span<const TrackFrame> frames, const TrackFitOptions& options_in) {
-  TrackFitOptions options = options_in;
-  if (getenv("TS_EXPR")) options.expression_prior_sigma = atof(getenv("TS_EXPR"));
-  if (getenv("TS_SHAPE")) options.shape_prior_sigma = atof(getenv("TS_SHAPE"));
-  if (getenv("TS_JAW")) options.jaw_line_weight = atof(getenv("TS_JAW"));
+Result<TrackFit> FitTrack(std::span<const TrackFrame> frames, const TrackFitOptions& options) {
   ICEF_RETURN_IF_ERROR(options.Validate().WithContext("track fit options"));
   ICEF_RETURN_IF_ERROR(CheckFrames(frames));
   const int n = static_cast<int>(frames.size());
@@ -381,6 +378,7 @@ Result<TrackFit> FitTrack(std::span<const TrackFrame> frames, const TrackFitOpti
   shared.max_expression = options.max_expression;
   shared.known_cameras = frames[0].world_from_cam.has_value();
   shared.dlib_convention = options.dlib_convention;
+  shared.landmark_sigma = options.landmark_sigma_iod;
   std::vector<FrameProblem> problems(n);
   Solution s;
   s.shape.fill(1.0);

@@ -69,9 +69,14 @@ Truth MakePhotos(const face::FaceModel& head, int n, double noise_px, uint64_t s
   return t;
 }
 
+// Exact landmarks of the model's own convention with sub-pixel noise: weaker priors than dlib's
+// noise calls for.
 TrackFitOptions ModelConvention() {
   TrackFitOptions o;
   o.dlib_convention = false;
+  o.landmark_sigma_iod = 0.02;
+  o.shape_prior_sigma = 0.15;
+  o.expression_prior_sigma = 0.6;
   return o;
 }
 

@@ -1,0 +1,68 @@
+#include "icef/track/dataset_retrack.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <filesystem>
+
+#include "icef/face/expression.h"
+#include "icef/landmarks/face_landmark_detector.h"
+#include "icef/synth/synthesize.h"
+
+namespace icef::track {
+namespace {
+
+namespace fs = std::filesystem;
+
+TEST(DatasetRetrackTest, SyntheticDatasetKeepsItsCamerasAndGetsItsExpressionsBack) {
+  if (!fs::exists(kDefaultShapePredictorPath)) GTEST_SKIP() << kDefaultShapePredictorPath << " not installed";
+  const fs::path dir = fs::temp_directory_path() / ("icef_retrack_test_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  synth::SynthOptions so;
+  so.out_dir = dir / "src";
+  so.identity_seed = 4;
+  so.num_train = 4;
+  so.resolution = 192;
+  so.test_views = 1;
+  so.novel_per_tier = 1;
+  so.render.supersample = 1;
+  ASSERT_TRUE(synth::SynthesizeDataset(so, Executor(2)).ok());
+  const Result<Dataset> source = LoadDataset(so.out_dir);
+  ASSERT_TRUE(source.ok()) << source.status().message();
+
+  const Result<RetrackResult> r = RetrackDataset(*source, {}, Executor(2));
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  const Dataset& d = r->dataset;
+  EXPECT_EQ(d.expression_names, face::ExpressionNames());
+  ASSERT_EQ(d.train.size(), source->train.size());
+  ASSERT_EQ(d.test.size(), source->test.size());
+  // The synthetic world frame is the head frame: the similarity is close to the identity.
+  const face::Similarity& s = *r->fit.head_from_world;
+  EXPECT_NEAR(s.scale, 1.0, 0.1) << s.ToString();
+  // dlib on these small renders leaves a pitch bias (11.6 degrees here): a loose bound that still
+  // catches a fit gone wrong.
+  EXPECT_LT(Eigen::AngleAxisd(s.rotation).angle() * 180 / M_PI, 15.0) << s.ToString();
+  double sum2 = 0;
+  int n = 0;
+  for (size_t i = 0; i < d.train.size(); ++i) {
+    EXPECT_EQ(d.train[i].camera.world_from_cam(), source->train[i].camera.world_from_cam());
+    EXPECT_EQ(d.train[i].file_path, source->train[i].file_path);
+    for (int e = 0; e < face::kNumExpressions; ++e)
+      if (e != face::kCheekPuff) sum2 += std::pow(d.train[i].expression[e] - source->train[i].expression[e], 2), ++n;
+  }
+  EXPECT_LT(std::sqrt(sum2 / n), 0.25);
+  EXPECT_EQ(d.test[0].tier, source->test[0].tier);
+
+  // Written, it loads back with its images; a second write does not replace it.
+  ASSERT_TRUE(WriteRetrackedDataset(*r, dir / "out").ok());
+  const Result<Dataset> loaded = LoadDataset(dir / "out");
+  ASSERT_TRUE(loaded.ok()) << loaded.status().message();
+  EXPECT_EQ(loaded->expression_dim, face::kNumExpressions);
+  EXPECT_TRUE(fs::exists(dir / "out" / "track" / "report.json"));
+  EXPECT_FALSE(WriteRetrackedDataset(*r, dir / "out").ok());
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace icef::track
