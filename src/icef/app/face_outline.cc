@@ -50,21 +50,24 @@ std::array<Vec3f, 68> FittedLandmarks(const face::FaceFit& fit, std::span<const 
 }
 
 void DrawFaceOutline(Image* image, const Camera& camera, std::span<const Vec3f> landmarks_world, const Vec3f& colour) {
-  const int thickness = image->width >= 256 ? 2 : 1;
+  // Camera::Project works in the camera's pixel units; the image may be another size.
+  const double sx = double(image->width) / camera.width(), sy = double(image->height) / camera.height();
   std::vector<std::optional<Vec2d>> uv;
   for (const Vec3f& p : landmarks_world) {
     const auto proj = camera.Project(p.cast<double>());
-    uv.push_back(proj ? std::optional<Vec2d>(proj->uv) : std::nullopt);
+    uv.push_back(proj ? std::optional<Vec2d>(Vec2d(proj->uv.x() * sx, proj->uv.y() * sy)) : std::nullopt);
   }
-  // Camera::Project works in the camera's pixel units; the image may be another size.
-  const double sx = double(image->width) / camera.width(), sy = double(image->height) / camera.height();
-  auto at = [&](int i) { return Vec2d(uv[i]->x() * sx, uv[i]->y() * sy); };
+  DrawFaceOutline2d(image, uv, colour);
+}
+
+void DrawFaceOutline2d(Image* image, std::span<const std::optional<Vec2d>> uv, const Vec3f& colour) {
+  const int thickness = image->width >= 256 ? 2 : 1;
   for (const Run& run : kRuns) {
     if (run.last >= static_cast<int>(uv.size())) continue;
     for (int i = run.first; i <= run.last; ++i) {
       const int j = i < run.last ? i + 1 : (run.closed ? run.first : -1);
       if (j < 0 || !uv[i] || !uv[j]) continue;
-      Line(image, at(i), at(j), thickness, colour);
+      Line(image, *uv[i], *uv[j], thickness, colour);
     }
   }
 }

@@ -51,17 +51,22 @@ Image TrackOverlay(const track::TrackResult& result, int photo_index) {
   const track::TrackedPhoto& p = result.photos[photo_index];
   const track::TrackedFrame& f = result.fit.frames[photo_index];
   const Vec3f green(0.1f, 0.95f, 0.2f), red(1.f, 0.15f, 0.1f);
-  const std::vector<Vec3f> model(f.landmarks_head.begin(), f.landmarks_head.end());
+  // The fitted landmarks as the fit saw them (dlib's convention), scaled to an image.
+  auto fitted = [&](const std::vector<Vec2f>& points, double scale) {
+    std::vector<std::optional<Vec2d>> uv;
+    for (const Vec2f& q : points)
+      uv.push_back(q.allFinite() ? std::optional<Vec2d>(q.cast<double>() * scale) : std::nullopt);
+    return uv;
+  };
 
   const int w = std::max(1, static_cast<int>(std::lround(double(p.photo.width) * kOverlayHeight / p.photo.height)));
   Image left = track::ResizeImage(p.photo, w, kOverlayHeight);
   const double s = double(kOverlayHeight) / p.photo.height;
-  DrawFaceOutline(&left, Camera(p.photo_intrinsics, f.cam_from_head.inverse()), model, red);
+  DrawFaceOutline2d(&left, fitted(f.projected, s), red);
   for (const Vec2f& l : p.detection.landmarks) Dot(&left, (l.cast<double>() * s).cast<float>(), green);
 
-  const Frame& frame = (p.test ? result.dataset.test : result.dataset.train)[p.frame_index];
   Image right = track::ResizeImage(OverChecker(p.image), kOverlayHeight, kOverlayHeight);
-  DrawFaceOutline(&right, frame.camera, model, red);
+  DrawFaceOutline2d(&right, fitted(track::CropPoints(f.projected, p.crop, kOverlayHeight), 1.0), red);
 
   Image out(left.width + right.width, kOverlayHeight, 3);
   for (int y = 0; y < kOverlayHeight; ++y) {

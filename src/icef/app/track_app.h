@@ -1,7 +1,7 @@
 // `icef track PHOTOS... --out DATASET`: track/photo_track.h's pipeline with what a user sees: the
-// log, an overlay per photo (track/overlay_NNN.png: the photo with the detected landmarks in green
-// and the fitted face model's outline in red, beside the dataset image over a checkerboard, which
-// shows the mask), and the summary. With --keep-cameras, an existing dataset re-expressed in the face
+// log, an overlay per photo (track/overlay_NNN.png: the photo with the detected landmarks as green
+// dots and the fitted face model's landmarks, where the fit put dlib's, as a red outline; beside
+// it the dataset image over a checkerboard, which shows the mask), and the summary. With --keep-cameras, an existing dataset re-expressed in the face
 // model's expression space instead.
 #pragma once
 
