@@ -328,11 +328,12 @@ Status SolveFrames(std::vector<FrameProblem>& problems, const std::vector<int>& 
 }  // namespace
 
 Vec3d TrackedFrame::YawPitchRollDeg() const {
-  // cam_from_head = Rz(roll) Rx(pitch) Ry(yaw) with angles about the camera's axes.
+  // cam_from_head = Rz(roll) Rx(-pitch) Ry(yaw), angles about the camera's axes (as icef synth
+  // --photos draws them).
   const Mat3d r = cam_from_head.block<3, 3>(0, 0);
-  const double pitch = std::asin(std::clamp(-r(1, 2), -1.0, 1.0));
-  const double yaw = std::atan2(r(0, 2), r(2, 2));
-  const double roll = std::atan2(r(1, 0), r(1, 1));
+  const double pitch = -std::asin(std::clamp(r(2, 1), -1.0, 1.0));
+  const double yaw = std::atan2(-r(2, 0), r(2, 2));
+  const double roll = std::atan2(-r(0, 1), r(1, 1));
   return Vec3d(yaw, pitch, roll) * 180.0 / M_PI;
 }
 

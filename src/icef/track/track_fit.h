@@ -57,7 +57,9 @@ struct TrackedFrame {
   double rms_iod = 0;                       // landmark residual of this frame (inliers)
   double max_iod = 0;                       // its largest landmark residual (all landmarks)
   int landmarks_used = 0;                   // inliers
-  // The head's rotation relative to the camera, degrees (yaw about +y, pitch about +x, roll about +z).
+  // The head's rotation relative to the camera, degrees: yaw (positive turns the face toward the
+  // subject's left, the image's right), pitch (positive lifts the chin), roll (positive turns the
+  // head counter-clockwise in the image); cam_from_head = Rz(roll) Rx(-pitch) Ry(yaw).
   Vec3d YawPitchRollDeg() const;
 };
 

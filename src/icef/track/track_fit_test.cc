@@ -144,6 +144,22 @@ TEST(TrackFitTest, KnownCamerasGiveTheSharedSimilarity) {
   for (int k = 0; k < 4; ++k) EXPECT_LT(ExpressionRms(fit.frames[k].expression, truth.expression[k]), 0.1);
 }
 
+TEST(TrackFitTest, YawPitchRollFollowTheirConvention) {
+  TrackedFrame f;
+  const double yaw = 0.3, pitch = -0.2, roll = 0.1;
+  f.cam_from_head.block<3, 3>(0, 0) = (Eigen::AngleAxisd(roll, Vec3d::UnitZ()) * Eigen::AngleAxisd(-pitch, Vec3d::UnitX()) *
+                                       Eigen::AngleAxisd(yaw, Vec3d::UnitY()))
+                                          .toRotationMatrix();
+  const Vec3d ypr = f.YawPitchRollDeg();
+  EXPECT_NEAR(ypr.x(), yaw * 180 / M_PI, 1e-9);
+  EXPECT_NEAR(ypr.y(), pitch * 180 / M_PI, 1e-9);
+  EXPECT_NEAR(ypr.z(), roll * 180 / M_PI, 1e-9);
+  // Positive pitch lifts the chin: the face's +z turns toward the camera's +y.
+  f.cam_from_head.block<3, 3>(0, 0) = Eigen::AngleAxisd(-0.2, Vec3d::UnitX()).toRotationMatrix();
+  EXPECT_GT((f.cam_from_head.block<3, 3>(0, 0) * Vec3d::UnitZ()).y(), 0);
+  EXPECT_GT(f.YawPitchRollDeg().y(), 0);
+}
+
 TEST(TrackFitTest, BadInputIsAnError) {
   EXPECT_FALSE(FitTrack({}).ok());
   const face::FaceModel head(KnownShape());
