@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <libexif/exif-data.h>
+#include <stb_image_write.h>
+
 #include <Eigen/Geometry>
 #include <filesystem>
 #include <fstream>
@@ -217,6 +220,43 @@ TEST(PhotoCropTest, ExifAndDefaultFocalLengths) {
   ASSERT_TRUE(WritePng(png, Image(8, 8, 3)).ok());
   EXPECT_FALSE(ExifFocalPixels(png, 8, 8).has_value());
   EXPECT_FALSE(ExifFocalPixels(s.dir / "missing.jpg", 8, 8).has_value());
+}
+
+// A JPEG whose EXIF says FocalLengthIn35mmFilm = `mm` (libexif builds the APP1 segment, which goes
+// right after the JPEG's start-of-image marker).
+void WriteJpegWithExifFocal(const fs::path& path, int width, int height, int mm) {
+  std::string jpeg;
+  std::vector<uint8_t> rgb(size_t(width) * height * 3, 128);
+  stbi_write_jpg_to_func([](void* ctx, void* data, int size) { static_cast<std::string*>(ctx)->append(static_cast<char*>(data), size); },
+                         &jpeg, width, height, 3, rgb.data(), 90);
+  ExifData* exif = exif_data_new();
+  exif_data_set_byte_order(exif, EXIF_BYTE_ORDER_INTEL);
+  ExifEntry* entry = exif_entry_new();
+  exif_content_add_entry(exif->ifd[EXIF_IFD_EXIF], entry);
+  exif_entry_initialize(entry, EXIF_TAG_FOCAL_LENGTH_IN_35MM_FILM);
+  exif_set_short(entry->data, EXIF_BYTE_ORDER_INTEL, static_cast<ExifShort>(mm));
+  exif_entry_unref(entry);
+  unsigned char* data = nullptr;
+  unsigned int size = 0;
+  exif_data_save_data(exif, &data, &size);
+  exif_data_unref(exif);
+  std::string app1 = "\xFF\xE1";
+  app1 += static_cast<char>((size + 2) >> 8);
+  app1 += static_cast<char>((size + 2) & 0xFF);
+  app1.append(reinterpret_cast<char*>(data), size);
+  free(data);
+  jpeg.insert(2, app1);
+  std::ofstream(path, std::ios::binary) << jpeg;
+}
+
+TEST(PhotoCropTest, ExifFocalLengthIsReadFromAJpeg) {
+  Scratch s;
+  const fs::path jpg = s.dir / "exif.jpg";
+  WriteJpegWithExifFocal(jpg, 64, 48, 28);
+  ASSERT_TRUE(ReadImage(jpg).ok());
+  const auto focal = ExifFocalPixels(jpg, 640, 480);
+  ASSERT_TRUE(focal.has_value());
+  EXPECT_NEAR(*focal, 28.0 / 43.2666 * 800, 0.01);
 }
 
 TEST(PhotoTrackArgs, DirectoriesExpandToTheirPhotosAndMissingPathsAreErrors) {
