@@ -45,8 +45,9 @@ CommandFn RegisterTrack(CLI::App& app) {
                "identities) and print the table of src/icef/track/detector_landmarks.cc");
   return [options, focal, calibrate, &app]() -> Status {
     if (*calibrate) {
+      const std::vector<uint64_t> validation_seeds = {101, 102, 103, 104, 105, 106, 107, 108, 109, 110, 111, 112};
       ICEF_ASSIGN_OR_RETURN(const DetectorCalibration c,
-                            CalibrateDetector({101, 102, 103, 104, 105, 106}, Executor(options->threads), &std::cerr));
+                            CalibrateDetector(validation_seeds, Executor(options->threads), &std::cerr));
       PrintDetectorTable(c, std::cout);
       return Status::Ok();
     }

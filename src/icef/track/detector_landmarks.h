@@ -6,8 +6,8 @@
 // (face::FaceModel::Landmarks with offsets). The offset depends on the view (dlib's jaw line is
 // the silhouette, its eye corners and nose drift as the head turns): it is linear in
 // ViewFeatures of the direction from the head towards the camera. The table comes from
-// `icef track --calibrate-detector` (app/detector_calibration.h: validation identities 101-106,
-// 15 views each, neutral).
+// `icef track --calibrate-detector` (app/detector_calibration.h: validation identities 101-112,
+// 35 views each, neutral).
 #pragma once
 
 #include <array>
