@@ -24,9 +24,14 @@ std::string FrameName(const std::string& split, int index, const Frame& f) {
 
 }  // namespace
 
+std::string RetrackOptions::ToString() const {
+  return "RetrackOptions(skip_bad=" + std::to_string(skip_bad) + ", predictor=" +
+         (predictor_path.empty() ? std::string("default") : predictor_path.string()) + ", " + fit.ToString() + ")";
+}
+
 Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions& options, const Executor& executor,
                                      const std::function<void(const std::string&)>& log) {
-  ICEF_RETURN_IF_ERROR(options.fit.Validate().WithContext("track fit options"));
+  ICEF_RETURN_IF_ERROR(options.Validate().WithContext("track fit options"));
   RetrackResult result;
   result.dataset = source;
   Dataset& d = result.dataset;

@@ -22,8 +22,10 @@ namespace icef::track {
 
 struct RetrackOptions {
   bool skip_bad = false;  // drop frames without a face instead of stopping
-  std::filesystem::path predictor_path;  // dlib's shape predictor (frames without landmarks_2d); empty: the default
+  std::filesystem::path predictor_path;  // dlib's shape predictor; empty: the Debian default
   TrackFitOptions fit;
+  Status Validate() const { return fit.Validate(); }
+  std::string ToString() const;
 };
 
 struct RetrackResult {

@@ -20,6 +20,10 @@ cv::Mat AsMat(const Image& image) {
 
 }  // namespace
 
+std::string CropBox::ToString() const {
+  return "CropBox(x0=" + std::to_string(x0) + ", y0=" + std::to_string(y0) + ", size=" + std::to_string(size) + ")";
+}
+
 CropBox HeadCropBox(const Camera& camera, double margin) {
   // The average head spans x +-0.28 (+-0.36 with the ears), y from -0.34 (chin) to 0.39 (crown),
   // z +-0.34; the box adds room for hair and keeps the neck down to y = -0.55.

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <optional>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "icef/core/status.h"
@@ -17,6 +18,7 @@ namespace icef::track {
 // A square in the photo's image coordinates: [x0, x0 + size) x [y0, y0 + size).
 struct CropBox {
   double x0 = 0, y0 = 0, size = 1;
+  std::string ToString() const;
 };
 
 // The square around the head (crown with room for hair down to the upper neck, in the head frame)

@@ -327,6 +327,14 @@ Status SolveFrames(std::vector<FrameProblem>& problems, const std::vector<int>& 
 
 }  // namespace
 
+std::string TrackedFrame::ToString() const {
+  std::ostringstream os;
+  const Vec3d ypr = YawPitchRollDeg();
+  os << "TrackedFrame(yaw=" << ypr.x() << ", pitch=" << ypr.y() << ", roll=" << ypr.z() << ", rms_iod=" << rms_iod
+     << ", landmarks_used=" << landmarks_used << ")";
+  return os.str();
+}
+
 Vec3d TrackedFrame::YawPitchRollDeg() const {
   // cam_from_head = Rz(roll) Rx(-pitch) Ry(yaw), angles about the camera's axes (as icef synth
   // --photos draws them).

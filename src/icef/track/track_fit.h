@@ -57,6 +57,7 @@ struct TrackedFrame {
   double rms_iod = 0;                       // landmark residual of this frame (inliers)
   double max_iod = 0;                       // its largest landmark residual (all landmarks)
   int landmarks_used = 0;                   // inliers
+  std::string ToString() const;
   // The head's rotation relative to the camera, degrees: yaw (positive turns the face toward the
   // subject's left, the image's right), pitch (positive lifts the chin), roll (positive turns the
   // head counter-clockwise in the image); cam_from_head = Rz(roll) Rx(-pitch) Ry(yaw).
@@ -72,6 +73,7 @@ struct TrackFit {
   double max_iod = 0;
   int iterations = 0;
   std::string BriefReport() const;
+  std::string ToString() const { return BriefReport(); }
 };
 
 // Errors: no frames; a frame without 68 finite landmarks, with coinciding eyes or invalid
