@@ -10,7 +10,8 @@ with truth/truth.json:
 - translation error: distance between the tracked and the true position of the head (the head
   frame's origin) in the camera frame, over the head's crown-to-chin height;
 - expression error: RMS over the 11 weights, and over the 10 the 68 landmarks can see (cheek_puff
-  moves none of them);
+  moves none of them), beside what predicting neutral would score; and the correlation of the
+  tracked with the true weights over all photos;
 - mask IoU: the dataset image's alpha against the true coverage cropped the same way.
 
 Usage: scripts/track_eval.py --icef build/icef --out DIR [--seeds 1,2,3] [--photos 5] [--res 256]
@@ -73,6 +74,7 @@ def evaluate_seed(icef, out, seed, photos, res, extra, synth_extra):
         seen = [i for i, n in enumerate(names) if n != "cheek_puff"]
         expr_all = float(np.sqrt(np.mean((te - pe) ** 2)))
         expr_seen = float(np.sqrt(np.mean((te[seen] - pe[seen]) ** 2)))
+        expr_zero = float(np.sqrt(np.mean(te ** 2)))  # what predicting neutral scores
         # The true coverage cropped like the dataset image.
         x0, y0, size = p["crop"]
         alpha = Image.open(os.path.join(photo_dir, t["alpha_file"])).convert("F")
@@ -82,7 +84,8 @@ def evaluate_seed(icef, out, seed, photos, res, extra, synth_extra):
         a, b = true_crop > 0.5, mask > 0.5
         iou = float((a & b).sum() / max(1, (a | b).sum()))
         rows.append({"seed": seed, "photo": os.path.basename(p["photo"]), "rotation_deg": rot,
-                     "translation_frac": trans, "expression_rms": expr_all, "expression_rms_seen": expr_seen,
+                     "translation_frac": trans, "expression_rms": expr_all, "expression_rms_seen": expr_seen, "expression_rms_neutral": expr_zero,
+                     "true_expression": te.tolist(), "tracked_expression": pe.tolist(),
                      "mask_iou": iou, "landmark_rms_iod": p["landmark_rms_iod"],
                      "true_pose_deg": t.get("head_pose_deg")})
     skipped = [{"seed": seed, "skipped": s} for s in report["skipped"]]
@@ -107,16 +110,24 @@ def main():
                              args.synth_args.split())
         rows += r
         skipped += s
-    keys = ["rotation_deg", "translation_frac", "expression_rms", "expression_rms_seen", "mask_iou", "landmark_rms_iod"]
+    keys = ["rotation_deg", "translation_frac", "expression_rms", "expression_rms_seen", "expression_rms_neutral",
+            "mask_iou", "landmark_rms_iod"]
     summary = {k: {"median": median([r[k] for r in rows]), "max": max(r[k] for r in rows),
                    "min": min(r[k] for r in rows)} for k in keys}
+    # How much of the expressions the tracker finds: correlation of the tracked with the true weights
+    # (all photos, the 10 weights landmarks can see).
+    names_seen = [i for i in range(11) if i != 10]
+    t = np.array([r["true_expression"] for r in rows])[:, names_seen].ravel()
+    p = np.array([r["tracked_expression"] for r in rows])[:, names_seen].ravel()
+    summary["expression_correlation"] = float(np.corrcoef(t, p)[0, 1]) if t.std() > 0 and p.std() > 0 else 0.0
     print(f"{'seed':>4} {'photo':>14} {'rot deg':>8} {'trans':>7} {'expr':>6} {'expr10':>6} {'IoU':>6} {'lm IOD':>7}")
     for r in rows:
         print(f"{r['seed']:>4} {r['photo']:>14} {r['rotation_deg']:8.2f} {r['translation_frac']:7.3f} "
               f"{r['expression_rms']:6.3f} {r['expression_rms_seen']:6.3f} {r['mask_iou']:6.3f} {r['landmark_rms_iod']:7.3f}")
     for s in skipped:
         print(f"seed {s['seed']}: skipped {s['skipped']}")
-    print("median " + "  ".join(f"{k} {summary[k]['median']:.3f}" for k in keys))
+    print("median " + "  ".join(f"{k} {summary[k]['median']:.3f}" for k in keys) +
+          f"  expression_correlation {summary['expression_correlation']:.3f}")
     with open(os.path.join(args.out, "track_eval.json"), "w") as f:
         json.dump({"seeds": args.seeds, "photos": args.photos, "res": args.res, "summary": summary, "rows": rows,
                    "skipped": skipped}, f,

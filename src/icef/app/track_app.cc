@@ -85,6 +85,7 @@ Status RunRetrack(const TrackAppOptions& options, std::ostream& out) {
   ICEF_ASSIGN_OR_RETURN(const Dataset source, LoadDataset(options.photos[0]));
   track::RetrackOptions ro;
   ro.skip_bad = options.track.skip_bad;
+  ro.landmarks = options.landmarks;
   ro.predictor_path = options.predictor;
   ro.fit = options.track.fit;
   out << "icef track --keep-cameras: " << options.photos[0].string() << " (" << source.train.size() << " training, "

@@ -24,6 +24,7 @@ struct TrackAppOptions {
   int threads = 0;
   // photos is one dataset directory, re-expressed with its cameras kept (track/dataset_retrack.h).
   bool keep_cameras = false;
+  track::RetrackLandmarks landmarks = track::RetrackLandmarks::kDetect;  // with keep_cameras
 };
 
 // The overlay of one tracked photo (see above), 384 pixels high.

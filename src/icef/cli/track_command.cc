@@ -36,6 +36,11 @@ CommandFn RegisterTrack(CLI::App& app) {
                "Skip photos without exactly one face (default: stop, naming the photo, and write nothing)");
   app.add_flag("--keep-cameras", options->keep_cameras,
                "PHOTOS is one dataset: keep its cameras and images, re-express its expressions in the face model's");
+  auto landmarks = std::make_shared<std::string>("detect");
+  app.add_option("--landmarks", *landmarks,
+                 "With --keep-cameras: whose 2D landmarks to fit: detect (dlib, in every frame; default), dlib (the "
+                 "dataset's own landmarks_2d, from icef landmarks or icef track), model (the dataset's own, in the face "
+                 "model's convention, as icef synth writes them)");
   app.add_option("--threads", options->threads, "Worker threads (0 = all cores)");
   app.add_option("--predictor", options->predictor,
                  "dlib 68-point shape predictor (default " + std::string(kDefaultShapePredictorPath) + ")");
@@ -43,7 +48,10 @@ CommandFn RegisterTrack(CLI::App& app) {
   app.add_flag("--calibrate-detector", *calibrate,
                "Developer: measure where dlib puts its landmarks on the face model (renders of validation "
                "identities) and print the table of src/icef/track/detector_landmarks.cc");
-  return [options, focal, calibrate, &app]() -> Status {
+  return [options, focal, calibrate, landmarks, &app]() -> Status {
+    const auto parsed = track::ParseRetrackLandmarks(*landmarks);
+    if (!parsed) return Status::Error("--landmarks: expected detect, dlib or model, got \"" + *landmarks + "\"");
+    options->landmarks = *parsed;
     if (*calibrate) {
       const std::vector<uint64_t> validation_seeds = {101, 102, 103, 104, 105, 106, 107, 108, 109, 110, 111, 112};
       ICEF_ASSIGN_OR_RETURN(const DetectorCalibration c,

@@ -24,8 +24,23 @@ std::string FrameName(const std::string& split, int index, const Frame& f) {
 
 }  // namespace
 
+const char* RetrackLandmarksName(RetrackLandmarks landmarks) {
+  switch (landmarks) {
+    case RetrackLandmarks::kDetect: return "detect";
+    case RetrackLandmarks::kDatasetDlib: return "dlib";
+    case RetrackLandmarks::kDatasetModel: return "model";
+  }
+  return "?";
+}
+
+std::optional<RetrackLandmarks> ParseRetrackLandmarks(const std::string& name) {
+  for (RetrackLandmarks l : {RetrackLandmarks::kDetect, RetrackLandmarks::kDatasetDlib, RetrackLandmarks::kDatasetModel})
+    if (name == RetrackLandmarksName(l)) return l;
+  return std::nullopt;
+}
+
 std::string RetrackOptions::ToString() const {
-  return "RetrackOptions(skip_bad=" + std::to_string(skip_bad) + ", predictor=" +
+  return "RetrackOptions(landmarks=" + std::string(RetrackLandmarksName(landmarks)) + ", skip_bad=" + std::to_string(skip_bad) + ", predictor=" +
          (predictor_path.empty() ? std::string("default") : predictor_path.string()) + ", " + fit.ToString() + ")";
 }
 
@@ -36,9 +51,8 @@ Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions
   result.dataset = source;
   Dataset& d = result.dataset;
 
-  // Landmarks: dlib's, in every frame (the fit's convention; a dataset's own landmarks_2d may follow
-  // another one, as the synthetic ground truth's do).
-  {
+  // Landmarks: dlib's, detected anew in every frame, unless the dataset's own are to be used.
+  if (options.landmarks == RetrackLandmarks::kDetect) {
     LandmarkDetectionOptions lo;
     lo.predictor_path = options.predictor_path;
     lo.overwrite = true;
@@ -61,9 +75,10 @@ Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions
         continue;
       }
       const std::string name = FrameName(split, static_cast<int>(i), (*frames)[i]);
-      if (!options.skip_bad) return Status::Error(source.root.string() + ": " + name + ": no face found (--skip-bad drops such frames)");
-      result.skipped.push_back(name + ": no face found");
-      if (log) log("skipped " + name + ": no face found");
+      const std::string why = options.landmarks == RetrackLandmarks::kDetect ? "no face found" : "no landmarks_2d";
+      if (!options.skip_bad) return Status::Error(source.root.string() + ": " + name + ": " + why + " (--skip-bad drops such frames)");
+      result.skipped.push_back(name + ": " + why);
+      if (log) log("skipped " + name + ": " + why);
     }
     *frames = std::move(kept);
   }
@@ -80,7 +95,16 @@ Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions
       result.frame_names.push_back(FrameName(split, static_cast<int>(i), f));
     }
   }
-  ICEF_ASSIGN_OR_RETURN(result.fit, FitTrack(track_frames, options.fit));
+  TrackFitOptions fit_options = options.fit;
+  if (options.landmarks == RetrackLandmarks::kDatasetModel) {
+    // The face model's own landmarks, as exact as the data that carries them: the priors of a
+    // sub-pixel source (track_fit_test's), not those balanced against dlib's scatter.
+    fit_options.dlib_convention = false;
+    fit_options.landmark_sigma_iod = 0.02;
+    fit_options.shape_prior_sigma = 0.15;
+    fit_options.expression_prior_sigma = 0.6;
+  }
+  ICEF_ASSIGN_OR_RETURN(result.fit, FitTrack(track_frames, fit_options));
   if (log) log(result.fit.BriefReport());
   const face::Similarity& sim = *result.fit.head_from_world;
   for (size_t k = 0; k < order.size(); ++k) {

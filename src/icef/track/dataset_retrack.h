@@ -1,14 +1,15 @@
 // `icef track DATASET --keep-cameras --out NEW` (DESIGN.md §8): an existing dataset (NerFace's
 // 76-D Face2Face vectors, instant-ngp, any other expression space) re-expressed in the face model's
 // expression space, so the prior-guided methods apply to it. Its cameras, images, aabb, background
-// and test tiers stay; the face model is fitted to dlib's landmarks of every frame (detected anew:
-// a dataset's own landmarks_2d may follow another convention) with one head_from_world similarity
-// shared by all frames (track_fit.h); each frame gets the fitted expression weights, dlib's 2D
-// landmarks and the fitted model's 3D landmarks (world frame).
+// and test tiers stay; the face model is fitted to the 2D landmarks of every frame (dlib's,
+// detected anew, by default; or the dataset's own, in a convention the caller names) with one
+// head_from_world similarity shared by all frames (track_fit.h); each frame gets the fitted
+// expression weights, the landmarks the fit used and the fitted model's 3D landmarks (world frame).
 #pragma once
 
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -20,8 +21,18 @@
 
 namespace icef::track {
 
+// Whose 2D landmarks the fit uses.
+enum class RetrackLandmarks {
+  kDetect,        // dlib's, detected anew in every frame (the default)
+  kDatasetDlib,   // the dataset's own landmarks_2d, in dlib's convention (icef landmarks, icef track)
+  kDatasetModel,  // the dataset's own landmarks_2d, in the face model's convention (icef synth)
+};
+const char* RetrackLandmarksName(RetrackLandmarks landmarks);
+std::optional<RetrackLandmarks> ParseRetrackLandmarks(const std::string& name);  // "detect", "dlib", "model"
+
 struct RetrackOptions {
-  bool skip_bad = false;  // drop frames without a face instead of stopping
+  RetrackLandmarks landmarks = RetrackLandmarks::kDetect;
+  bool skip_bad = false;  // drop frames without landmarks (no face found) instead of stopping
   std::filesystem::path predictor_path;  // dlib's shape predictor; empty: the Debian default
   TrackFitOptions fit;
   Status Validate() const { return fit.Validate(); }

@@ -54,6 +54,18 @@ TEST(DatasetRetrackTest, SyntheticDatasetKeepsItsCamerasAndGetsItsExpressionsBac
   EXPECT_LT(std::sqrt(sum2 / n), 0.25);
   EXPECT_EQ(d.test[0].tier, source->test[0].tier);
 
+  // The dataset's own landmarks, in the face model's convention (icef synth's): close to exact.
+  RetrackOptions own;
+  own.landmarks = RetrackLandmarks::kDatasetModel;
+  const Result<RetrackResult> exact = RetrackDataset(*source, own, Executor(2));
+  ASSERT_TRUE(exact.ok()) << exact.status().message();
+  EXPECT_LT(Eigen::AngleAxisd(exact->fit.head_from_world->rotation).angle() * 180 / M_PI, 1.0);
+  double exact2 = 0;
+  for (size_t i = 0; i < d.train.size(); ++i)
+    for (int e = 0; e < face::kNumExpressions; ++e)
+      if (e != face::kCheekPuff) exact2 += std::pow(exact->dataset.train[i].expression[e] - source->train[i].expression[e], 2);
+  EXPECT_LT(std::sqrt(exact2 / n), 0.12);
+
   // Written, it loads back with its images; a second write does not replace it.
   ASSERT_TRUE(WriteRetrackedDataset(*r, dir / "out").ok());
   const Result<Dataset> loaded = LoadDataset(dir / "out");
@@ -62,6 +74,12 @@ TEST(DatasetRetrackTest, SyntheticDatasetKeepsItsCamerasAndGetsItsExpressionsBac
   EXPECT_TRUE(fs::exists(dir / "out" / "track" / "report.json"));
   EXPECT_FALSE(WriteRetrackedDataset(*r, dir / "out").ok());
   fs::remove_all(dir);
+}
+
+TEST(DatasetRetrackTest, LandmarkSourcesParse) {
+  for (RetrackLandmarks l : {RetrackLandmarks::kDetect, RetrackLandmarks::kDatasetDlib, RetrackLandmarks::kDatasetModel})
+    EXPECT_EQ(ParseRetrackLandmarks(RetrackLandmarksName(l)), l);
+  EXPECT_FALSE(ParseRetrackLandmarks("mediapipe").has_value());
 }
 
 }  // namespace
