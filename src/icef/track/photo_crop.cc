@@ -112,6 +112,40 @@ std::optional<double> ExifFocalPixels(const std::filesystem::path& path, int wid
   return focal;
 }
 
+int ExifOrientation(const std::filesystem::path& path) {
+  ExifData* data = exif_data_new_from_file(path.c_str());
+  if (!data) return 1;
+  int orientation = 1;
+  if (ExifEntry* e = exif_data_get_entry(data, EXIF_TAG_ORIENTATION);
+      e && e->format == EXIF_FORMAT_SHORT && e->components >= 1) {
+    const int v = exif_get_short(e->data, exif_data_get_byte_order(data));
+    if (v >= 1 && v <= 8) orientation = v;
+  }
+  exif_data_unref(data);
+  return orientation;
+}
+
+Image Oriented(const Image& stored, int orientation) {
+  if (orientation <= 1 || orientation > 8) return stored;
+  const bool swap = orientation >= 5;  // 5-8 exchange width and height
+  Image out(swap ? stored.height : stored.width, swap ? stored.width : stored.height, stored.channels);
+  for (int y = 0; y < out.height; ++y)
+    for (int x = 0; x < out.width; ++x) {
+      int sx = x, sy = y;  // the stored pixel shown at (x, y)
+      switch (orientation) {
+        case 2: sx = stored.width - 1 - x; break;
+        case 3: sx = stored.width - 1 - x, sy = stored.height - 1 - y; break;
+        case 4: sy = stored.height - 1 - y; break;
+        case 5: sx = y, sy = x; break;
+        case 6: sx = y, sy = stored.height - 1 - x; break;
+        case 7: sx = stored.width - 1 - y, sy = stored.height - 1 - x; break;
+        case 8: sx = stored.width - 1 - y, sy = x; break;
+      }
+      for (int c = 0; c < stored.channels; ++c) out.At(x, y, c) = stored.At(sx, sy, c);
+    }
+  return out;
+}
+
 double DefaultFocalPixels(int width, int height) {
   return kDefaultFocal35mm / kFilmDiagonalMm * std::hypot(width, height);
 }

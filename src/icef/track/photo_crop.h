@@ -41,6 +41,13 @@ std::vector<Vec2f> CropPoints(std::span<const Vec2f> points, const CropBox& box,
 // 35 mm film); nullopt when the file has no such tag.
 std::optional<double> ExifFocalPixels(const std::filesystem::path& path, int width, int height);
 
+// The EXIF orientation of a JPEG (1-8, as the tag defines it; 1 = as stored), 1 without the tag.
+int ExifOrientation(const std::filesystem::path& path);
+
+// The image as it is meant to be seen: the stored pixels turned/mirrored by the EXIF orientation
+// (3: 180 degrees, 6: 90 degrees clockwise, 8: 90 counter-clockwise, 2/4/5/7 their mirrored forms).
+Image Oriented(const Image& stored, int orientation);
+
 // The focal length assumed without --focal or EXIF: a 35 mm-equivalent lens (between phones' and
 // webcams' 24-28 mm and portrait lenses' 50-85 mm), 0.81 x the photo's diagonal in pixels.
 double DefaultFocalPixels(int width, int height);

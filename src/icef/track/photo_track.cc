@@ -56,7 +56,8 @@ Result<std::vector<Detected>> DetectAll(const std::vector<fs::path>& photos, con
         read_errors[i] = image.status();
         continue;
       }
-      out[i].photo = image->HasAlpha() ? CompositeOver(*image, Vec3f::Ones()) : std::move(*image);
+      const Image upright = Oriented(*image, ExifOrientation(photos[i]));
+      out[i].photo = upright.HasAlpha() ? CompositeOver(upright, Vec3f::Ones()) : upright;
       out[i].detection = local.DetectFace(out[i].photo);
     }
   });

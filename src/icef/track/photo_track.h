@@ -46,7 +46,7 @@ const char* FocalSourceName(FocalSource source);
 
 struct TrackedPhoto {
   std::filesystem::path source;  // the photo
-  Image photo;                   // as read (RGB or RGBA)
+  Image photo;                   // as read, turned upright by its EXIF orientation, alpha composited over white
   FaceDetection detection;       // in the photo's coordinates
   Intrinsics photo_intrinsics;
   FocalSource focal_source = FocalSource::kDefault;

@@ -224,7 +224,7 @@ TEST(PhotoCropTest, ExifAndDefaultFocalLengths) {
 
 // A JPEG whose EXIF says FocalLengthIn35mmFilm = `mm` (libexif builds the APP1 segment, which goes
 // right after the JPEG's start-of-image marker).
-void WriteJpegWithExifFocal(const fs::path& path, int width, int height, int mm) {
+void WriteJpegWithExif(const fs::path& path, int width, int height, int mm, int orientation = 0) {
   std::string jpeg;
   std::vector<uint8_t> rgb(size_t(width) * height * 3, 128);
   stbi_write_jpg_to_func([](void* ctx, void* data, int size) { static_cast<std::string*>(ctx)->append(static_cast<char*>(data), size); },
@@ -236,6 +236,13 @@ void WriteJpegWithExifFocal(const fs::path& path, int width, int height, int mm)
   exif_entry_initialize(entry, EXIF_TAG_FOCAL_LENGTH_IN_35MM_FILM);
   exif_set_short(entry->data, EXIF_BYTE_ORDER_INTEL, static_cast<ExifShort>(mm));
   exif_entry_unref(entry);
+  if (orientation > 0) {
+    ExifEntry* o = exif_entry_new();
+    exif_content_add_entry(exif->ifd[EXIF_IFD_0], o);
+    exif_entry_initialize(o, EXIF_TAG_ORIENTATION);
+    exif_set_short(o->data, EXIF_BYTE_ORDER_INTEL, static_cast<ExifShort>(orientation));
+    exif_entry_unref(o);
+  }
   unsigned char* data = nullptr;
   unsigned int size = 0;
   exif_data_save_data(exif, &data, &size);
@@ -252,11 +259,39 @@ void WriteJpegWithExifFocal(const fs::path& path, int width, int height, int mm)
 TEST(PhotoCropTest, ExifFocalLengthIsReadFromAJpeg) {
   Scratch s;
   const fs::path jpg = s.dir / "exif.jpg";
-  WriteJpegWithExifFocal(jpg, 64, 48, 28);
+  WriteJpegWithExif(jpg, 64, 48, 28);
   ASSERT_TRUE(ReadImage(jpg).ok());
   const auto focal = ExifFocalPixels(jpg, 640, 480);
   ASSERT_TRUE(focal.has_value());
   EXPECT_NEAR(*focal, 28.0 / 43.2666 * 800, 0.01);
+}
+
+TEST(PhotoCropTest, ExifOrientationTurnsThePhotoUpright) {
+  Scratch s;
+  const fs::path jpg = s.dir / "turned.jpg";
+  WriteJpegWithExif(jpg, 64, 48, 28, 6);
+  EXPECT_EQ(ExifOrientation(jpg), 6);
+  EXPECT_EQ(ExifOrientation(s.dir / "missing.jpg"), 1);
+  // A stored image with a marked top-left pixel, shown for each orientation.
+  Image stored(4, 3, 1);
+  stored.At(0, 0, 0) = 1.f;
+  auto marked = [](const Image& im) {
+    for (int y = 0; y < im.height; ++y)
+      for (int x = 0; x < im.width; ++x)
+        if (im.At(x, y, 0) > 0.5f) return Vec2i(x, y);
+    return Vec2i(-1, -1);
+  };
+  EXPECT_EQ(marked(Oriented(stored, 1)), Vec2i(0, 0));
+  EXPECT_EQ(marked(Oriented(stored, 2)), Vec2i(3, 0));
+  EXPECT_EQ(marked(Oriented(stored, 3)), Vec2i(3, 2));
+  EXPECT_EQ(marked(Oriented(stored, 4)), Vec2i(0, 2));
+  const Image cw = Oriented(stored, 6);  // shown turned 90 degrees clockwise
+  EXPECT_EQ(cw.width, 3);
+  EXPECT_EQ(cw.height, 4);
+  EXPECT_EQ(marked(cw), Vec2i(2, 0));
+  EXPECT_EQ(marked(Oriented(stored, 8)), Vec2i(0, 3));
+  EXPECT_EQ(marked(Oriented(stored, 5)), Vec2i(0, 0));
+  EXPECT_EQ(marked(Oriented(stored, 7)), Vec2i(2, 3));
 }
 
 TEST(PhotoTrackArgs, DirectoriesExpandToTheirPhotosAndMissingPathsAreErrors) {
