@@ -353,5 +353,35 @@ TEST(AtomicFileTest, ReplacesWholeFileAndLeavesNoTemporaries) {
   fs::remove_all(dir);
 }
 
+TEST(AtomicFileTest, NewDirectoryIsAllOrNothing) {
+  const fs::path dir = TempDir("atomic_dir");
+  auto count = [](const fs::path& d) {
+    int n = 0;
+    for (auto& e : fs::directory_iterator(d)) (void)e, ++n;
+    return n;
+  };
+  // Filled and moved into place; an empty directory may be taken over.
+  fs::create_directories(dir / "empty");
+  for (const char* name : {"new", "empty"}) {
+    ASSERT_TRUE(CreateDirectoryAtomic(dir / name, [](const fs::path& tmp) {
+                  return WriteFileAtomic(tmp / "a.txt", "a");
+                }).ok());
+    EXPECT_EQ(*ReadFile(dir / name / "a.txt"), "a");
+  }
+  // A directory with something in it is refused and left alone.
+  const Status refused = CreateDirectoryAtomic(dir / "new", [](const fs::path&) { return Status::Ok(); });
+  EXPECT_NE(refused.message().find("already exists"), std::string::npos);
+  EXPECT_EQ(*ReadFile(dir / "new" / "a.txt"), "a");
+  // A failing fill leaves neither the directory nor its temporary.
+  const Status failed = CreateDirectoryAtomic(dir / "failed", [](const fs::path& tmp) {
+    (void)WriteFileAtomic(tmp / "half.txt", "x");
+    return Status::Error("fill failed");
+  });
+  EXPECT_EQ(failed.message(), "fill failed");
+  EXPECT_FALSE(fs::exists(dir / "failed"));
+  EXPECT_EQ(count(dir), 2);  // new, empty
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace icef
