@@ -2,9 +2,9 @@
 // identities (seeds 101+, generic expression style, neutral) from a grid of views are run through
 // the detector, and each landmark's offset from the face model's own landmark (canonical head frame)
 // is fitted, over all views and identities, as a linear function of the viewing direction
-// (track/detector_landmarks.h: dlib's bias changes as the head turns) by linear least squares on
-// the views' rays (the known cameras).
-// `icef track --calibrate-detector` prints the table that track/detector_landmarks.cc holds.
+// (track/detector_landmarks.h: dlib's bias changes as the head turns), by Gauss-Newton on the
+// pixel residuals through the known cameras with a small ridge on the coefficients.
+// `icef track --calibrate-detector` prints the table that track/detector_landmarks.inc holds.
 #pragma once
 
 #include <array>
@@ -27,7 +27,7 @@ struct DetectorCalibration {
 Result<DetectorCalibration> CalibrateDetector(const std::vector<uint64_t>& seeds, const Executor& executor,
                                               std::ostream* log = nullptr);
 
-// The table as C++ (the body of track/detector_landmarks.cc's array).
+// The table as C++ (track/detector_landmarks.inc, the body of detector_landmarks.cc's array).
 void PrintDetectorTable(const DetectorCalibration& calibration, std::ostream& out);
 
 }  // namespace icef

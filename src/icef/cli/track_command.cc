@@ -47,7 +47,7 @@ CommandFn RegisterTrack(CLI::App& app) {
   auto calibrate = std::make_shared<bool>(false);
   app.add_flag("--calibrate-detector", *calibrate,
                "Developer: measure where dlib puts its landmarks on the face model (renders of validation "
-               "identities) and print the table of src/icef/track/detector_landmarks.cc");
+               "identities) and print the table of src/icef/track/detector_landmarks.inc");
   return [options, focal, calibrate, landmarks, &app]() -> Status {
     const auto parsed = track::ParseRetrackLandmarks(*landmarks);
     if (!parsed) return Status::Error("--landmarks: expected detect, dlib or model, got \"" + *landmarks + "\"");
