@@ -1,8 +1,11 @@
-// What `icef render` / `icef eval` cost per image: a 128x128 frame (the default 2x2 supersampling)
-// of a model trained with the default config on the synthetic K = 5 subject of identity seed 1,
-// at a far expression, with the occupancy grid built for that expression (the default) and with
-// the training grid; and building that grid alone. The model is trained once per process (300
-// steps, about half a minute on 2 cores), so the first benchmark that needs it pays for it.
+// What users wait for, on the synthetic K = 5 subject of identity seed 1 with the default config
+// (the default method): `icef render` / `icef eval` per image, a 128x128 and a 256x256 frame (the
+// default 2x2 supersampling) at a far expression, with the occupancy grid built for that expression
+// (the default) and with the training grid, and building that grid alone; and `icef train`'s step
+// (BM_TrainStep: rays/s, samples/s and steps/s of the full default training step). The render
+// model is trained once per process (300 steps, about half a minute on 2 cores), so the first
+// benchmark that needs it pays for it; the training step runs on a trainer of its own, warmed up
+// for 100 steps. Compare with BM_GemmFp32 of the same run (the machine's matrix-multiply rate).
 #include <benchmark/benchmark.h>
 
 #include <filesystem>
@@ -66,6 +69,51 @@ void BM_RenderImage128(benchmark::State& state) {
   state.counters["frames/s"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_RenderImage128)->ArgName("training_grid")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// A 256x256 frame of the same view (intrinsics scaled by 2).
+void BM_RenderImage256(benchmark::State& state) {
+  const Subject& s = TrainedSubject();
+  if (!s.error.empty()) return state.SkipWithError(s.error.c_str());
+  const icef::Frame& frame = FarFrame(s);
+  icef::Intrinsics k = frame.camera.intrinsics();
+  k.width *= 2, k.height *= 2, k.fl_x *= 2, k.fl_y *= 2, k.cx *= 2, k.cy *= 2;
+  const icef::Camera camera(k, frame.camera.world_from_cam());
+  const icef::Executor executor(2);
+  for (auto _ : state)
+    benchmark::DoNotOptimize(icef::RenderImage(s.trainer->model(), camera, frame.expression, s.dataset.background,
+                                               executor, icef::RenderOccupancyMode::kExpression));
+  state.counters["frames/s"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_RenderImage256)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// icef train's full default step (batch, forward, every loss, backward, Adam, schedules) on 2
+// threads, after 100 warm-up steps of a fresh trainer.
+void BM_TrainStep(benchmark::State& state) {
+  const Subject& s = TrainedSubject();
+  if (!s.error.empty()) return state.SkipWithError(s.error.c_str());
+  icef::RunConfig config;
+  config.train.steps = 1000000;
+  config.train.threads = 2;
+  config.train.checkpoint_every = 0;
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("icef_train_bench_" + std::to_string(::getpid()));
+  auto trainer = icef::Trainer::Create(s.dataset, dir, config);
+  if (!trainer.ok()) return state.SkipWithError(trainer.status().message().c_str());
+  for (int i = 0; i < 100; ++i)
+    if (!(*trainer)->Step().ok()) return state.SkipWithError("warm-up step failed");
+  int64_t samples = 0;
+  for (auto _ : state) {
+    const icef::Result<icef::LossTerms> terms = (*trainer)->Step();
+    if (!terms.ok()) return state.SkipWithError(terms.status().message().c_str());
+    samples += terms->samples;
+  }
+  const double steps = static_cast<double>(state.iterations());
+  state.counters["steps/s"] = benchmark::Counter(steps, benchmark::Counter::kIsRate);
+  state.counters["rays/s"] = benchmark::Counter(steps * config.train.batch_rays, benchmark::Counter::kIsRate);
+  state.counters["samples/s"] = benchmark::Counter(static_cast<double>(samples), benchmark::Counter::kIsRate);
+  std::filesystem::remove_all(dir);
+}
+BENCHMARK(BM_TrainStep)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
 
 // AvatarModel::RenderOccupancy alone: one density query per 2x2x2 cells through the warp.
 void BM_RenderOccupancy(benchmark::State& state) {
