@@ -2,7 +2,8 @@
 // (the default method): `icef render` / `icef eval` per image, a 128x128 and a 256x256 frame (the
 // default 2x2 supersampling) at a far expression, with the occupancy grid built for that expression
 // (the default) and with the training grid, and building that grid alone; and `icef train`'s step
-// (BM_TrainStep: rays/s, samples/s and steps/s of the full default training step). The render
+// (BM_TrainStep: rays/s, samples/s and steps/s of the full default training step), and `icef eval`
+// per test frame (BM_EvalFrame). The render
 // model is trained once per process (300 steps, about half a minute on 2 cores), so the first
 // benchmark that needs it pays for it; the training step runs on a trainer of its own, warmed up
 // for 100 steps. Compare with BM_GemmFp32 of the same run (the machine's matrix-multiply rate).
@@ -12,6 +13,7 @@
 #include <memory>
 #include <unistd.h>
 
+#include "icef/eval/evaluate.h"
 #include "icef/model/render_image.h"
 #include "icef/synth/synthesize.h"
 #include "icef/train/trainer.h"
@@ -22,11 +24,18 @@ struct Subject {
   icef::Dataset dataset;
   std::unique_ptr<icef::Trainer> trainer;
   std::string error;
+  std::filesystem::path dir;  // removed at exit
+  ~Subject() {
+    trainer.reset();
+    std::error_code ec;
+    if (!dir.empty()) std::filesystem::remove_all(dir, ec);
+  }
 };
 
 icef::Status Train(Subject* s) {
   const std::filesystem::path dir =
       std::filesystem::temp_directory_path() / ("icef_render_bench_" + std::to_string(::getpid()));
+  s->dir = dir;
   icef::synth::SynthOptions so;
   so.out_dir = dir / "data";
   ICEF_RETURN_IF_ERROR(icef::synth::SynthesizeDataset(so, icef::Executor(2)));
@@ -63,10 +72,14 @@ void BM_RenderImage128(benchmark::State& state) {
   const icef::Frame& frame = FarFrame(s);
   const icef::Executor executor(2);
   const auto mode = state.range(0) == 0 ? icef::RenderOccupancyMode::kExpression : icef::RenderOccupancyMode::kTraining;
-  for (auto _ : state)
-    benchmark::DoNotOptimize(
-        icef::RenderImage(s.trainer->model(), frame.camera, frame.expression, s.dataset.background, executor, mode));
+  int64_t samples = 0;
+  for (auto _ : state) {
+    const icef::RenderedImage img =
+        icef::RenderImage(s.trainer->model(), frame.camera, frame.expression, s.dataset.background, executor, mode);
+    samples += img.samples_evaluated;
+  }
   state.counters["frames/s"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["samples/frame"] = static_cast<double>(samples) / static_cast<double>(state.iterations());
 }
 BENCHMARK(BM_RenderImage128)->ArgName("training_grid")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
@@ -114,6 +127,30 @@ void BM_TrainStep(benchmark::State& state) {
   std::filesystem::remove_all(dir);
 }
 BENCHMARK(BM_TrainStep)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
+
+// icef eval's work per test frame (the far frame of the subject): its render and the model's
+// neutral render of the same view, PSNR, SSIM, the expression-fidelity measures and, where the
+// face-descriptor network is installed, the three face descriptors (the label says whether it
+// was). LPIPS needs user-supplied weights and is left out.
+void BM_EvalFrame(benchmark::State& state) {
+  const Subject& s = TrainedSubject();
+  if (!s.error.empty()) return state.SkipWithError(s.error.c_str());
+  icef::Dataset one = s.dataset;
+  one.test = {FarFrame(s)};
+  const icef::Executor executor(2);
+  icef::Result<icef::eval::FaceIdentity> identity = icef::eval::FaceIdentity::Load(icef::eval::FaceIdentityOptions{});
+  icef::eval::EvalNetworks networks;
+  if (identity.ok()) networks.identity = &*identity;
+  icef::eval::EvalOptions options;  // no out_dir: nothing written
+  for (auto _ : state) {
+    const icef::Result<icef::eval::EvalResult> result =
+        icef::eval::EvaluateModel(s.trainer->model(), one, options, networks, executor, nullptr);
+    if (!result.ok()) return state.SkipWithError(result.status().message().c_str());
+  }
+  state.counters["frames/s"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.SetLabel(identity.ok() ? "with face descriptors" : "without face descriptors (network not installed)");
+}
+BENCHMARK(BM_EvalFrame)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // AvatarModel::RenderOccupancy alone: one density query per 2x2x2 cells through the warp.
 void BM_RenderOccupancy(benchmark::State& state) {

@@ -10,12 +10,13 @@
 #include "icef/model/symmetry_loss.h"
 #include "icef/render/distortion_loss.h"
 #include "icef/render/occlusion_loss.h"
+#include "icef/render/ray_march.h"
 
 namespace icef {
 
 struct ModelWorkspace {
   RaySamples samples;
-  std::vector<float> dirs, betas, offsets, residual, canonical, sigma, rgb, d_sigma, d_rgb, d_canonical, mask_values;
+  std::vector<float> positions, dirs, betas, offsets, residual, canonical, sigma, rgb, d_sigma, d_rgb, d_canonical, mask_values, extras;
   std::vector<uint8_t> cavity;
   CompositeOutputs<float> composite;
   std::vector<float> d_color, d_opacity, d_weights;
@@ -187,9 +188,8 @@ void AvatarModel::ExpandRays(const TrainRays& batch, ModelWorkspace& ws, const E
   });
 }
 
-void AvatarModel::FieldForward(ModelWorkspace& ws, bool train, const Executor& executor) const {
-  const int64_t n = ws.samples.size();
-  const float* positions = ws.samples.positions.data();
+void AvatarModel::FieldForward(ModelWorkspace& ws, int64_t n, const float* positions, bool train,
+                               const Executor& executor) const {
   const float* canonical = positions;
   if (warp_) {
     Fit(ws.canonical, 3 * n);
@@ -279,7 +279,7 @@ LossTerms AvatarModel::TrainForwardBackward(const TrainRays& batch, const LossWe
     warp_->ForwardTrain(executor, n, ws.samples.positions.data(), ws.betas.data(), ws.offsets.data(),
                         ws.residual.data(), &ws.deform_ctx, true);
   }
-  FieldForward(ws, true, executor);
+  FieldForward(ws, ws.samples.size(), ws.samples.positions.data(), true, executor);
 
   // Compositing over the known background.
   const float bg[3] = {setup_.background.x(), setup_.background.y(), setup_.background.z()};
@@ -481,7 +481,7 @@ OccupancyGrid AvatarModel::RenderOccupancy(std::span<const float> beta, const Ex
 }
 
 void AvatarModel::Render(std::span<const Ray> rays, std::span<const float> beta, const Vec3f& background,
-                       const Executor& executor, RenderOutput* out, const OccupancyGrid* occupancy) const {
+                         const Executor& executor, RenderOutput* out, const OccupancyGrid* occupancy) const {
   ICEF_CHECK(static_cast<int>(beta.size()) == setup_.expression_dim, "beta has the wrong length");
   ModelWorkspace& ws = *render_ws_;
   const int64_t total_rays = static_cast<int64_t>(rays.size());
@@ -490,41 +490,50 @@ void AvatarModel::Render(std::span<const Ray> rays, std::span<const float> beta,
   out->opacity.assign(total_rays, 0.f);
   out->mask.assign(total_rays, 0.f);
   out->deformation.assign(total_rays, 0.f);
+  out->samples_evaluated = 0;
   const float bg[3] = {background.x(), background.y(), background.z()};
-  constexpr int64_t kChunk = 4096;
+  constexpr int64_t kChunk = 1 << 14;
   for (int64_t r0 = 0; r0 < total_rays; r0 += kChunk) {
     const int64_t nr = std::min(kChunk, total_rays - r0);
     SampleRays(rays.subspan(r0, nr), setup_.aabb, config_.SamplerOptions(false), occupancy ? occupancy : &occupancy_,
                0, 0, executor, &ws.samples);
-    const int64_t n = ws.samples.size();
-    const float* positions = ws.samples.positions.data();
-    Fit(ws.dirs, 3 * n);
-    for (int64_t r = 0; r < nr; ++r)
-      for (int64_t i = ws.samples.ray_offset[r]; i < ws.samples.ray_offset[r] + ws.samples.ray_count[r]; ++i)
-        for (int a = 0; a < 3; ++a) ws.dirs[3 * i + a] = rays[r0 + r].direction[a];
-    if (warp_ || traits_.entangled_beta) BroadcastExpression(beta, n, &ws.betas);
-    Fit(ws.offsets, 3 * n);
-    std::fill(ws.offsets.begin(), ws.offsets.end(), 0.f);
-    if (warp_) warp_->Offsets(executor, n, positions, beta, ws.offsets.data(), &ws.warp_ws);
-    FieldForward(ws, false, executor);
-    CompositeInputs<float> in{ws.sigma, ws.rgb, ws.samples.t, ws.samples.dt, ws.samples.ray_offset,
-                              ws.samples.ray_count, std::span<const float>(bg, 3)};
-    CompositeForward(in, config_.CompositeOpts(), executor, &ws.composite);
-    Fit(ws.mask_values, n);
-    mask_.EvaluateBatch(positions, n, ws.mask_values.data());
+    RayMarch march;
+    march.Start(ws.samples, 2);  // extras: the region mask M(x) and the warp's length ||D_final(x) - x||
+    while (march.NextRound(ws.samples)) {
+      const int64_t n = march.round_size();
+      Fit(ws.positions, 3 * n);
+      Fit(ws.dirs, 3 * n);
+      for (int64_t k = 0; k < march.active(); ++k) {
+        const Vec3f& dir = rays[r0 + march.ray(k)].direction;
+        for (int64_t i = march.round_begin(k); i < march.round_end(k); ++i) {
+          const int64_t s = march.Sample(k, i);
+          for (int a = 0; a < 3; ++a) ws.positions[3 * i + a] = ws.samples.positions[3 * s + a], ws.dirs[3 * i + a] = dir[a];
+        }
+      }
+      const float* positions = ws.positions.data();
+      if (warp_ || traits_.entangled_beta) BroadcastExpression(beta, n, &ws.betas);
+      Fit(ws.offsets, 3 * n);
+      std::fill(ws.offsets.begin(), ws.offsets.end(), 0.f);
+      if (warp_) warp_->Offsets(executor, n, positions, beta, ws.offsets.data(), &ws.warp_ws);
+      FieldForward(ws, n, positions, false, executor);
+      Fit(ws.mask_values, n);
+      mask_.EvaluateBatch(positions, n, ws.mask_values.data());
+      Fit(ws.extras, 2 * n);
+      for (int64_t i = 0; i < n; ++i) {
+        ws.extras[2 * i] = ws.mask_values[i];
+        ws.extras[2 * i + 1] = Vec3f(ws.offsets[3 * i], ws.offsets[3 * i + 1], ws.offsets[3 * i + 2]).norm();
+      }
+      march.Composite(ws.samples, ws.sigma.data(), ws.rgb.data(), ws.extras.data(),
+                      static_cast<float>(config_.transmittance_eps), executor);
+      out->samples_evaluated += n;
+    }
     for (int64_t r = 0; r < nr; ++r) {
       const int64_t o = r0 + r;
-      for (int a = 0; a < 3; ++a) out->color[3 * o + a] = ws.composite.color[3 * r + a];
-      out->depth[o] = ws.composite.depth[r];
-      out->opacity[o] = ws.composite.opacity[r];
-      float m = 0, d = 0;
-      for (int64_t i = ws.samples.ray_offset[r]; i < ws.samples.ray_offset[r] + ws.samples.ray_count[r]; ++i) {
-        const float w = ws.composite.weights[i];
-        m += w * ws.mask_values[i];
-        d += w * Vec3f(ws.offsets[3 * i], ws.offsets[3 * i + 1], ws.offsets[3 * i + 2]).norm();
-      }
-      out->mask[o] = m;
-      out->deformation[o] = d;
+      march.Color(r, bg, &out->color[3 * o]);
+      out->depth[o] = march.depth(r);
+      out->opacity[o] = march.opacity(r);
+      out->mask[o] = march.extra(r, 0);
+      out->deformation[o] = march.extra(r, 1);
     }
   }
 }

@@ -82,6 +82,7 @@ struct RenderOutput {
   std::vector<float> opacity;      // [R]
   std::vector<float> mask;         // [R] sum_i w_i M(x_i)
   std::vector<float> deformation;  // [R] sum_i w_i ||D_final(x_i) - x_i|| (world units)
+  int64_t samples_evaluated = 0;   // field evaluations (samples behind opaque surfaces are skipped)
 };
 
 // Reusable buffers of TrainForwardBackward / Render (no allocation once grown).
@@ -106,6 +107,9 @@ class AvatarModel {
 
   // Renders rays at expression beta [expression_dim] over `background`. Samples are placed by
   // `occupancy` (null: the training grid occupancy(); RenderImage passes RenderOccupancy(beta)).
+  // Rays march front to back in rounds and stop once opaque (render/ray_march.h): the fields are
+  // evaluated only at samples that can still change the pixel, with the result of compositing
+  // every sample.
   void Render(std::span<const Ray> rays, std::span<const float> beta, const Vec3f& background,
               const Executor& executor, RenderOutput* out, const OccupancyGrid* occupancy = nullptr) const;
 
@@ -162,7 +166,9 @@ class AvatarModel {
                       const Executor& executor);
   // Pieces of TrainForwardBackward / Render.
   void ExpandRays(const TrainRays& batch, ModelWorkspace& ws, const Executor& executor) const;
-  void FieldForward(ModelWorkspace& ws, bool train, const Executor& executor) const;
+  // Static field (and the prior's cavity) at n samples: canonical = positions + ws.offsets; reads
+  // ws.dirs and ws.betas, writes ws.sigma and ws.rgb.
+  void FieldForward(ModelWorkspace& ws, int64_t n, const float* positions, bool train, const Executor& executor) const;
   double PhotoAndMaskLoss(const TrainRays& batch, const LossWeights& weights, ModelWorkspace& ws,
                           LossTerms* terms) const;
   std::span<const float> DistortionTerm(int64_t num_rays, const LossWeights& weights, ModelWorkspace& ws,

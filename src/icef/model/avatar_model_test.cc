@@ -245,6 +245,62 @@ TEST(RenderImageTest, BandedRenderMatchesPerPixelRays) {
     }
 }
 
+// Render marches rays in rounds and stops them once opaque; the result must be that of
+// evaluating the fields at every sample and compositing them all (render/compositing.h).
+TEST(AvatarModelTest, RenderEqualsCompositingEverySampleWhileSkippingOccludedOnes) {
+  for (const char* method : {"icef", "nerface"}) {
+    SCOPED_TRACE(method);
+    ModelConfig config = TinyModelConfig(method);
+    config.density_bias = 4.5f;  // opaque within a few samples along most rays
+    config.deform_init_scale = 0.5f;
+    auto created = AvatarModel::Create(config, TinySetup(), Executor(2));
+    ASSERT_TRUE(created.ok()) << created.status().message();
+    AvatarModel& model = **created;
+    model.Initialize(5);
+    std::vector<Ray> rays;
+    Rng rng(8, StreamId("rays"));
+    for (int r = 0; r < 500; ++r) {
+      const Vec3f o(float(rng.Uniform(-0.6, 0.6)), float(rng.Uniform(-0.6, 0.6)), 2.f);
+      const Vec3f target(float(rng.Uniform(-0.3, 0.3)), float(rng.Uniform(-0.3, 0.3)), 0.f);
+      rays.push_back(Ray{o, (target - o).normalized()});
+    }
+    const std::vector<float> beta = {0.9f, 0.1f, 0.7f};  // far from the training expressions: kappa < 1
+    const Executor ex(2);
+    RenderOutput out;
+    model.Render(rays, beta, Vec3f(1, 1, 1), ex, &out);
+
+    RaySamples samples;
+    SampleRays(rays, model.setup().aabb, config.SamplerOptions(false), &model.occupancy(), 0, 0, ex, &samples);
+    const int64_t n = samples.size();
+    std::vector<float> dirs(3 * n), offsets(3 * n, 0.f), canonical(samples.positions), sigma(n), rgb(3 * n);
+    for (int64_t r = 0; r < samples.num_rays(); ++r)
+      for (int64_t i = samples.ray_offset[r]; i < samples.ray_offset[r] + samples.ray_count[r]; ++i)
+        for (int a = 0; a < 3; ++a) dirs[3 * i + a] = rays[r].direction[a];
+    std::vector<float> betas;
+    for (int64_t i = 0; i < n; ++i) betas.insert(betas.end(), beta.begin(), beta.end());
+    if (model.warp()) {
+      model.Offsets(ex, n, samples.positions.data(), beta, offsets.data());
+      for (int64_t i = 0; i < 3 * n; ++i) canonical[i] += offsets[i];
+    }
+    model.QueryStatic(ex, n, canonical.data(), dirs.data(), model.warp() ? nullptr : betas.data(), sigma.data(),
+                      rgb.data());
+    const float bg[3] = {1.f, 1.f, 1.f};
+    CompositeInputs<float> in{sigma, rgb, samples.t, samples.dt, samples.ray_offset, samples.ray_count,
+                              std::span<const float>(bg, 3)};
+    CompositeOutputs<float> ref;
+    CompositeForward(in, config.CompositeOpts(), ex, &ref);
+    int64_t used = 0;
+    for (int64_t r = 0; r < samples.num_rays(); ++r) {
+      for (int a = 0; a < 3; ++a) ASSERT_NEAR(out.color[3 * r + a], ref.color[3 * r + a], 2e-6) << r;
+      ASSERT_NEAR(out.opacity[r], ref.opacity[r], 2e-6) << r;
+      ASSERT_NEAR(out.depth[r], ref.depth[r], 2e-5) << r;
+      used += ref.num_used[r];
+    }
+    EXPECT_GE(out.samples_evaluated, used);
+    EXPECT_LT(out.samples_evaluated, n * 3 / 4) << "used " << used << " of " << n;
+  }
+}
+
 TEST(AvatarModelTest, TrainLossGradientMatchesFiniteDifferences) {
   for (const char* method : {"icef", "nerface"}) {
     auto model = MakeModel(method, 0.05f);

@@ -34,6 +34,7 @@ RenderedImage RenderImage(const AvatarModel& model, const Camera& camera, std::s
         for (int q = 0; q < s2; ++q)
           rays[(size_t(j - j0) * w + i) * s2 + q] = camera.RayThrough(i + (q % s + 0.5) / s, j + (q / s + 0.5) / s);
     model.Render(rays, beta, background, executor, &out, occupancy ? &*occupancy : nullptr);
+    img.samples_evaluated += out.samples_evaluated;
     const size_t first = size_t(j0) * w, pixels = size_t(j1 - j0) * w;
     auto average = [&](const std::vector<float>& v, int channels, Image& dst) {
       for (size_t p = 0; p < pixels; ++p)

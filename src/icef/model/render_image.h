@@ -17,6 +17,7 @@ struct RenderedImage {
   Image mask;         // 1 channel: expected region mask M along each ray
   Image deformation;  // 1 channel: expected ||D_final(x) - x|| (world units)
   NearestExpression nearest;  // beta_n, delta, kappa of the expression
+  int64_t samples_evaluated = 0;  // field evaluations (all sub-pixel rays)
 };
 
 // Which occupancy grid places the samples: the one built for the rendered expression

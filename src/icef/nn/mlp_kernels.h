@@ -151,7 +151,13 @@ void MlpJvp(const MlpShape& s, const T* w, int64_t n, const T* x, int slice_begi
     }
     const int64_t count = n * out_w;
     const Activation a = last ? s.output_activation() : Activation::kRelu;
-    if (a != Activation::kNone) {
+    if (a == Activation::kRelu) {  // the hidden layers: a branch-free loop the compiler vectorises
+      for (int64_t i = 0; i < count; ++i) {
+        const bool on = out[i] > T(0);
+        out[i] = on ? out[i] : T(0);
+        tout[i] = on ? tout[i] : T(0);
+      }
+    } else if (a != Activation::kNone) {
       for (int64_t i = 0; i < count; ++i) {
         out[i] = ApplyActivation(a, out[i]);
         tout[i] *= ActivationDerivativeFromOutput(a, out[i]);
