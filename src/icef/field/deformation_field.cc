@@ -18,6 +18,7 @@ nn::FrequencyMlpOptions MlpOptionsFor(const DeformationFieldOptions& o, int expr
   m.output_dims = 3;
   m.output_activation = nn::Activation::kNone;
   m.output_init_scale = o.output_init_scale;
+  m.bf16_inference = o.bf16_inference;
   return m;
 }
 }  // namespace

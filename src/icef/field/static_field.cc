@@ -14,6 +14,7 @@ nn::MlpOptions DensityMlpOptions(const StaticFieldOptions& o, int grid_dims) {
   nn::MlpOptions m;
   m.widths = {grid_dims + o.condition_dims, o.density_hidden, o.geo_features};
   m.output_activation = nn::Activation::kNone;
+  m.bf16_inference = o.bf16_inference;
   return m;
 }
 nn::MlpOptions ColorMlpOptions(const StaticFieldOptions& o) {
@@ -22,6 +23,7 @@ nn::MlpOptions ColorMlpOptions(const StaticFieldOptions& o) {
   for (int w : o.color_hidden) m.widths.push_back(w);
   m.widths.push_back(3);
   m.output_activation = nn::Activation::kSigmoid;
+  m.bf16_inference = o.bf16_inference;
   return m;
 }
 }  // namespace

@@ -38,6 +38,8 @@ struct StaticFieldOptions {
   int condition_dims = 0;
   // Added to the log-density before exp: sigma = exp(h_0 + density_bias).
   float density_bias = 0.f;
+  // Inference passes (renders, occupancy) in BF16 with FP32 sums (nn::MlpOptions::bf16_inference).
+  bool bf16_inference = false;
 
   Status Validate() const;
   std::string ToString() const;

@@ -8,6 +8,7 @@
 #include "icef/model/identity_losses.h"
 #include "icef/model/model_test_util.h"
 #include "icef/model/render_image.h"
+#include "icef/nn/gemm_bf16.h"
 
 namespace icef {
 namespace {
@@ -15,9 +16,11 @@ namespace {
 using testing_model::TinyModelConfig;
 using testing_model::TinySetup;
 
-std::unique_ptr<AvatarModel> MakeModel(const std::string& method, float deform_scale = 0.5f) {
+// bf16 = false: inference in FP32 (finite-difference checks need more than BF16's 8 bits).
+std::unique_ptr<AvatarModel> MakeModel(const std::string& method, float deform_scale = 0.5f, bool bf16 = true) {
   ModelConfig config = TinyModelConfig(method);
   config.deform_init_scale = deform_scale;  // a clearly non-zero warp from the start
+  config.bf16_inference = bf16;
   auto model = AvatarModel::Create(config, TinySetup(), Executor(2));
   ICEF_CHECK(model.ok(), model.status().message());
   (*model)->Initialize(7);
@@ -112,7 +115,7 @@ TEST(AvatarModelTest, ConfidenceBlendAtObservedAndFarExpressions) {
 }
 
 TEST(AvatarModelTest, LinearizedWarpMatchesFiniteDifferences) {
-  auto model = MakeModel("icef");
+  auto model = MakeModel("icef", 0.5f, /*bf16=*/false);
   const int n = 32;
   const std::vector<float> x = RandomPoints(n, 3);
   const Executor ex(1);
@@ -299,6 +302,37 @@ TEST(AvatarModelTest, RenderEqualsCompositingEverySampleWhileSkippingOccludedOne
     EXPECT_GE(out.samples_evaluated, used);
     EXPECT_LT(out.samples_evaluated, n * 3 / 4) << "used " << used << " of " << n;
   }
+}
+
+// bf16_inference changes renders by no more than BF16's precision allows, and only renders.
+TEST(AvatarModelTest, Bf16InferenceRendersCloseToFp32) {
+  std::vector<Ray> rays;
+  Rng rng(9, StreamId("rays"));
+  for (int r = 0; r < 400; ++r) {
+    const Vec3f o(float(rng.Uniform(-0.3, 0.3)), float(rng.Uniform(-0.3, 0.3)), 2.f);
+    rays.push_back(Ray{o, Vec3f(0, 0, -1)});
+  }
+  const std::vector<float> beta = {0.9f, 0.1f, 0.7f};  // kappa < 1: the JVP runs too
+  RenderOutput out[2];
+  for (int b = 0; b < 2; ++b) {
+    ModelConfig config = TinyModelConfig("icef");
+    config.density_bias = 2.f;
+    config.deform_init_scale = 0.5f;
+    config.bf16_inference = b == 1;
+    auto created = AvatarModel::Create(config, TinySetup(), Executor(2));
+    ASSERT_TRUE(created.ok()) << created.status().message();
+    (*created)->Initialize(5);
+    (*created)->Render(rays, beta, Vec3f(1, 1, 1), Executor(2), &out[b]);
+  }
+  double mse = 0, max_diff = 0;
+  for (size_t i = 0; i < out[0].color.size(); ++i) {
+    const double d = out[1].color[i] - out[0].color[i];
+    mse += d * d / out[0].color.size();
+    max_diff = std::max(max_diff, std::abs(d));
+  }
+  EXPECT_LT(max_diff, 0.03);
+  EXPECT_GT(-10 * std::log10(std::max(mse, 1e-20)), 40.0);
+  if (nn::Bf16Supported()) EXPECT_GT(max_diff, 0.0);
 }
 
 TEST(AvatarModelTest, TrainLossGradientMatchesFiniteDifferences) {

@@ -47,6 +47,7 @@ struct ModelConfig {
   float occupancy_threshold = 0.5f;   // density above which a cell is occupied
   float occupancy_decay = 0.9f;       // EMA-of-max decay of stored cell densities per update
   double transmittance_eps = 1e-4;    // stop compositing a ray below this transmittance
+  bool bf16_inference = true;         // renders/eval/occupancy: MLP products in BF16, FP32 sums (AVX512-BF16 CPUs)
 
   void Bind(ConfigSchema& s);
   Status Validate() const;

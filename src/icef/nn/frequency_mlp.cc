@@ -19,6 +19,7 @@ MlpOptions FrequencyMlpOptions::ToMlpOptions() const {
   m.widths.push_back(output_dims);
   m.output_activation = output_activation;
   m.output_init_scale = output_init_scale;
+  m.bf16_inference = bf16_inference;
   return m;
 }
 
@@ -54,6 +55,11 @@ void FrequencyMlp::Forward(const Executor& executor, int64_t n, const float* x, 
   }
   const float* w = mlp_.weights();
   const float* fw = encoding_.weights().data();
+  const MlpBf16Weights* bf = nullptr;
+  if (!keep_for_backward && options_.bf16_inference && Bf16Supported()) {
+    ctx->mlp.bf16.Pack(s, w);
+    bf = &ctx->mlp.bf16;
+  }
   ParallelForChunks(executor, n, kMlpChunk, [&](int64_t begin, int64_t end) {
     const SlotAllocator::Slot slot(&slots);
     const int t = slot.index();
@@ -65,7 +71,7 @@ void FrequencyMlp::Forward(const Executor& executor, int64_t n, const float* x, 
       float* in = keep_for_backward ? ctx->input.data() + r * w0 : tile_in;
       float* hidden = keep_for_backward ? ctx->mlp.hidden.data() + r * hps : tile_hidden;
       FrequencyMlpForward<float>(options_.encoding, fw, s, w, m, x + r * d, c + r * dc, in, hidden,
-                                 y + r * out, scratch);
+                                 y + r * out, scratch, bf);
     }
   });
 }
@@ -122,6 +128,11 @@ void FrequencyMlp::Jvp(const Executor& executor, int64_t n, const float* x, cons
   const int d = options_.encoding.input_dims, dc = options_.condition_dims;
   const float* w = mlp_.weights();
   const float* fw = encoding_.weights().data();
+  const MlpBf16Weights* bf = nullptr;
+  if (options_.bf16_inference && Bf16Supported()) {
+    ctx->mlp.bf16.Pack(s, w);
+    bf = &ctx->mlp.bf16;
+  }
   ParallelForChunks(executor, n, kMlpChunk, [&](int64_t begin, int64_t end) {
     const SlotAllocator::Slot slot(&slots);
     const int t = slot.index();
@@ -130,7 +141,7 @@ void FrequencyMlp::Jvp(const Executor& executor, int64_t n, const float* x, cons
       const int64_t m = std::min(kMlpTile, end - r);
       FrequencyMlpJvp<float>(options_.encoding, fw, s, w, m, x + r * d, c + r * dc,
                              vx ? vx + r * d : nullptr, vc ? vc + r * dc : nullptr, y + r * out,
-                             jy + r * out, scratch);
+                             jy + r * out, scratch, bf);
     }
   });
 }

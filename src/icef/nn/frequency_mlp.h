@@ -38,10 +38,10 @@ void FrequencyMlpInput(const FrequencyEncodingOptions& fo, const T* freq_weights
 template <typename T>
 void FrequencyMlpForward(const FrequencyEncodingOptions& fo, const T* freq_weights, const MlpShape& s,
                          const T* w, int64_t n, const T* x, const T* c, T* in, T* hidden, T* y,
-                         T* scratch) {
+                         T* scratch, const MlpBf16Weights* bf = nullptr) {
   const int dc = s.input_dims() - fo.output_dims();
   FrequencyMlpInput(fo, freq_weights, dc, n, x, c, in, scratch);
-  MlpForward<T>(s, w, n, in, hidden, y);
+  MlpForward<T>(s, w, n, in, hidden, y, bf);
 }
 
 // Tile backward: accumulates dw; writes dx [n, d] and dc_out [n, dc] unless null.
@@ -68,7 +68,7 @@ void FrequencyMlpBackward(const FrequencyEncodingOptions& fo, const T* freq_weig
 template <typename T>
 void FrequencyMlpJvp(const FrequencyEncodingOptions& fo, const T* freq_weights, const MlpShape& s,
                      const T* w, int64_t n, const T* x, const T* c, const T* vx, const T* vc, T* y,
-                     T* jy, T* scratch) {
+                     T* jy, T* scratch, const MlpBf16Weights* bf = nullptr) {
   const int D = fo.output_dims(), w0 = s.input_dims(), dc = w0 - D;
   T* in = scratch;               // [n, w0]
   T* tin = scratch + n * w0;     // [n, w0]
@@ -95,7 +95,7 @@ void FrequencyMlpJvp(const FrequencyEncodingOptions& fo, const T* freq_weights, 
       std::fill(tin + r * w0 + D, tin + (r + 1) * w0, T(0));
     }
   }
-  MlpJvp<T>(s, w, n, in, 0, w0, tin, y, jy, mlp_scratch);
+  MlpJvp<T>(s, w, n, in, 0, w0, tin, y, jy, mlp_scratch, bf);
 }
 
 struct FrequencyMlpOptions {
@@ -111,6 +111,8 @@ struct FrequencyMlpOptions {
   Activation output_activation = Activation::kNone;
   // Multiplies the initial output-layer weights (small: start near a zero residual).
   float output_init_scale = 1.0f;
+  // Forward and JVP passes without a backward pass in BF16 (MlpOptions::bf16_inference).
+  bool bf16_inference = false;
 
   Status Validate() const;
   std::string ToString() const;

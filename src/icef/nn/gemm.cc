@@ -79,6 +79,28 @@ inline void NNBlockMasked(int k, int m, const float* a, const float* b, float* c
   for (int r = 0; r < R; ++r) _mm512_mask_storeu_ps(c + static_cast<int64_t>(r) * m, mask, acc[r]);
 }
 
+// C[n, m] = A[n, k] B[k, m] for m < 16 columns and k a multiple of 16 (the 3-wide output layers):
+// vectorised along k, one dot product per (row, column) from the columns of B gathered once.
+template <int KV>
+void NNSmallM(int64_t n, int m, const float* a, const float* b, float* c) {
+  constexpr int k = 16 * KV;
+  __m512 bt[15][KV];
+  alignas(64) float col[k];
+  for (int j = 0; j < m; ++j) {
+    for (int p = 0; p < k; ++p) col[p] = b[int64_t{p} * m + j];
+    for (int v = 0; v < KV; ++v) bt[j][v] = _mm512_load_ps(col + 16 * v);
+  }
+  for (int64_t s = 0; s < n; ++s) {
+    __m512 av[KV];
+    for (int v = 0; v < KV; ++v) av[v] = _mm512_loadu_ps(a + s * k + 16 * v);
+    for (int j = 0; j < m; ++j) {
+      __m512 acc = _mm512_mul_ps(av[0], bt[j][0]);
+      for (int v = 1; v < KV; ++v) acc = _mm512_fmadd_ps(av[v], bt[j][v], acc);
+      c[s * m + j] = _mm512_reduce_add_ps(acc);
+    }
+  }
+}
+
 void NNTail(int64_t n, int k, int m, int j0, const float* a, const float* b, float* c) {
   const __mmask16 mask = static_cast<__mmask16>((1u << (m - j0)) - 1u);
   int64_t s = 0;
@@ -116,6 +138,8 @@ void GemmNN<float>(int64_t n, int k, int m, const float* a, const float* b, floa
   if (m % 64 == 0) return NNPanel<6, 4>(n, k, m, a, b, c);
   if (m % 32 == 0) return NNPanel<12, 2>(n, k, m, a, b, c);
   if (m % 16 == 0) return NNPanel<16, 1>(n, k, m, a, b, c);
+  if (m < 16 && k == 64) return NNSmallM<4>(n, m, a, b, c);
+  if (m < 16 && k == 32) return NNSmallM<2>(n, m, a, b, c);
   const int full = m / 16 * 16;
   if (full > 0) {
     // Full 16-column panels straight into C (row stride m), then the masked tail.

@@ -93,6 +93,11 @@ void Mlp::Forward(const Executor& executor, int64_t n, const float* x, float* y,
     ctx->num_threads = threads;
   }
   const float* w = weights();
+  const MlpBf16Weights* bf = nullptr;
+  if (!keep_for_backward && options_.bf16_inference && Bf16Supported()) {
+    ctx->bf16.Pack(shape_, w);
+    bf = &ctx->bf16;
+  }
   const int hps = shape_.hidden_per_sample();
   const int in_w = input_dims(), out_w = output_dims();
   ParallelForChunks(executor, n, kMlpChunk, [&](int64_t begin, int64_t end) {
@@ -102,7 +107,7 @@ void Mlp::Forward(const Executor& executor, int64_t n, const float* x, float* y,
     for (int64_t s = begin; s < end; s += kMlpTile) {
       const int64_t m = std::min(kMlpTile, end - s);
       float* hidden = keep_for_backward ? ctx->hidden.data() + s * hps : scratch;
-      MlpForward<float>(shape_, w, m, x + s * in_w, hidden, y + s * out_w);
+      MlpForward<float>(shape_, w, m, x + s * in_w, hidden, y + s * out_w, bf);
     }
   });
 }

@@ -40,6 +40,9 @@ struct MlpOptions {
   Activation output_activation = Activation::kNone;
   // Multiplies the initial output-layer weights.
   float output_init_scale = 1.0f;
+  // Forward passes without a backward pass (inference) multiply in BF16 with FP32 sums
+  // (nn/gemm_bf16.h) when the build has the kernel; training passes are always FP32.
+  bool bf16_inference = false;
 
   Status Validate() const;
   std::string ToString() const;
@@ -54,6 +57,7 @@ struct MlpContext {
   AlignedVector<float> scratch;      // per thread: tile-sized work buffers
   AlignedVector<float> weight_grads; // per chunk: [num_params] gradient accumulators
   AlignedVector<float> w_transposed; // untransposed weights for the backward pass
+  MlpBf16Weights bf16;               // the weights packed for BF16 inference
 };
 
 class Mlp {

@@ -13,11 +13,13 @@
 #include <algorithm>
 #include <cstdint>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "icef/core/status.h"
 #include "icef/nn/activation.h"
 #include "icef/nn/gemm.h"
+#include "icef/nn/gemm_bf16.h"
 
 namespace icef::nn {
 
@@ -52,6 +54,33 @@ class MlpShape {
   int max_width_ = 0;
 };
 
+// An MLP's weights packed for GemmNNBf16 (nn/gemm_bf16.h), layer by layer; layers whose output
+// width is not a multiple of 16 (the small output layers) stay FP32.
+struct MlpBf16Weights {
+  std::vector<uint16_t> packed;
+  std::vector<int64_t> offsets;  // [layers] first value of layer l in packed, -1: FP32
+  void Pack(const MlpShape& s, const float* w) {
+    offsets.assign(s.num_layers(), -1);
+    int64_t size = 0;
+    for (int l = 0; l < s.num_layers(); ++l)
+      if (s.widths()[l + 1] % 16 == 0) offsets[l] = size, size += Bf16PackedSize(s.widths()[l], s.widths()[l + 1]);
+    packed.resize(size);
+    for (int l = 0; l < s.num_layers(); ++l)
+      if (offsets[l] >= 0) PackBf16Pairs(s.widths()[l], s.widths()[l + 1], w + s.WeightOffset(l), packed.data() + offsets[l]);
+  }
+  const uint16_t* layer(int l) const { return offsets[l] < 0 ? nullptr : packed.data() + offsets[l]; }
+};
+
+// Layer l's product: BF16 when bf packs the layer (float only), else GemmNN.
+template <typename T>
+inline void LayerProduct(const MlpShape& s, int l, const T* w, const MlpBf16Weights* bf, int64_t n, const T* in, T* out) {
+  const int in_w = s.widths()[l], out_w = s.widths()[l + 1];
+  if constexpr (std::is_same_v<T, float>) {
+    if (bf && bf->layer(l)) return GemmNNBf16(n, in_w, out_w, in, bf->layer(l), out);
+  }
+  GemmNN<T>(n, in_w, out_w, in, w + s.WeightOffset(l), out);
+}
+
 // Writes W_l [w_{l+1}, w_l] (the untransposed layer) for every layer into wt_out, same offsets.
 // The backward pass multiplies by these. Call once per batch, not per tile.
 template <typename T>
@@ -66,15 +95,17 @@ void MlpTransposeWeights(const MlpShape& s, const T* w, T* w_transposed) {
 }
 
 // x [n, w_0] -> y [n, w_L]; hidden [n * hidden_per_sample] receives the hidden activations.
+// bf (float only, may be null): the weights packed for BF16 products (inference).
 template <typename T>
-void MlpForward(const MlpShape& s, const T* w, int64_t n, const T* x, T* hidden, T* y) {
+void MlpForward(const MlpShape& s, const T* w, int64_t n, const T* x, T* hidden, T* y,
+                const MlpBf16Weights* bf = nullptr) {
   const T* in = x;
   const int layers = s.num_layers();
   for (int l = 0; l < layers; ++l) {
     const bool last = l == layers - 1;
-    const int in_w = s.widths()[l], out_w = s.widths()[l + 1];
+    const int out_w = s.widths()[l + 1];
     T* out = last ? y : hidden + n * s.HiddenOffset(l);
-    GemmNN<T>(n, in_w, out_w, in, w + s.WeightOffset(l), out);
+    LayerProduct<T>(s, l, w, bf, n, in, out);
     const int64_t count = n * out_w;
     if (!last) {
       for (int64_t i = 0; i < count; ++i) out[i] = out[i] > T(0) ? out[i] : T(0);
@@ -130,7 +161,7 @@ inline int64_t MlpJvpScratch(const MlpShape& s, int64_t n) { return 4 * n * s.ma
 // [n, slice_dims] is non-zero only on input columns [slice_begin, slice_begin + slice_dims).
 template <typename T>
 void MlpJvp(const MlpShape& s, const T* w, int64_t n, const T* x, int slice_begin, int slice_dims,
-            const T* v, T* y, T* jy, T* scratch) {
+            const T* v, T* y, T* jy, T* scratch, const MlpBf16Weights* bf = nullptr) {
   const int layers = s.num_layers();
   const int64_t stride = n * s.max_width();
   T* h[2] = {scratch, scratch + stride};
@@ -140,14 +171,14 @@ void MlpJvp(const MlpShape& s, const T* w, int64_t n, const T* x, int slice_begi
   int cur = 0;
   for (int l = 0; l < layers; ++l) {
     const bool last = l == layers - 1;
-    const int in_w = s.widths()[l], out_w = s.widths()[l + 1];
+    const int out_w = s.widths()[l + 1];
     T* out = last ? y : h[cur];
     T* tout = last ? jy : t[cur];
-    GemmNN<T>(n, in_w, out_w, in, w + s.WeightOffset(l), out);
-    if (l == 0) {
+    LayerProduct<T>(s, l, w, bf, n, in, out);
+    if (l == 0) {  // the tangent's slice of the first layer stays FP32 (its rows need not pair up)
       GemmNN<T>(n, slice_dims, out_w, tin, w + s.WeightOffset(0) + int64_t{slice_begin} * out_w, tout);
     } else {
-      GemmNN<T>(n, in_w, out_w, tin, w + s.WeightOffset(l), tout);
+      LayerProduct<T>(s, l, w, bf, n, tin, tout);
     }
     const int64_t count = n * out_w;
     const Activation a = last ? s.output_activation() : Activation::kRelu;
