@@ -175,7 +175,9 @@ void MlpJvp(const MlpShape& s, const T* w, int64_t n, const T* x, int slice_begi
     T* out = last ? y : h[cur];
     T* tout = last ? jy : t[cur];
     LayerProduct<T>(s, l, w, bf, n, in, out);
-    if (l == 0) {  // the tangent's slice of the first layer stays FP32 (its rows need not pair up)
+    if (l == 0 && !(slice_begin == 0 && slice_dims == s.widths()[0])) {
+      // A tangent on part of the input: that slice of the first layer, in FP32 (its rows need not
+      // pair up for BF16).
       GemmNN<T>(n, slice_dims, out_w, tin, w + s.WeightOffset(0) + int64_t{slice_begin} * out_w, tout);
     } else {
       LayerProduct<T>(s, l, w, bf, n, tin, tout);

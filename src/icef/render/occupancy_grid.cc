@@ -54,22 +54,6 @@ Status OccupancyGrid::SetAllowed(std::vector<uint8_t> allowed) {
   return Status::Ok();
 }
 
-int64_t OccupancyGrid::CellOf(const Vec3f& p) const {
-  const Vec3f q = (p - aabb_.min).cwiseProduct(inv_cell_size_);
-  const int r = options_.resolution;
-  int c[3];
-  for (int a = 0; a < 3; ++a) {
-    if (!(q[a] >= 0.f && q[a] <= float(r))) return -1;  // also rejects NaN
-    c[a] = std::min(int(q[a]), r - 1);
-  }
-  return CellIndex(c[0], c[1], c[2]);
-}
-
-bool OccupancyGrid::IsOccupied(const Vec3f& p) const {
-  const int64_t c = CellOf(p);
-  return c >= 0 && bits_[c] != 0;
-}
-
 int64_t OccupancyGrid::NumOccupied() const {
   int64_t n = 0;
   for (uint8_t b : bits_) n += b;

@@ -4,6 +4,8 @@
 // Covering all training expressions is the caller's job (query each expression and take the max).
 #pragma once
 
+#include <algorithm>
+
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -52,7 +54,10 @@ class OccupancyGrid {
   OccupancyGrid WithQueriedCells(const DensityQuery& cell_query, int stride = 1) const;
 
   // True when the cell containing p (world frame) is occupied; false outside the aabb.
-  bool IsOccupied(const Vec3f& p) const;
+  bool IsOccupied(const Vec3f& p) const {  // inline: the sampler asks for every sample
+    const int64_t c = CellOf(p);
+    return c >= 0 && bits_[c] != 0;
+  }
   bool IsCellOccupied(int x, int y, int z) const { return bits_[CellIndex(x, y, z)] != 0; }
   // Marks every cell occupied (or empty) and sets the stored densities to +threshold*2 (or 0).
   // Cells outside the allowed set (SetAllowed) stay empty.
@@ -74,7 +79,16 @@ class OccupancyGrid {
   // Restores densities saved from densities() and recomputes the bits; error on a size mismatch.
   Status SetDensities(std::vector<float> densities);
   // The cell index of p, or -1 outside the aabb.
-  int64_t CellOf(const Vec3f& p) const;
+  int64_t CellOf(const Vec3f& p) const {
+    const Vec3f q = (p - aabb_.min).cwiseProduct(inv_cell_size_);
+    const int r = options_.resolution;
+    int c[3];
+    for (int a = 0; a < 3; ++a) {
+      if (!(q[a] >= 0.f && q[a] <= float(r))) return -1;  // also rejects NaN
+      c[a] = std::min(int(q[a]), r - 1);
+    }
+    return CellIndex(c[0], c[1], c[2]);
+  }
   int64_t CellIndex(int x, int y, int z) const { return (int64_t(z) * options_.resolution + y) * options_.resolution + x; }
 
   std::string ToString() const;
