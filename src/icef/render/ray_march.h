@@ -13,9 +13,10 @@
 //
 // Each round takes the next few samples of every ray still marching (more per ray as fewer rays
 // remain); a ray stops after the first sample that leaves its transmittance below
-// transmittance_eps, exactly where CompositeRayForward stops, with the same float arithmetic in
-// the same order: the results are bit-identical to CompositeForward over all samples, while the
-// samples behind an opaque surface are never evaluated. `extras` are per-sample scalars
+// transmittance_eps, exactly where CompositeRayForward stops, with the same float operations in
+// the same order: the results equal CompositeForward's over all samples (to the last bit, up to
+// how the compiler fuses multiply-adds), while the samples behind an opaque surface are never
+// evaluated. `extras` are per-sample scalars
 // accumulated as sum_i w_i v_i (e.g. the expected region mask).
 #pragma once
 
