@@ -21,6 +21,7 @@
 #include "icef/field/region_mask.h"
 #include "icef/field/static_field.h"
 #include "icef/field/symmetry_plane.h"
+#include "icef/model/losses.h"
 #include "icef/model/model_config.h"
 #include "icef/model/model_setup.h"
 #include "icef/nn/parameter_store.h"
@@ -34,47 +35,6 @@ namespace icef {
 inline constexpr int kGridGroup = 0;
 inline constexpr int kMlpGroup = 1;
 inline constexpr int kDeformGroup = 2;
-
-// Loss weights of L = L_photo + lambda_mask L_mask + lambda_id L_id + lambda_smooth L_smooth
-// + lambda_distortion L_dist + lambda_occlusion L_occ + lambda_symmetry L_sym (the trainer fills them from TrainConfig; the method's traits zero
-// L_id and L_smooth where the method has none).
-struct LossWeights {
-  double lambda_id = 0.0;
-  double lambda_smooth = 0.0;
-  double lambda_mask = 0.0;
-  double lambda_distortion = 0.0;
-  double lambda_occlusion = 0.0;
-  double lambda_symmetry = 0.0;
-  double symmetry_colour = 0.0;  // weight of the colour part of L_sym (model/symmetry_loss.h)
-  int symmetry_max_samples = 16384;  // cap on the samples mirrored by L_sym per batch
-  double smooth_epsilon = 0.01;  // finite-difference offset of L_smooth, in half-extent units of the aabb
-  int smooth_max_samples = 8192;  // cap on boundary samples used by L_smooth per batch
-};
-
-// A batch of training rays, each from a training frame with a known expression.
-struct TrainRays {
-  std::vector<Ray> rays;              // [R] world frame
-  std::vector<int32_t> frame;         // [R] training frame index (its expression is setup.training_expressions[k])
-  std::vector<float> target_rgb;      // [R, 3] composited over the background
-  std::vector<float> target_alpha;    // [R] foreground mask, or empty when the images have no alpha
-  std::vector<float> background;      // [R, 3] per-ray background the targets are composited over, or
-                                      // empty for setup.background
-};
-
-struct LossTerms {
-  double photo = 0;       // mean squared error over rays and channels
-  double mask = 0;        // mean squared error of opacity against alpha
-  double id = 0;          // L_id (mean over samples, half-extent units squared)
-  double smooth = 0;      // L_smooth estimate
-  double distortion = 0;  // mean distortion loss per ray (distances in aabb diagonals)
-  double occlusion = 0;   // mean occlusion sparsity loss per ray (render/occlusion_loss.h)
-  double symmetry = 0;    // L_sym (model/symmetry_loss.h)
-  double total = 0;       // weighted sum
-  int64_t samples = 0;    // samples evaluated
-  double psnr() const;    // from `photo`
-  bool AllFinite() const;
-  std::string ToString() const;
-};
 
 struct RenderOutput {
   std::vector<float> color;        // [R, 3]
@@ -101,7 +61,8 @@ class AvatarModel {
   // Draws initial parameters (deterministic for the seed).
   void Initialize(uint64_t seed);
 
-  // Forward + backward of one batch: accumulates d total / d parameters into store().grads().
+  // Forward + backward of one batch: every loss term (model/losses.h) with its weight and value,
+  // and d total / d parameters accumulated into store().grads().
   LossTerms TrainForwardBackward(const TrainRays& batch, const LossWeights& weights, uint64_t seed, int64_t step,
                                  const Executor& executor);
 
@@ -160,24 +121,13 @@ class AvatarModel {
 
  private:
   AvatarModel(const ModelConfig& config, const ModelSetup& setup, RegionMask mask, ExpressionConfidence confidence);
-  // L_sym of the batch in `ws` (canonical sample positions given): adds its gradient w.r.t. the
-  // batch's sigma and rgb to ws.d_sigma / ws.d_rgb and back-propagates the mirror images' share.
-  double SymmetryTerm(ModelWorkspace& ws, int64_t n, const float* canonical, const LossWeights& weights,
-                      const Executor& executor);
   // Pieces of TrainForwardBackward / Render.
   void ExpandRays(const TrainRays& batch, ModelWorkspace& ws, const Executor& executor) const;
   // Static field (and the prior's cavity) at n samples: canonical = positions + ws.offsets; reads
   // ws.dirs and ws.betas, writes ws.sigma and ws.rgb.
   void FieldForward(ModelWorkspace& ws, int64_t n, const float* positions, bool train, const Executor& executor) const;
-  double PhotoAndMaskLoss(const TrainRays& batch, const LossWeights& weights, ModelWorkspace& ws,
-                          LossTerms* terms) const;
-  std::span<const float> DistortionTerm(int64_t num_rays, const LossWeights& weights, ModelWorkspace& ws,
-                                        LossTerms* terms) const;
-  void OcclusionTerm(int64_t num_rays, const LossWeights& weights, ModelWorkspace& ws, LossTerms* terms) const;
-  void IdentityTerms(const LossWeights& weights, uint64_t seed, int64_t step, ModelWorkspace& ws, LossTerms* terms,
-                     const Executor& executor);
-  double SmoothTerm(const LossWeights& weights, uint64_t seed, int64_t step, ModelWorkspace& ws,
-                    const Executor& executor);
+  // Runs the terms of one stage (model/losses.h) and records their values in `terms`.
+  void RunLosses(LossStage stage, LossContext& ctx, LossTerms* terms);
   void WarpOffsets(const Executor& executor, int64_t n, const float* positions, std::span<const float> beta,
                    float* offsets, WarpPart part) const;
 
@@ -196,6 +146,8 @@ class AvatarModel {
   std::optional<SymmetryPlane> symmetry_;
   std::unique_ptr<ModelWorkspace> train_ws_;
   mutable std::unique_ptr<ModelWorkspace> render_ws_;
+  std::vector<std::unique_ptr<Loss>> losses_;  // every term of the objective, in evaluation order
+  std::vector<Loss*> evaluated_losses_;        // those with a non-zero weight in the current batch
 };
 
 }  // namespace icef

@@ -121,8 +121,8 @@ TEST(PriorGuidedTest, ZeroResidualIsThePriorAndCostsNoIdentityLoss) {
   w.lambda_smooth = 1.0;
   const LossTerms terms = model->TrainForwardBackward(Batch(32, 1), w, 3, 0, Executor(1));
   EXPECT_GT(terms.samples, 0);
-  EXPECT_EQ(terms.id, 0.0);
-  EXPECT_EQ(terms.smooth, 0.0);
+  EXPECT_EQ(terms.Get("id"), 0.0);
+  EXPECT_EQ(terms.Get("smooth"), 0.0);
 }
 
 // D_final = P + kappa R_phi + (1 - kappa) R_lin: P enters with weight 1 at every kappa.

@@ -163,16 +163,8 @@ Result<LossTerms> Trainer::Step() {
   const LossTerms terms = model_->TrainForwardBackward(batch_, w, seed, state_.step, executor_);
   // What is non-finite this step ("" when nothing is).
   std::string nonfinite;
-  for (const auto& [name, v] : {std::pair{"photo", terms.photo}, std::pair{"mask", terms.mask},
-                                std::pair{"id", terms.id}, std::pair{"smooth", terms.smooth},
-                                std::pair{"distortion", terms.distortion}, std::pair{"occlusion", terms.occlusion},
-                                std::pair{"symmetry", terms.symmetry},
-                                std::pair{"total", terms.total}}) {
-    if (!std::isfinite(v)) {
-      nonfinite = std::string("loss term '") + name + "' is not finite";
-      break;
-    }
-  }
+  if (const std::string term = terms.FirstNonFinite(); !term.empty())
+    nonfinite = "loss term '" + term + "' is not finite";
   if (nonfinite.empty()) {
     const float* g = model_->store().grads();
     float sum = 0;
@@ -259,13 +251,7 @@ Result<TrainSummary> Trainer::Run(const ProgressFn& progress, const std::atomic<
       line["step"] = state_.step;
       line["seconds"] = state_.elapsed_seconds;
       line["loss"] = terms.total;
-      line["photo"] = terms.photo;
-      line["mask"] = terms.mask;
-      line["id"] = terms.id;
-      line["smooth"] = terms.smooth;
-      line["distortion"] = terms.distortion;
-      line["occlusion"] = terms.occlusion;
-      line["symmetry"] = terms.symmetry;
+      for (const LossValue& term : terms.terms) line[term.name] = term.value;
       line["batch_psnr"] = terms.psnr();
       line["occupied"] = model_->occupancy().OccupiedFraction();
       if (last_step_skipped_) line["skipped"] = true;

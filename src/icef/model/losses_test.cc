@@ -1,0 +1,189 @@
+// The loss terms as a list (model/losses.h): what the training step reports, and that each term's
+// gradient reaches the parameters with its weight.
+#include "icef/model/losses.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "icef/core/rng.h"
+#include "icef/model/avatar_model.h"
+#include "icef/model/model_test_util.h"
+
+namespace icef {
+namespace {
+
+using testing_model::TinyModelConfig;
+using testing_model::TinySetup;
+
+const std::vector<std::string> kTerms = {"photo", "mask", "distortion", "occlusion", "symmetry", "id", "smooth"};
+
+// coarse: a coarse grid, visible opacities and a field with structure (random offsets on every
+// parameter), as the finite-difference checks need (see symmetry_loss_test.cc).
+std::unique_ptr<AvatarModel> MakeModel(const std::string& method, bool coarse = false) {
+  ModelConfig config = TinyModelConfig(method);
+  config.deform_init_scale = 0.05f;
+  config.bf16_inference = false;
+  if (coarse) {
+    config.grid_levels = 2;
+    config.grid_finest_resolution = 6;
+    config.density_bias = 1.f;
+  }
+  auto model = AvatarModel::Create(config, TinySetup(), Executor(1));
+  ICEF_CHECK(model.ok(), model.status().message());
+  (*model)->Initialize(7);
+  if (coarse) {
+    Rng noise(12, StreamId("params"));
+    for (int64_t i = 0; i < (*model)->store().size(); ++i)
+      (*model)->store().params()[i] += static_cast<float>(noise.Uniform(-0.3, 0.3));
+  }
+  return std::move(model).value();
+}
+
+TrainRays Batch(bool alpha) {
+  TrainRays batch;
+  Rng rng(5, StreamId("batch"));
+  for (int r = 0; r < 24; ++r) {
+    const Vec3f o(static_cast<float>(rng.Uniform(-0.2, 0.2)), static_cast<float>(rng.Uniform(-0.2, 0.2)), 2.f);
+    batch.rays.push_back(Ray{o, Vec3f(0, 0, -1)});
+    batch.frame.push_back(r % 3);
+    for (int a = 0; a < 3; ++a) batch.target_rgb.push_back(static_cast<float>(rng.Uniform()));
+    if (alpha) batch.target_alpha.push_back(static_cast<float>(rng.Uniform()));
+  }
+  return batch;
+}
+
+LossWeights AllOn() {
+  LossWeights w;
+  w.lambda_id = 0.5;
+  w.lambda_smooth = 0.01;
+  w.lambda_mask = 0.2;
+  w.lambda_distortion = 0.02;
+  w.lambda_occlusion = 0.1;
+  w.lambda_symmetry = 0.3;
+  w.symmetry_max_samples = 64;
+  w.smooth_max_samples = 64;
+  w.smooth_epsilon = 0.05;
+  return w;
+}
+
+TEST(LossesTest, EveryTermListedOnceAndTheTotalIsTheirWeightedSum) {
+  for (const std::string method : {"icef", "icef-no-id", "nerface"}) {
+    auto model = MakeModel(method);
+    model->store().ZeroGrads();
+    const LossWeights w = AllOn();
+    const LossTerms t = model->TrainForwardBackward(Batch(true), w, 3, 0, Executor(1));
+    ASSERT_EQ(t.terms.size(), kTerms.size()) << method;
+    double total = 0;
+    for (size_t i = 0; i < kTerms.size(); ++i) {
+      EXPECT_EQ(t.terms[i].name, kTerms[i]) << method;
+      EXPECT_TRUE(std::isfinite(t.terms[i].value)) << method << " " << kTerms[i];
+      total += t.terms[i].weight * t.terms[i].value;
+    }
+    EXPECT_NEAR(t.total, total, 1e-12 * std::max(1.0, std::abs(total))) << method;
+    EXPECT_EQ(t.terms[0].weight, 1.0);
+    EXPECT_EQ(t.terms[1].weight, w.lambda_mask);
+    EXPECT_GT(t.Get("photo"), 0.0);
+    EXPECT_GT(t.Get("mask"), 0.0);
+    EXPECT_GT(t.samples, 0);
+    EXPECT_TRUE(t.AllFinite());
+    const bool identity = method == "icef";
+    EXPECT_EQ(t.terms[5].weight, identity ? w.lambda_id : 0.0) << method;
+    EXPECT_EQ(t.terms[6].weight, identity ? w.lambda_smooth : 0.0) << method;
+    if (identity) {
+      EXPECT_GT(t.Get("id"), 0.0);
+    } else {
+      EXPECT_EQ(t.Get("id"), 0.0) << method;
+    }
+    // nerface has no canonical space: no symmetry prior.
+    EXPECT_EQ(t.terms[4].weight, method == "nerface" ? 0.0 : w.lambda_symmetry) << method;
+  }
+  // Without alpha the mask term has nothing to act on.
+  auto model = MakeModel("icef");
+  const LossTerms t = model->TrainForwardBackward(Batch(false), AllOn(), 3, 0, Executor(1));
+  EXPECT_EQ(t.terms[1].weight, 0.0);
+  EXPECT_EQ(t.Get("mask"), 0.0);
+}
+
+TEST(LossesTest, FirstNonFiniteNamesTheTerm) {
+  LossTerms t;
+  t.terms = {{"photo", 1, 0.5}, {"id", 1, 0.1}};
+  t.total = 0.6;
+  EXPECT_EQ(t.FirstNonFinite(), "");
+  t.terms[1].value = std::nan("");
+  EXPECT_EQ(t.FirstNonFinite(), "id");
+  t.terms[1].value = 0.1;
+  t.total = INFINITY;
+  EXPECT_EQ(t.FirstNonFinite(), "total");
+  EXPECT_NE(t.ToString().find("photo 0.5"), std::string::npos) << t.ToString();
+}
+
+// Each term alone (on top of the photo term, which is always on): the parameter gradients it adds
+// equal its weight times central differences of its own value. Not L_occ: it holds the occlusion
+// in front of a sample constant by design (render/occlusion_loss.h, tested there), so its gradient
+// is no derivative of its value; the list test above checks that it is evaluated. The hash grid is trilinear, so its
+// position derivative jumps at cell faces; parameters whose differences at h and h/2 disagree (the
+// stencil straddles a face) are skipped, and most must remain.
+TEST(LossesTest, EachTermsGradientIsItsWeightTimesItsDerivative) {
+  const TrainRays batch = Batch(true);
+  const Executor ex(1);
+  const LossWeights all = AllOn();
+  struct Case {
+    std::string term;
+    double LossWeights::*lambda;
+  };
+  const std::vector<Case> cases = {{"mask", &LossWeights::lambda_mask},
+                                   {"distortion", &LossWeights::lambda_distortion},
+                                   {"symmetry", &LossWeights::lambda_symmetry},
+                                   {"id", &LossWeights::lambda_id},
+                                   {"smooth", &LossWeights::lambda_smooth}};
+  for (const Case& c : cases) {
+    auto model = MakeModel("icef", true);
+    nn::ParameterStore& store = model->store();
+    LossWeights off;  // only the photo term
+    off.symmetry_max_samples = all.symmetry_max_samples;
+    off.smooth_max_samples = all.smooth_max_samples;
+    off.smooth_epsilon = all.smooth_epsilon;
+    LossWeights on = off;
+    on.*c.lambda = all.*c.lambda;
+    store.ZeroGrads();
+    model->TrainForwardBackward(batch, off, 3, 0, ex);
+    const std::vector<float> g_off(store.grads(), store.grads() + store.size());
+    store.ZeroGrads();
+    const double value = model->TrainForwardBackward(batch, on, 3, 0, ex).Get(c.term);
+    const std::vector<float> g_on(store.grads(), store.grads() + store.size());
+    EXPECT_GT(std::abs(value), 0.0) << c.term;
+    std::vector<double> added(g_on.size());
+    for (size_t i = 0; i < added.size(); ++i) added[i] = double(g_on[i]) - double(g_off[i]);
+    std::vector<int64_t> order(added.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = int64_t(i);
+    std::partial_sort(order.begin(), order.begin() + 12, order.end(),
+                      [&](int64_t a, int64_t b) { return std::abs(added[a]) > std::abs(added[b]); });
+    ASSERT_GT(std::abs(added[order[0]]), 1e-7) << c.term << " adds no gradient";
+    auto fd_at = [&](int64_t i, float h) {
+      const float saved = store.params()[i];
+      store.params()[i] = saved + h;
+      const double vp = model->TrainForwardBackward(batch, on, 3, 0, ex).Get(c.term);
+      store.params()[i] = saved - h;
+      const double vm = model->TrainForwardBackward(batch, on, 3, 0, ex).Get(c.term);
+      store.params()[i] = saved;
+      return on.*c.lambda * (vp - vm) / (2.0 * (double(saved + h) - double(saved)));
+    };
+    int checked = 0;
+    for (int k = 0; k < 12; ++k) {
+      const int64_t i = order[k];
+      const float h = std::max(1e-3f, 1e-3f * std::abs(store.params()[i]));
+      const double fd = fd_at(i, h), fd_half = fd_at(i, 0.5f * h);
+      if (std::abs(fd - fd_half) > 0.01 * std::abs(fd_half) + 1e-3 * std::abs(added[order[0]])) continue;
+      ++checked;
+      EXPECT_NEAR(added[i], fd_half, 3e-2 * std::abs(fd_half) + 2e-3 * std::abs(added[order[0]]))
+          << c.term << " parameter " << i;
+    }
+    EXPECT_GE(checked, 6) << c.term;
+    store.ZeroGrads();
+  }
+}
+
+}  // namespace
+}  // namespace icef
