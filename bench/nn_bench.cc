@@ -80,7 +80,7 @@ BENCHMARK(BM_GemmFp32)->Unit(benchmark::kMillisecond);
 
 struct GridFixture {
   ParameterStore store;
-  HashGridEncoding grid{HashGridOptions{}, &store, "grid"};
+  HashGridEncoding grid{ReferenceHashGridOptions(), &store, "grid"};
   std::vector<float> pos, feat, jac, dfeat, dpos;
   GridFixture() {
     grid.Initialize(1);

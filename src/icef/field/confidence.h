@@ -16,6 +16,7 @@ namespace icef {
 struct ConfidenceOptions {
   double lambda = 0.5;  // length scale of kappa = exp(-delta / lambda), in expression-coefficient units (> 0)
 
+  bool operator==(const ConfidenceOptions&) const = default;
   Status Validate() const;
   std::string ToString() const;
 };

@@ -29,8 +29,9 @@ struct DeformationFieldOptions {
   // Scale of the initial output-layer weights (small: the warp starts near the identity).
   float output_init_scale = 1e-2f;
   // Inference passes (renders, occupancy) in BF16 with FP32 sums (nn::MlpOptions::bf16_inference).
-  bool bf16_inference = false;
+  bool bf16_inference = true;
 
+  bool operator==(const DeformationFieldOptions&) const = default;
   Status Validate() const;
   std::string ToString() const;
 };

@@ -38,11 +38,12 @@ struct RegionMaskOptions {
   bool mouth = true;          // include the mouth region (landmarks 48-67)
   float brow_margin = 0.15f;  // capsule radius around the brow polylines, fraction of iod
   float eye_margin = 0.15f;   // capsule radius around the eye contours, fraction of iod
-  float mouth_margin = 0.2f;  // capsule radius around the lip contours, fraction of iod
+  float mouth_margin = 0.25f; // capsule radius around the lip contours, fraction of iod
   float softness = 0.08f;     // half-width of the 1 -> 0 transition, fraction of iod (<= every margin)
   float grid_cell = 0.03f;    // cell size of the lookup grid, fraction of iod
   int max_grid_resolution = 256;  // cap on lookup-grid cells per axis
 
+  bool operator==(const RegionMaskOptions&) const = default;
   Status Validate() const;
   std::string ToString() const;
 };

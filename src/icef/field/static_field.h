@@ -33,14 +33,15 @@ struct StaticFieldOptions {
   // Widths of the colour MLP's hidden layers.
   std::vector<int> color_hidden = {64, 64};
   // Spherical-harmonics degree of the view-direction encoding (degree^2 values).
-  int sh_degree = 4;
+  int sh_degree = 2;
   // Expression dimensions appended to the density MLP input (0 = no beta; nerface only).
   int condition_dims = 0;
   // Added to the log-density before exp: sigma = exp(h_0 + density_bias).
-  float density_bias = 0.f;
+  float density_bias = -4.f;
   // Inference passes (renders, occupancy) in BF16 with FP32 sums (nn::MlpOptions::bf16_inference).
-  bool bf16_inference = false;
+  bool bf16_inference = true;
 
+  bool operator==(const StaticFieldOptions&) const = default;
   Status Validate() const;
   std::string ToString() const;
 };

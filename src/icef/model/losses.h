@@ -26,8 +26,9 @@
 
 namespace icef {
 
-// Weights and settings of the terms (the trainer fills them from TrainConfig; a term's Weight()
-// zeroes it where the method or the batch has nothing for it to act on).
+// Weights and settings of the terms. The lambdas default to 0 (term off): a run's weights come
+// from TrainConfig::Losses(); the settings' defaults are TrainConfig's too. A term's Weight() zeroes
+// it where the method or the batch has nothing for it to act on.
 struct LossWeights {
   double lambda_id = 0.0;
   double lambda_smooth = 0.0;

@@ -23,17 +23,27 @@ struct HashGridOptions {
   // Features per level F.
   int features_per_level = 2;
   // log2 of the hashed table size T per level.
-  int log2_table_size = 19;
+  int log2_table_size = 17;
   // Resolution of the coarsest level (cells per axis).
   double base_resolution = 16.0;
   // Resolution of the finest level; levels grow geometrically in between.
-  double finest_resolution = 1024.0;
+  double finest_resolution = 512.0;
   // Initial table values are uniform in [-init_scale, init_scale].
   float init_scale = 1e-4f;
 
+  bool operator==(const HashGridOptions&) const = default;
   Status Validate() const;
   std::string ToString() const;
 };
+
+// DESIGN.md §7's reference configuration (instant-ngp's: T = 2^19, finest resolution 1024), which
+// the reference model and the engine benchmarks use; the avatar's default grid is smaller.
+inline HashGridOptions ReferenceHashGridOptions() {
+  HashGridOptions o;
+  o.log2_table_size = 19;
+  o.finest_resolution = 1024.0;
+  return o;
+}
 
 // Resolutions, indexing mode and table offsets of every level.
 HashGridLayout MakeHashGridLayout(const HashGridOptions& options);

@@ -14,7 +14,7 @@ using testing::MaxRelativeError;
 using testing::RandomVector;
 
 TEST(HashGridLayoutTest, ReferenceConfigurationIsDenseAtLevelsZeroToFive) {
-  const HashGridLayout g = MakeHashGridLayout(HashGridOptions{});
+  const HashGridLayout g = MakeHashGridLayout(ReferenceHashGridOptions());
   ASSERT_EQ(g.num_levels, 16);
   EXPECT_EQ(g.levels[0].resolution, 16);
   EXPECT_EQ(g.levels[15].resolution, 1024);

@@ -133,7 +133,7 @@ struct ReferenceModel::ThreadBuffers {
 };
 
 ReferenceModel::ReferenceModel(uint64_t seed)
-    : grid_(HashGridOptions{}, &store_, "static/hash_grid", kGridGroup),
+    : grid_(ReferenceHashGridOptions(), &store_, "static/hash_grid", kGridGroup),
       deform_(DeformOptions(), &store_, "deform/mlp", kMlpGroup),
       density_(DensityOptions(), &store_, "static/density_mlp", kMlpGroup),
       colour_(ColourOptions(), &store_, "static/colour_mlp", kMlpGroup),

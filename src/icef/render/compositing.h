@@ -33,6 +33,7 @@ namespace icef {
 struct CompositeOptions {
   double transmittance_eps = 1e-4;  // stop marching a ray once its transmittance falls below this (0 = never)
 
+  bool operator==(const CompositeOptions&) const = default;
   Status Validate() const;
   std::string ToString() const;
 };

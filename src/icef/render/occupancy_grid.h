@@ -19,12 +19,13 @@ namespace icef {
 
 struct OccupancyGridOptions {
   int resolution = 64;       // cells per axis (resolution^3 cells over the aabb)
-  float decay = 0.95f;       // EMA: stored density <- max(decay * stored, new density) per update
-  float threshold = 0.01f;   // a cell is occupied when its stored density (sigma, 1/world units) exceeds this
+  float decay = 0.9f;        // EMA: stored density <- max(decay * stored, new density) per update
+  float threshold = 0.5f;    // a cell is occupied when its stored density (sigma, 1/world units) exceeds this
   int dilation = 1;          // occupied cells are dilated by this many cells (Chebyshev distance)
   int64_t query_batch = 65536;  // positions per density-query call
   float update_fraction = 1.f;  // fraction of cells re-queried per Update (a random subset; all cells decay)
 
+  bool operator==(const OccupancyGridOptions&) const = default;
   Status Validate() const;
   std::string ToString() const;
 };

@@ -27,13 +27,14 @@
 namespace icef {
 
 struct RaySamplerOptions {
-  int num_samples = 32;      // fixed-count mode: samples per ray over the ray/aabb interval
+  int num_samples = 48;      // fixed-count mode: samples per ray over the ray/aabb interval
   float step_size = 0.f;     // marching mode: minimum step (world units); 0 = fixed-count mode unless cone_angle > 0
   float cone_angle = 0.f;    // marching mode: step grows as cone_angle * t (instant-ngp: 1/256); 0 = constant step
   int max_samples = 1024;    // marching mode: cap on samples per ray
   bool stratified = true;    // jitter sample positions per ray (training); false = deterministic midpoints
 
   bool Marching() const { return step_size > 0.f || cone_angle > 0.f; }
+  bool operator==(const RaySamplerOptions&) const = default;
   Status Validate() const;
   std::string ToString() const;
 };

@@ -76,7 +76,7 @@ TEST(RaySamplerTest, RaysMissingTheAabbGetNoSamples) {
   RaySamples s;
   SampleRays(rays, Aabb(), RaySamplerOptions(), nullptr, 0, 0, Executor(1), &s);
   EXPECT_EQ(s.ray_count[0], 0);
-  EXPECT_EQ(s.ray_count[1], 32);
+  EXPECT_EQ(s.ray_count[1], RaySamplerOptions{}.num_samples);
   EXPECT_EQ(s.ray_offset[1], 0);
 }
 

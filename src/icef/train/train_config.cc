@@ -50,6 +50,21 @@ void TrainConfig::Bind(ConfigSchema& s) {
            "row still stops training)");
 }
 
+LossWeights TrainConfig::Losses(bool has_alpha) const {
+  LossWeights w;
+  w.lambda_id = lambda_id;
+  w.lambda_smooth = lambda_smooth;
+  w.lambda_mask = has_alpha ? lambda_mask : 0.0;
+  w.lambda_distortion = lambda_distortion;
+  w.lambda_occlusion = lambda_occlusion;
+  w.lambda_symmetry = lambda_symmetry;
+  w.symmetry_colour = symmetry_colour;
+  w.symmetry_max_samples = symmetry_max_samples;
+  w.smooth_epsilon = smooth_epsilon;
+  w.smooth_max_samples = smooth_max_samples;
+  return w;
+}
+
 Status TrainConfig::Validate() const {
   auto positive = [](double v) { return std::isfinite(v) && v > 0; };
   auto non_negative = [](double v) { return std::isfinite(v) && v >= 0; };

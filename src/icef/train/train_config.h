@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "icef/io/config_schema.h"
+#include "icef/model/losses.h"
 #include "icef/model/model_config.h"
 
 namespace icef {
@@ -25,12 +26,12 @@ struct TrainConfig {
   double lambda_smooth = 1e-4;       // weight of L_smooth (deformation smoothness at the region boundary)
   double lambda_mask = 0.1;          // weight of the alpha-mask loss (images with alpha only)
   double lambda_distortion = 0.035;  // weight of the mip-NeRF 360 distortion loss (0 = off)
-  double smooth_epsilon = 0.01;      // finite-difference offset of L_smooth (half-extent units)
-  int smooth_max_samples = 4096;     // boundary samples per step used by L_smooth
+  double smooth_epsilon = LossWeights{}.smooth_epsilon;  // finite-difference offset of L_smooth (half-extent units)
+  int smooth_max_samples = LossWeights{}.smooth_max_samples;  // boundary samples per step used by L_smooth
   double lambda_occlusion = 1e-4;    // weight of the occlusion sparsity prior (0 = off)
   double lambda_symmetry = 0.1;      // weight of the left-right symmetry prior L_sym (0 = off)
-  double symmetry_colour = 0.0;      // weight of L_sym's colour part relative to its opacity part
-  int symmetry_max_samples = 16384;  // samples per step mirrored by L_sym
+  double symmetry_colour = LossWeights{}.symmetry_colour;  // weight of L_sym's colour part relative to its opacity part
+  int symmetry_max_samples = LossWeights{}.symmetry_max_samples;  // samples per step mirrored by L_sym
   bool pixel_jitter = true;          // training rays through random points of their pixels
   bool random_background = true;     // train over random background colours (images with alpha only)
   int grid_anneal_steps = 0;         // coarse-to-fine hash grid: levels beyond the 4 coarsest switch on over these steps (0 = off)
@@ -46,6 +47,8 @@ struct TrainConfig {
 
   void Bind(ConfigSchema& s);
   Status Validate() const;
+  // The loss terms' weights and settings (the mask term only when the images have alpha).
+  LossWeights Losses(bool has_alpha) const;
 };
 
 struct RunConfig {

@@ -149,17 +149,7 @@ Result<LossTerms> Trainer::Step() {
   if (state_.step >= t.occupancy_warmup && state_.step % t.occupancy_every == 0)
     model_->UpdateOccupancy(seed, state_.step, executor_);
   data_.SampleBatch(t.batch_rays, seed, state_.step, t.random_background, t.pixel_jitter, &batch_);
-  LossWeights w;
-  w.lambda_id = t.lambda_id;
-  w.lambda_smooth = t.lambda_smooth;
-  w.lambda_mask = data_.has_alpha() ? t.lambda_mask : 0.0;
-  w.lambda_distortion = t.lambda_distortion;
-  w.lambda_occlusion = t.lambda_occlusion;
-  w.lambda_symmetry = t.lambda_symmetry;
-  w.symmetry_colour = t.symmetry_colour;
-  w.symmetry_max_samples = t.symmetry_max_samples;
-  w.smooth_epsilon = t.smooth_epsilon;
-  w.smooth_max_samples = t.smooth_max_samples;
+  const LossWeights w = t.Losses(data_.has_alpha());
   const LossTerms terms = model_->TrainForwardBackward(batch_, w, seed, state_.step, executor_);
   // What is non-finite this step ("" when nothing is).
   std::string nonfinite;
