@@ -9,6 +9,7 @@
 #include "icef/core/rng.h"
 #include "icef/model/avatar_model.h"
 #include "icef/model/model_test_util.h"
+#include "icef/testing/gradient_check.h"
 
 namespace icef {
 namespace {
@@ -134,36 +135,19 @@ TEST(SymmetryLossTest, ModelGradientMatchesFiniteDifferences) {
       EXPECT_EQ(g_on, g_off) << "nerface: lambda_symmetry must not change its gradients";
       continue;
     }
-    ASSERT_GT(t_on.Get("symmetry"), 1e-4) << method;
+    ASSERT_GT(t_on.Get("symmetry"), 1e-4) << method;  // differences at h and h/2: testing/gradient_check.h
     std::vector<double> g(g_on.size());
     for (size_t i = 0; i < g.size(); ++i) g[i] = g_on[i] - g_off[i];
-    std::vector<int64_t> order(g.size());
-    for (size_t i = 0; i < order.size(); ++i) order[i] = int64_t(i);
-    std::partial_sort(order.begin(), order.begin() + 16, order.end(),
-                      [&](int64_t a, int64_t b) { return std::abs(g[a]) > std::abs(g[b]); });
-    ASSERT_GT(std::abs(g[order[0]]), 1e-5) << method;
-    // The hash grid is trilinear, so its position derivative jumps at cell faces: a central difference
-    // whose stencil straddles a face is no derivative at all. Such parameters (where the differences at
-    // h and h/2 disagree) are skipped, and most must remain.
-    auto fd_at = [&](int64_t i, float h) {
-      const float saved = store.params()[i];
-      store.params()[i] = saved + h;
-      const double lp = model.TrainForwardBackward(batch, on, 3, 0, ex).Get("symmetry");
-      store.params()[i] = saved - h;
-      const double lm = model.TrainForwardBackward(batch, on, 3, 0, ex).Get("symmetry");
-      store.params()[i] = saved;
-      return (lp - lm) / (2.0 * (double(saved + h) - double(saved)));
-    };
-    int checked = 0;
-    for (int k = 0; k < 16; ++k) {
-      const int64_t i = order[k];
-      const float h = std::max(1e-3f, 1e-3f * std::abs(store.params()[i]));
-      const double fd = fd_at(i, h), fd_half = fd_at(i, 0.5f * h);
-      if (std::abs(fd - fd_half) > 0.01 * std::abs(fd_half) + 1e-7) continue;
-      ++checked;
-      EXPECT_NEAR(g[i], fd_half, 2e-2 * std::abs(fd_half) + 1e-6) << method << " parameter " << i;
-    }
-    EXPECT_GE(checked, 10) << method;
+    testing::ParameterGradientCheck check;
+    check.top_k = 16;
+    check.rel_tol = 2e-2;
+    check.abs_tol_frac = 0;
+    check.abs_tol = 1e-6;
+    check.min_checked = 10;
+    const auto report = check.Run(store.params(), g, [&] {
+      return model.TrainForwardBackward(batch, on, 3, 0, ex).Get("symmetry");
+    });
+    EXPECT_TRUE(report.ok()) << method << ":\n" << report.failures;
     store.ZeroGrads();
   }
 }

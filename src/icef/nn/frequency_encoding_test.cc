@@ -2,7 +2,7 @@
 
 #include <gtest/gtest.h>
 
-#include "icef/nn/gradient_check_test_util.h"
+#include "icef/testing/gradient_check.h"
 
 namespace icef::nn {
 namespace {

@@ -2,7 +2,7 @@
 
 #include <gtest/gtest.h>
 
-#include "icef/nn/gradient_check_test_util.h"
+#include "icef/testing/gradient_check.h"
 #include "icef/nn/hash_grid.h"
 
 namespace icef::nn {

@@ -4,7 +4,7 @@
 
 #include <cstring>
 
-#include "icef/nn/gradient_check_test_util.h"
+#include "icef/testing/gradient_check.h"
 
 namespace icef::nn {
 namespace {
