@@ -133,12 +133,13 @@ for mode in 2d 3d; do
     grep -qF "$OUT/$f" "$TMP/stdout_$mode" || fail "$f path not printed"
   done
   read -r MX MY NX NY < "$DATA/expect.txt"
-  # The projection is ~1 at the mouth centre, 0 at the nose tip and in the image corner.
+  # The projection is ~1 at the mouth centre, ~0 at the nose tip (the mouth capsule's soft edge,
+  # margin 0.25 + softness 0.08 inter-ocular distances, ends just short of it) and 0 in the corner.
   read -r m _ _ <<< "$(pixel "$OUT/mask_projection_frame1.png" "$MX" "$MY")"
   read -r n _ _ <<< "$(pixel "$OUT/mask_projection_frame1.png" "$NX" "$NY")"
   read -r c _ _ <<< "$(pixel "$OUT/mask_projection_frame1.png" 2 2)"
   [ "$m" -ge 250 ] || fail "mask projection at the mouth is $m, expected ~255"
-  [ "$n" -le 5 ] || fail "mask projection at the nose tip is $n, expected ~0"
+  [ "$n" -le 25 ] || fail "mask projection at the nose tip is $n, expected ~0"
   [ "$c" -eq 0 ] || fail "mask projection in the corner is $c, expected 0"
   # The overlay is red-tinted at the mouth (the skin there is (170, 140, 120)) and untouched in the corner.
   read -r r g b <<< "$(pixel "$OUT/mask_overlay_frame1.png" "$MX" "$MY")"

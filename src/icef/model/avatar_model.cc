@@ -307,7 +307,7 @@ void AvatarModel::Render(std::span<const Ray> rays, std::span<const float> beta,
         ws.extras[2 * i + 1] = Vec3f(ws.offsets[3 * i], ws.offsets[3 * i + 1], ws.offsets[3 * i + 2]).norm();
       }
       march.Composite(ws.samples, ws.sigma.data(), ws.rgb.data(), ws.extras.data(),
-                      static_cast<float>(config_.transmittance_eps), executor);
+                      static_cast<float>(config_.render_transmittance_eps), executor);
       out->samples_evaluated += n;
     }
     for (int64_t r = 0; r < nr; ++r) {

@@ -258,6 +258,7 @@ TEST(AvatarModelTest, RenderEqualsCompositingEverySampleWhileSkippingOccludedOne
     ModelConfig config = TinyModelConfig(method);
     config.density_bias = 4.5f;  // opaque within a few samples along most rays
     config.deform_init_scale = 0.5f;
+    config.render_transmittance_eps = 3e-3;  // renders stop at their own threshold, not training's
     auto created = AvatarModel::Create(config, TinySetup(), Executor(2));
     ASSERT_TRUE(created.ok()) << created.status().message();
     AvatarModel& model = **created;
@@ -293,7 +294,9 @@ TEST(AvatarModelTest, RenderEqualsCompositingEverySampleWhileSkippingOccludedOne
     CompositeInputs<float> in{sigma, rgb, samples.t, samples.dt, samples.ray_offset, samples.ray_count,
                               std::span<const float>(bg, 3)};
     CompositeOutputs<float> ref;
-    CompositeForward(in, config.CompositeOpts(), ex, &ref);
+    CompositeOptions render_eps;
+    render_eps.transmittance_eps = config.render_transmittance_eps;
+    CompositeForward(in, render_eps, ex, &ref);
     int64_t used = 0;
     for (int64_t r = 0; r < samples.num_rays(); ++r) {
       for (int a = 0; a < 3; ++a) ASSERT_NEAR(out.color[3 * r + a], ref.color[3 * r + a], 2e-6) << r;

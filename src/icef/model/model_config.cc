@@ -29,9 +29,13 @@ void ModelConfig::Bind(ConfigSchema& s) {
   s.Int("occupancy_resolution", &occupancy_resolution, "occupancy grid cells per axis");
   s.Float("occupancy_threshold", &occupancy_threshold, "density above which an occupancy cell is occupied");
   s.Float("occupancy_decay", &occupancy_decay, "occupancy EMA-of-max decay per update");
-  s.Number("transmittance_eps", &transmittance_eps, "stop compositing a ray once its transmittance is below this");
+  s.Number("transmittance_eps", &transmittance_eps,
+           "training: stop compositing a ray once its transmittance is below this (renders: render_transmittance_eps)");
   s.Int("render_supersample", &render_supersample,
         "image renders average s x s rays per pixel (anti-aliasing; photos and the synthetic data integrate over the pixel)");
+  s.Number("render_transmittance_eps", &render_transmittance_eps,
+           "renders and evaluation: stop a ray once its transmittance is below this (what is left behind can change "
+           "a pixel by at most this fraction: 1e-2 is at most 2.5/255); training composites to transmittance_eps");
   s.Bool("bf16_inference", &bf16_inference,
          "renders, evaluation and occupancy updates multiply in BF16 with FP32 sums on CPUs with AVX512-BF16 (about 2x "
          "the MLP throughput); training passes are always FP32");
@@ -43,6 +47,8 @@ Status ModelConfig::Validate() const {
   if (hull_margin_px < 0) return Status::Error("hull_margin_px must be >= 0");
   if (hull_min_views < 0) return Status::Error("hull_min_views must be >= 0");
   if (render_supersample < 1 || render_supersample > 8) return Status::Error("render_supersample must be in 1..8");
+  if (!(render_transmittance_eps >= 0.0 && render_transmittance_eps < 1.0))
+    return Status::Error("render_transmittance_eps must be in [0, 1)");
   ICEF_RETURN_IF_ERROR(DeformationOptions().Validate());
   ICEF_RETURN_IF_ERROR(MaskOptions().Validate().WithContext("mask"));
   ICEF_RETURN_IF_ERROR(ConfidenceOpts().Validate().WithContext("kappa_lambda"));

@@ -52,6 +52,7 @@ struct ModelConfig {
   float density_bias = kStatic.density_bias;  // added to the log-density before exp (negative: space starts nearly empty)
   int samples_per_ray = RaySamplerOptions{}.num_samples;  // samples per ray over the ray/aabb interval
   int render_supersample = 2;         // image renders: s x s rays per pixel, averaged
+  double render_transmittance_eps = 1e-2;  // renders and eval: stop a ray once its transmittance is below this
   int occupancy_resolution = kOccupancy.resolution;  // occupancy grid cells per axis
   float occupancy_threshold = kOccupancy.threshold;  // density above which a cell is occupied
   float occupancy_decay = kOccupancy.decay;  // EMA-of-max decay of stored cell densities per update
