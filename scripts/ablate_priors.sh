@@ -39,6 +39,7 @@ done
 variants=(
   "default|all defaults (docs/config.md)|"
   "no-symmetry|left-right symmetry prior off|train.lambda_symmetry=0"
+  "symmetry-4k|symmetry prior on 4096 mirrored samples per step instead of 16384|train.symmetry_max_samples=4096"
   "no-occlusion|occlusion sparsity prior off|train.lambda_occlusion=0"
   "distortion-1e-3|distortion loss weight 1e-3 instead of the default|train.lambda_distortion=0.001"
   "no-distortion|distortion loss off|train.lambda_distortion=0"

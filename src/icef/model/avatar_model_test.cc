@@ -344,15 +344,7 @@ TEST(AvatarModelTest, TrainLossGradientMatchesFiniteDifferences) {
   for (const char* method : {"icef", "nerface"}) {
     auto model = MakeModel(method, 0.05f);
     model->static_field().SetLevelWeights({1.f, 0.8f, 0.4f, 0.1f});  // coarse-to-fine scaling too
-    TrainRays batch;
-    Rng rng(5, StreamId("batch"));
-    for (int r = 0; r < 24; ++r) {
-      const Vec3f o(static_cast<float>(rng.Uniform(-0.2, 0.2)), static_cast<float>(rng.Uniform(-0.2, 0.2)), 2.f);
-      batch.rays.push_back(Ray{o, Vec3f(0, 0, -1)});
-      batch.frame.push_back(r % 3);
-      for (int a = 0; a < 3; ++a) batch.target_rgb.push_back(static_cast<float>(rng.Uniform()));
-      batch.target_alpha.push_back(static_cast<float>(rng.Uniform()));
-    }
+    const TrainRays batch = testing_model::RandomBatch(24, 5);
     LossWeights w;
     w.lambda_id = 0.5;
     w.lambda_mask = 0.2;

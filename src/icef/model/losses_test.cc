@@ -42,18 +42,7 @@ std::unique_ptr<AvatarModel> MakeModel(const std::string& method, bool coarse = 
   return std::move(model).value();
 }
 
-TrainRays Batch(bool alpha) {
-  TrainRays batch;
-  Rng rng(5, StreamId("batch"));
-  for (int r = 0; r < 24; ++r) {
-    const Vec3f o(static_cast<float>(rng.Uniform(-0.2, 0.2)), static_cast<float>(rng.Uniform(-0.2, 0.2)), 2.f);
-    batch.rays.push_back(Ray{o, Vec3f(0, 0, -1)});
-    batch.frame.push_back(r % 3);
-    for (int a = 0; a < 3; ++a) batch.target_rgb.push_back(static_cast<float>(rng.Uniform()));
-    if (alpha) batch.target_alpha.push_back(static_cast<float>(rng.Uniform()));
-  }
-  return batch;
-}
+TrainRays Batch(bool alpha) { return testing_model::RandomBatch(24, 5, alpha); }
 
 LossWeights AllOn() {
   LossWeights w;

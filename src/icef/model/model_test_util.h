@@ -3,6 +3,8 @@
 
 #include <vector>
 
+#include "icef/core/rng.h"
+
 #include "icef/model/avatar_model.h"
 
 namespace icef::testing_model {
@@ -70,6 +72,21 @@ inline ModelSetup TinySetup(int expression_dim = 3) {
     s.training_cameras.push_back(Camera::LookAt(in, Vec3d(0.5 * (k - 1), 0, 2), Vec3d::Zero()));
   }
   return s;
+}
+
+// `rays` training rays along -z through random points of [-0.2, 0.2] x [y_lo, 0.2], frames
+// cycling over the 3 training frames, random targets (and alpha targets when `alpha`).
+inline TrainRays RandomBatch(int rays, uint64_t seed, bool alpha = true, double y_lo = -0.2) {
+  TrainRays batch;
+  Rng rng(seed, StreamId("batch"));
+  for (int r = 0; r < rays; ++r) {
+    const Vec3f o(static_cast<float>(rng.Uniform(-0.2, 0.2)), static_cast<float>(rng.Uniform(y_lo, 0.2)), 2.f);
+    batch.rays.push_back(Ray{o, Vec3f(0, 0, -1)});
+    batch.frame.push_back(r % 3);
+    for (int a = 0; a < 3; ++a) batch.target_rgb.push_back(static_cast<float>(rng.Uniform()));
+    if (alpha) batch.target_alpha.push_back(static_cast<float>(rng.Uniform()));
+  }
+  return batch;
 }
 
 }  // namespace icef::testing_model

@@ -69,18 +69,7 @@ void ZeroResidual(AvatarModel& model) {
       for (float& v : store.params(b)) v = 0.f;
 }
 
-TrainRays Batch(int rays, uint64_t seed) {
-  TrainRays batch;
-  Rng rng(seed, StreamId("batch"));
-  for (int r = 0; r < rays; ++r) {
-    const Vec3f o(static_cast<float>(rng.Uniform(-0.2, 0.2)), static_cast<float>(rng.Uniform(-0.3, 0.2)), 2.f);
-    batch.rays.push_back(Ray{o, Vec3f(0, 0, -1)});
-    batch.frame.push_back(r % 3);
-    for (int a = 0; a < 3; ++a) batch.target_rgb.push_back(static_cast<float>(rng.Uniform()));
-    batch.target_alpha.push_back(static_cast<float>(rng.Uniform()));
-  }
-  return batch;
-}
+TrainRays Batch(int rays, uint64_t seed) { return testing_model::RandomBatch(rays, seed, true, -0.3); }
 
 TEST(PriorGuidedTest, MethodsAndTraits) {
   EXPECT_TRUE(TraitsOf(Method::kIcefPrior).prior);
