@@ -36,7 +36,7 @@ CommandFn RegisterRender(CLI::App& app) {
   app.add_option("--threads", o->threads, "Worker threads (0 = all cores)")->check(CLI::NonNegativeNumber);
   app.add_option("--set", o->overrides,
                  "Override an inference-only model key, model.KEY=VALUE with KEY render_supersample, samples_per_ray, "
-                 "transmittance_eps or bf16_inference (repeatable; keys fixed by training are refused)");
+                 "render_transmittance_eps or bf16_inference (repeatable; keys fixed by training are refused)");
   return [=]() -> Status {
     RenderAppOptions opts = *o;
     if (!frame->empty()) opts.frame = *frame;

@@ -36,8 +36,8 @@ Result<int64_t> ParseCheckpointStep(const std::string& trainer_text, const std::
 }
 
 const std::vector<std::string>& InferenceModelKeys() {
-  static const std::vector<std::string> keys = {"render_supersample", "samples_per_ray", "transmittance_eps",
-                                                "bf16_inference"};
+  static const std::vector<std::string> keys = {"render_supersample", "samples_per_ray",
+                                                "render_transmittance_eps", "bf16_inference"};
   return keys;
 }
 
@@ -52,7 +52,7 @@ Status ApplyInferenceOverride(const std::string& assignment, ModelConfig* config
       probe.Bind(schema);
       const std::vector<std::string> keys = schema.Keys();
       if (std::find(keys.begin(), keys.end(), o.key) != keys.end())
-        why = "it sets the architecture or parameters the model was trained with";
+        why = "fixed when the model was trained";
       else
         why = "no such model key";
     }

@@ -47,7 +47,7 @@ Result<int64_t> ParseCheckpointStep(const std::string& trainer_text, const std::
                                     const std::string& origin);
 
 // The model keys that change how a trained model is rendered but not its architecture or
-// parameters: render_supersample, samples_per_ray, transmittance_eps, bf16_inference.
+// parameters: render_supersample, samples_per_ray, render_transmittance_eps, bf16_inference.
 const std::vector<std::string>& InferenceModelKeys();
 
 // Applies one "model.KEY=VALUE" override of an inference-only key (VALUE as for `icef train

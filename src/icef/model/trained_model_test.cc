@@ -152,11 +152,11 @@ TEST(TrainedModel, InferenceOverridesChangeTheLoadedConfig) {
   const fs::path path = WriteTinyCheckpoint("trained_model_override");
   Result<TrainedModel> loaded = LoadTrainedModel(
       path, Executor(1),
-      {"model.render_supersample=3", "model.transmittance_eps=0.001", "model.bf16_inference=false",
+      {"model.render_supersample=3", "model.render_transmittance_eps=0.001", "model.bf16_inference=false",
        "model.samples_per_ray=24"});
   ASSERT_TRUE(loaded.ok()) << loaded.status().message();
   EXPECT_EQ(loaded->config.render_supersample, 3);
-  EXPECT_EQ(loaded->config.transmittance_eps, 0.001);
+  EXPECT_EQ(loaded->config.render_transmittance_eps, 0.001);
   EXPECT_FALSE(loaded->config.bf16_inference);
   EXPECT_EQ(loaded->config.samples_per_ray, 24);
   EXPECT_EQ(loaded->model->config().render_supersample, 3);  // the model is built from it
