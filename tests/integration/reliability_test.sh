@@ -173,7 +173,8 @@ an error naming the file).
 Related guarantees tested elsewhere: checkpoints are written to a temporary file, flushed and
 renamed (`io/atomic_file`), carry a format version, the config hash and an FNV-1a checksum, and a
 truncated or bit-flipped file is refused (`io/checkpoint_test`, rows above); the trainer state's
-step range and the config hash are checked on load (`train/model_io_test`);
+step range and the config hash are checked on load (`train/model_io_test`; for inference loads,
+`model/trained_model_test`, with damaged files, other format versions and missing sections);
 `tests/integration/kill_test.sh` kills training with SIGKILL at random moments and checks that the
 checkpoint always loads and `--resume` continues; `src/icef/train/nan_guard_test.cc` checks that a
 non-finite loss stops training with the step and the term named and the previous checkpoint intact

@@ -9,7 +9,7 @@
 #include "icef/io/atomic_file.h"
 #include "icef/io/gif_writer.h"
 #include "icef/model/render_image.h"
-#include "icef/train/model_io.h"
+#include "icef/model/trained_model.h"
 
 namespace icef {
 
@@ -113,7 +113,7 @@ Image ToRgb(const Image& scalar) {
 
 Result<std::vector<RenderedFrameInfo>> RunRender(const RenderAppOptions& o, std::ostream& out) {
   const Executor executor(o.threads);
-  ICEF_ASSIGN_OR_RETURN(LoadedModel loaded, LoadModel(o.model, executor));
+  ICEF_ASSIGN_OR_RETURN(const TrainedModel loaded, LoadTrainedModel(o.model, executor, o.overrides));
   const AvatarModel& model = *loaded.model;
   const ModelSetup& setup = model.setup();
   std::optional<Dataset> dataset;
@@ -231,7 +231,7 @@ Result<std::vector<RenderedFrameInfo>> RunRender(const RenderAppOptions& o, std:
   }
   Json doc;
   doc["model"] = o.model.string();
-  doc["method"] = loaded.config.model.method;
+  doc["method"] = loaded.config.method;
   doc["frames"] = frames;
   ICEF_RETURN_IF_ERROR(WriteFileAtomic(o.out / "frames.json", FormatJson(doc)));
   if (n > 1) {

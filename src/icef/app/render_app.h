@@ -6,7 +6,8 @@
 // ("jaw_open=0.8", starting from neutral), or a sweep from neutral to a target and beyond. The
 // number of output frames is the larger of the camera and expression counts (a single camera or
 // expression is repeated). Per frame it writes color, depth, mask and deformation PNGs; sequences
-// also get animated GIFs; frames.json lists delta, kappa and beta_n of every frame.
+// also get animated GIFs; frames.json lists delta, kappa and beta_n of every frame. Inference-only
+// model keys (render_supersample, ...) may be overridden with "model.KEY=VALUE".
 #pragma once
 
 #include <filesystem>
@@ -39,6 +40,7 @@ struct RenderAppOptions {
   double sweep_beyond = 1.5;                         // the sweep ends at this multiple of the target
   int gif_delay_cs = 8;                              // GIF frame delay (1/100 s)
   int threads = 0;                                   // worker threads (0 = all cores)
+  std::vector<std::string> overrides;                // "model.KEY=VALUE" of inference-only keys (model/trained_model.h)
 };
 
 struct RenderedFrameInfo {

@@ -1,14 +1,14 @@
 // icef bench --out DIR [--identities N] [--k 3,5,10] [--methods a,b] [--res R] [--steps S |
 //   --time-budget T] [--quick] [--validation] [--shard i/n] [--threads N] [--set section.key=value ...]
 // icef bench merge DIR... --out DIR   (or icef bench --merge DIR... --out DIR)
-// The whole evaluation protocol (eval/bench_protocol.h): synthesise, train, evaluate every
-// identity x K x method, then report.md + report.json + plots.
+// app/bench_app.h (merge: eval::MergeBench).
 #include <filesystem>
 #include <iostream>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "icef/app/bench_app.h"
 #include "icef/cli/commands.h"
 #include "icef/core/progress.h"
 #include "icef/eval/bench_protocol.h"
@@ -17,13 +17,8 @@ namespace icef::cli {
 
 CommandFn RegisterBench(CLI::App& app) {
   struct Args {
-    eval::BenchOptions options;
-    std::string out;
-    std::string ks;
-    std::vector<std::string> methods;
-    std::string shard;
-    bool quick = false;
-    bool validation = false;
+    BenchAppOptions app;
+    eval::BenchOptions options;  // bound to the options that win over --quick / --validation when given
     std::vector<std::string> merge;
     std::vector<std::string> merge_inputs;
     std::string merge_out;
@@ -35,12 +30,12 @@ CommandFn RegisterBench(CLI::App& app) {
       "with the same budget, evaluate, and write DIR/runs/<id>_k<K>_<method>/metrics.json; then DIR/report.md, "
       "report.json and plots/. Re-running skips finished runs. `icef bench merge A B --out C` builds one "
       "report from shard directories.");
-  app.add_option("--out,-o", args->out, "Output directory (created)");
+  app.add_option("--out,-o", args->app.out, "Output directory (created)");
   app.add_option("--identities", o.identities, "Number of identities (test seeds 1..N; with --validation 6, seeds 101..106)")
       ->capture_default_str();
   app.add_option("--first-seed", o.first_identity_seed, "Seed of the first identity")->capture_default_str();
-  app.add_option("--k", args->ks, "Training-frame counts K, comma-separated (default 3,5,10)");
-  app.add_option("--methods", args->methods, "Methods (default: all seven: icef-prior, warp-prior, icef, icef-no-conf, icef-uniform, warp, nerface)")->delimiter(',');
+  app.add_option("--k", args->app.ks, "Training-frame counts K, comma-separated (default 3,5,10)");
+  app.add_option("--methods", args->app.methods, "Methods (default: all seven: icef-prior, warp-prior, icef, icef-no-conf, icef-uniform, warp, nerface)")->delimiter(',');
   app.add_option("--res", o.resolution, "Image width = height")->capture_default_str();
   app.add_option("--test-views", o.test_views, "Held-out test views per dataset")->capture_default_str();
   app.add_option("--novel-per-tier", o.novel_per_tier, "Novel test expressions per tier")->capture_default_str();
@@ -49,12 +44,12 @@ CommandFn RegisterBench(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--config", o.config_path, "Base run config file (default: built-in defaults)");
   app.add_option("--set", o.overrides, "Config override for every run, e.g. train.batch_rays=2048 (repeatable)");
-  app.add_flag("--quick", args->quick, "Tiny settings for CI: 1 identity, K=3, 32x32, 20 steps of a tiny model");
-  app.add_flag("--validation", args->validation,
+  app.add_flag("--quick", args->app.quick, "Tiny settings for CI: 1 identity, K=3, 32x32, 20 steps of a tiny model");
+  app.add_flag("--validation", args->app.validation,
                "Validation bench: validation identities (seeds 101 and up, 6 by default) at K=5, for tuning and "
                "prior experiments. Without it the identities are test seeds (below 101), which are only reported, "
                "never tuned on");
-  app.add_option("--shard", args->shard, "Run only shard i of n (i/n, 0-based): runs i, i+n, ... of the stable order");
+  app.add_option("--shard", args->app.shard, "Run only shard i of n (i/n, 0-based): runs i, i+n, ... of the stable order");
   app.add_option("--threads", o.threads, "Worker threads (0 = all cores)")->capture_default_str();
   app.add_option("--faceid-model", o.faceid_model_dir, "Face-identity model directory");
   app.add_option("--lpips-weights", o.lpips_weights, "LPIPS weights file (without it LPIPS is null)");
@@ -69,40 +64,22 @@ CommandFn RegisterBench(CLI::App& app) {
     if (merge->parsed() || !args->merge.empty()) {
       std::vector<std::filesystem::path> inputs;
       for (const auto& d : merge->parsed() ? args->merge_inputs : args->merge) inputs.emplace_back(d);
-      const std::string out = merge->parsed() ? args->merge_out : args->out;
+      const std::string out = merge->parsed() ? args->merge_out : args->app.out.string();
       if (out.empty()) return Status::Error("bench merge: --out is required");
       return eval::MergeBench(inputs, out, std::cout);
     }
-    eval::BenchOptions options = args->options;
-    if (args->validation) {
-      options.ApplyValidation();
-      // Options given explicitly win over the validation settings.
-      if (self->count("--identities")) options.identities = args->options.identities;
-      if (self->count("--first-seed")) options.first_identity_seed = args->options.first_identity_seed;
-    }
-    if (args->quick) {
-      const std::vector<std::string> user = options.overrides;
-      options.overrides.clear();
-      options.ApplyQuick();
-      // Options given explicitly win over the quick settings.
-      const eval::BenchOptions& given = args->options;
-      if (self->count("--identities")) options.identities = given.identities;
-      if (self->count("--res")) options.resolution = given.resolution;
-      if (self->count("--test-views")) options.test_views = given.test_views;
-      if (self->count("--novel-per-tier")) options.novel_per_tier = given.novel_per_tier;
-      if (self->count("--steps")) options.steps = given.steps;
-      if (self->count("--time-budget")) options.time_budget_seconds = given.time_budget_seconds;
-      options.overrides.insert(options.overrides.end(), user.begin(), user.end());
-    }
-    // --steps alone is a pure step budget (reproducible); the default caps steps by time.
-    if (self->count("--steps") && !self->count("--time-budget")) options.time_budget_seconds = 0;
-    options.out_dir = args->out;
-    if (!args->ks.empty()) {
-      ICEF_ASSIGN_OR_RETURN(options.ks, eval::ParseIntList(args->ks, "--k"));
-    }
-    if (!args->methods.empty()) options.methods = args->methods;
-    if (!args->shard.empty()) ICEF_RETURN_IF_ERROR(eval::ParseShard(args->shard, &options.shard_index, &options.shard_count));
-    return eval::RunBench(options, std::cout, interactive);
+    BenchAppOptions options = args->app;
+    const eval::BenchOptions& given = args->options;
+    options.base = given;
+    if (self->count("--identities")) options.identities = given.identities;
+    if (self->count("--first-seed")) options.first_seed = given.first_identity_seed;
+    if (self->count("--res")) options.resolution = given.resolution;
+    if (self->count("--test-views")) options.test_views = given.test_views;
+    if (self->count("--novel-per-tier")) options.novel_per_tier = given.novel_per_tier;
+    if (self->count("--steps")) options.steps = given.steps;
+    if (self->count("--time-budget")) options.time_budget = given.time_budget_seconds;
+    options.interactive = interactive;
+    return RunBench(options, std::cout);
   };
 }
 

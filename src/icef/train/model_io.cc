@@ -1,6 +1,5 @@
 #include "icef/train/model_io.h"
 
-#include <cstring>
 #include <sstream>
 
 #include "icef/io/checkpoint.h"
@@ -41,29 +40,20 @@ Status SaveCheckpoint(const fs::path& path, const RunConfig& config, const Avata
 
 Result<TrainerState> ParseTrainerSection(const std::string& trainer_text, const std::string& config_text,
                                          const std::string& origin) {
+  TrainerState state;
+  ICEF_ASSIGN_OR_RETURN(state.step, ParseCheckpointStep(trainer_text, config_text, origin));
   ICEF_ASSIGN_OR_RETURN(const Json json, ParseJson(trainer_text, origin + " [trainer]"));
   ICEF_ASSIGN_OR_RETURN(const JsonObjectView tv, JsonObjectView::Make(json, origin, "trainer"));
-  TrainerState state;
-  ICEF_ASSIGN_OR_RETURN(state.step, tv.Int64("step", 0, kMaxCheckpointStep));
   ICEF_ASSIGN_OR_RETURN(state.elapsed_seconds, tv.Number("elapsed_seconds"));
   if (state.elapsed_seconds < 0) return tv.Error("elapsed_seconds", "must be >= 0, got " + json["elapsed_seconds"].dump());
   if (tv.Has("skipped_steps")) {
     ICEF_ASSIGN_OR_RETURN(state.skipped_steps, tv.Int64("skipped_steps", 0, state.step));
   }
-  // The hash covers the config section exactly as written, so a checkpoint whose config was
-  // edited (or whose sections come from different runs) is refused.
-  ICEF_ASSIGN_OR_RETURN(const uint64_t stored_hash, tv.Uint64("config_hash"));
-  if (stored_hash != Fnv1a64(config_text))
-    return tv.Error("config_hash", "does not match the checkpoint's config section (the config or the trainer state "
-                                   "was altered after the checkpoint was written)");
   return state;
 }
 
 Result<LoadedModel> LoadModel(const fs::path& given, const Executor& executor) {
-  std::error_code ec;
-  const fs::path path = fs::is_directory(given, ec) ? given / kCheckpointFile : given;
-  if (!fs::exists(path, ec))
-    return Status::Error(path.string() + ": no checkpoint here (train a model with `icef train` first)");
+  ICEF_ASSIGN_OR_RETURN(const fs::path path, ResolveCheckpointPath(given));
   ICEF_ASSIGN_OR_RETURN(const Checkpoint ckpt, Checkpoint::Read(path));
   const std::string origin = path.string();
   LoadedModel out;
@@ -72,27 +62,12 @@ Result<LoadedModel> LoadModel(const fs::path& given, const Executor& executor) {
   ICEF_ASSIGN_OR_RETURN(out.state, ParseTrainerSection(trainer_text, config_text, origin));
   ICEF_ASSIGN_OR_RETURN(const Json config_json, ParseJson(config_text, origin + " [config]"));
   ICEF_ASSIGN_OR_RETURN(out.config, RunConfig::FromJson(config_json, origin + " [config]"));
-  ICEF_ASSIGN_OR_RETURN(const std::string setup_text, ckpt.Section("setup"));
-  ICEF_ASSIGN_OR_RETURN(const Json setup_json, ParseJson(setup_text, origin + " [setup]"));
-  ICEF_ASSIGN_OR_RETURN(const ModelSetup setup, ModelSetup::FromJson(setup_json, origin + " [setup]"));
-  ICEF_ASSIGN_OR_RETURN(out.model, AvatarModel::Create(out.config.model, setup, executor));
-  ICEF_ASSIGN_OR_RETURN(const std::string params, ckpt.Section("params"));
-  std::istringstream params_in(params);
-  ICEF_RETURN_IF_ERROR(out.model->store().Read(params_in).WithContext(origin + " [params]"));
-  ICEF_ASSIGN_OR_RETURN(std::string occ, ckpt.Section("occupancy"));
-  if (occ.size() % sizeof(float) != 0) return Status::Error(origin + " [occupancy]: size is not a whole number of floats");
-  std::vector<float> densities(occ.size() / sizeof(float));
-  if (!occ.empty()) std::memcpy(densities.data(), occ.data(), occ.size());  // never memcpy(nullptr, ...)
-  ICEF_RETURN_IF_ERROR(out.model->occupancy().SetDensities(std::move(densities)).WithContext(origin + " [occupancy]"));
-  ICEF_ASSIGN_OR_RETURN(const std::string allowed, ckpt.Section("occupancy_allowed"));
-  ICEF_RETURN_IF_ERROR(out.model->occupancy()
-                           .SetAllowed(std::vector<uint8_t>(allowed.begin(), allowed.end()))
-                           .WithContext(origin + " [occupancy_allowed]"));
+  // The model, as inference loads it (with the coarse-to-fine state of out.state.step).
+  ICEF_ASSIGN_OR_RETURN(TrainedModel trained, LoadTrainedModel(ckpt, origin, executor));
+  out.model = std::move(trained.model);
   if (ckpt.Has("adam")) {
     ICEF_ASSIGN_OR_RETURN(out.adam_state, ckpt.Section("adam"));
   }
-  if (DeformationField* d = out.model->residual_field()) d->SetAnnealing(DeformationAnnealing(out.config, out.state.step));
-  out.model->static_field().SetLevelWeights(GridLevelWeights(out.config, out.state.step));
   if (ckpt.Has("log")) {
     ICEF_ASSIGN_OR_RETURN(const std::string log, ckpt.Section("log"));
     std::istringstream in(log);

@@ -5,7 +5,9 @@
 //   config.json       the effective run config (also inside the checkpoint)
 //   summary.json      written when training ends
 //   train_log.jsonl   one JSON line per logged step
-// Rendering and evaluation rebuild everything from checkpoint.icef alone.
+// Rendering and evaluation rebuild everything from checkpoint.icef alone, through
+// model/trained_model.h (the model without the optimiser and trainer state); LoadModel here builds
+// on it for training and --resume.
 #pragma once
 
 #include <filesystem>
@@ -14,12 +16,11 @@
 
 #include "icef/io/json_util.h"
 #include "icef/model/avatar_model.h"
+#include "icef/model/trained_model.h"
 #include "icef/nn/adam.h"
 #include "icef/train/train_config.h"
 
 namespace icef {
-
-inline constexpr const char* kCheckpointFile = "checkpoint.icef";
 
 struct TrainerState {
   int64_t step = 0;              // completed optimiser steps
@@ -27,9 +28,6 @@ struct TrainerState {
   int64_t skipped_steps = 0;     // steps skipped for a non-finite loss or gradient (train.on_nonfinite = skip)
   std::vector<std::string> log;  // train_log.jsonl lines so far
 };
-
-// Largest step count a checkpoint may hold (exact in a double, far beyond any real run).
-inline constexpr int64_t kMaxCheckpointStep = int64_t(1) << 53;
 
 Status SaveCheckpoint(const std::filesystem::path& path, const RunConfig& config, const AvatarModel& model,
                       const nn::Adam* adam, const TrainerState& state);
@@ -43,13 +41,16 @@ struct LoadedModel {
 
 // The checkpoint's "trainer" section: step (an integer in [0, kMaxCheckpointStep]), elapsed_seconds
 // (finite, >= 0), skipped_steps (optional, in [0, step]) and config_hash, which must equal the hash
-// of `config_text`, the checkpoint's "config" section, byte for byte as stored. Errors name
-// `origin` and the field ("model/checkpoint.icef: trainer.step: ...").
+// of `config_text`, the checkpoint's "config" section, byte for byte as stored (step and
+// config_hash: model/trained_model.h's ParseCheckpointStep). Errors name `origin` and the field
+// ("model/checkpoint.icef: trainer.step: ...").
 Result<TrainerState> ParseTrainerSection(const std::string& trainer_text, const std::string& config_text,
                                          const std::string& origin);
 
-// Reads a checkpoint file, or MODEL_DIR/checkpoint.icef when given a directory. Errors name the
-// file and what is wrong (corrupt, truncated, from another version, missing section).
+// Reads a checkpoint file, or MODEL_DIR/checkpoint.icef when given a directory: the whole run config,
+// the trainer state, the Adam state and the model (LoadTrainedModel). Errors name the file and what
+// is wrong (corrupt, truncated, from another version, missing section). Inference needs only
+// LoadTrainedModel.
 Result<LoadedModel> LoadModel(const std::filesystem::path& path, const Executor& executor);
 
 }  // namespace icef

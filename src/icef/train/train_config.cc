@@ -5,6 +5,7 @@
 #include <set>
 
 #include "icef/io/checkpoint.h"
+#include "icef/io/config_override.h"
 
 namespace icef {
 
@@ -150,16 +151,9 @@ Result<RunConfig> RunConfig::FromFile(const std::filesystem::path& path) {
 }
 
 Status RunConfig::ApplyOverride(const std::string& assignment) {
-  const size_t eq = assignment.find('=');
-  const size_t dot = assignment.find('.');
-  if (eq == std::string::npos || dot == std::string::npos || dot > eq)
-    return Status::Error("--set '" + assignment + "': expected SECTION.KEY=VALUE, e.g. train.steps=500");
-  const std::string section = assignment.substr(0, dot), key = assignment.substr(dot + 1, eq - dot - 1);
-  const std::string text = assignment.substr(eq + 1);
-  Json value = Json::parse(text, nullptr, /*allow_exceptions=*/false);
-  if (value.is_discarded()) value = text;
+  ICEF_ASSIGN_OR_RETURN(const ConfigOverride o, ParseConfigOverride(assignment));
   Json patch;
-  patch[section][key] = value;
+  patch[o.section][o.key] = o.value;
   std::set<std::string> visited;
   RunConfig updated = *this;
   ICEF_RETURN_IF_ERROR(ApplyJson(patch, "--set " + assignment, ".", &visited, &updated));
@@ -171,22 +165,11 @@ Status RunConfig::ApplyOverride(const std::string& assignment) {
 uint64_t RunConfig::Hash() const { return Fnv1a64(ToJson().dump()); }
 
 double DeformationAnnealing(const RunConfig& config, int64_t step) {
-  const double n = config.model.deform_frequencies;
-  const int anneal = config.train.anneal_steps;
-  return anneal > 0 ? std::min(n, n * double(step) / anneal) : n;
+  return DeformationAnnealing(config.model, config.train.anneal_steps, step);
 }
 
 std::vector<float> GridLevelWeights(const RunConfig& config, int64_t step) {
-  const int levels = config.model.grid_levels, anneal = config.train.grid_anneal_steps;
-  std::vector<float> w(levels, 1.f);
-  if (anneal <= 0 || step >= anneal) return w;
-  constexpr double kFirst = 4;  // levels on from the start
-  const double alpha = kFirst + (levels - kFirst) * double(step) / anneal;
-  for (int l = 0; l < levels; ++l) {
-    const double x = std::clamp(alpha - l, 0.0, 1.0);
-    w[l] = static_cast<float>(0.5 * (1.0 - std::cos(M_PI * x)));
-  }
-  return w;
+  return GridLevelWeights(config.model, config.train.grid_anneal_steps, step);
 }
 
 std::string ConfigDocumentation() {

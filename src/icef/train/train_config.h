@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "icef/io/config_schema.h"
+#include "icef/model/coarse_to_fine.h"
 #include "icef/model/losses.h"
 #include "icef/model/model_config.h"
 
@@ -34,8 +35,8 @@ struct TrainConfig {
   int symmetry_max_samples = LossWeights{}.symmetry_max_samples;  // samples per step mirrored by L_sym
   bool pixel_jitter = true;          // training rays through random points of their pixels
   bool random_background = true;     // train over random background colours (images with alpha only)
-  int grid_anneal_steps = 0;         // coarse-to-fine hash grid: levels beyond the 4 coarsest switch on over these steps (0 = off)
-  int anneal_steps = 500;            // coarse-to-fine: deformation frequencies are switched on over these steps (0 = off)
+  int grid_anneal_steps = kDefaultGridAnnealSteps;  // coarse-to-fine hash grid: levels beyond the 4 coarsest switch on over these steps (0 = off)
+  int anneal_steps = kDefaultAnnealSteps;  // coarse-to-fine: deformation frequencies are switched on over these steps (0 = off)
   int occupancy_warmup = 256;        // steps before the occupancy grid starts skipping empty space
   int occupancy_every = 16;          // steps between occupancy grid updates
   int checkpoint_every = 500;        // steps between checkpoints (0 = only at the end)
@@ -68,7 +69,8 @@ struct RunConfig {
 };
 
 // The deformation encoding's coarse-to-fine parameter alpha after `step` steps (all frequencies
-// on once step >= train.anneal_steps). Training and every later render use the same value.
+// on once step >= train.anneal_steps; model/coarse_to_fine.h). Training and every later render use
+// the same value.
 double DeformationAnnealing(const RunConfig& config, int64_t step);
 
 // Per-level weights of the static field's hash grid after `step` steps (coarse-to-fine; all ones

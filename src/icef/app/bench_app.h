@@ -1,0 +1,46 @@
+// `icef bench --out DIR ...`: the whole evaluation protocol (eval/bench_protocol.h): synthesise,
+// train and evaluate every identity x K x method, then report.md, report.json and plots. This
+// resolves the command's options into eval::BenchOptions: the defaults, then --validation, then
+// --quick, with the options given explicitly winning over both.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "icef/core/status.h"
+#include "icef/eval/bench_protocol.h"
+
+namespace icef {
+
+struct BenchAppOptions {
+  eval::BenchOptions base;    // config, overrides, threads, faceid / LPIPS, keep_models (the rest is below)
+  std::filesystem::path out;  // output directory
+  std::optional<int> identities;       // number of identities (wins over --quick / --validation)
+  std::optional<uint64_t> first_seed;  // seed of the first identity (wins over --validation)
+  std::optional<int> resolution;       // image width = height (wins over --quick)
+  std::optional<int> test_views;       // held-out test views per dataset (wins over --quick)
+  std::optional<int> novel_per_tier;   // novel test expressions per tier (wins over --quick)
+  std::optional<int64_t> steps;        // training steps per run; alone, it drops the time cap
+  std::optional<double> time_budget;   // training wall-clock cap per run, seconds (0 = none)
+  std::string ks;                      // training-frame counts, comma-separated (empty: the default)
+  std::vector<std::string> methods;    // methods (empty: the default, all seven)
+  std::string shard;                   // "i/n": run only shard i of n (empty: all runs)
+  bool quick = false;                  // tiny settings for CI (eval::BenchOptions::ApplyQuick)
+  bool validation = false;             // validation identities (eval::BenchOptions::ApplyValidation)
+  bool interactive = false;            // redraw progress bars in place (stdout is a terminal)
+
+  // The resolved options' check (eval::BenchOptions::Validate); errors name the option.
+  Status Validate() const;
+};
+
+// The bench the options describe (validated by eval::RunBench).
+Result<eval::BenchOptions> ResolveBenchOptions(const BenchAppOptions& options);
+
+// Resolves and runs the bench, logging on `out`.
+Status RunBench(const BenchAppOptions& options, std::ostream& out);
+
+}  // namespace icef

@@ -1,0 +1,80 @@
+// ResolveBenchOptions: the defaults, then --validation, then --quick, with the options given
+// explicitly winning over both; --steps alone drops the time cap.
+#include "icef/app/bench_app.h"
+
+#include <gtest/gtest.h>
+
+namespace icef {
+namespace {
+
+TEST(BenchApp, DefaultsPassThrough) {
+  BenchAppOptions a;
+  a.out = "b";
+  const Result<eval::BenchOptions> o = ResolveBenchOptions(a);
+  ASSERT_TRUE(o.ok()) << o.status().message();
+  const eval::BenchOptions d;
+  EXPECT_EQ(o->out_dir, "b");
+  EXPECT_EQ(o->identities, d.identities);
+  EXPECT_EQ(o->ks, d.ks);
+  EXPECT_EQ(o->steps, d.steps);
+  EXPECT_EQ(o->time_budget_seconds, d.time_budget_seconds);
+  EXPECT_TRUE(a.Validate().ok()) << a.Validate().message();
+}
+
+TEST(BenchApp, QuickSettingsLoseToExplicitOptions) {
+  BenchAppOptions a;
+  a.out = "b";
+  a.quick = true;
+  a.resolution = 48;
+  a.base.overrides = {"train.lambda_id=0.5"};
+  const Result<eval::BenchOptions> o = ResolveBenchOptions(a);
+  ASSERT_TRUE(o.ok()) << o.status().message();
+  EXPECT_EQ(o->identities, 1);
+  EXPECT_EQ(o->ks, std::vector<int>{3});
+  EXPECT_EQ(o->resolution, 48);  // given
+  EXPECT_EQ(o->steps, 20);
+  EXPECT_EQ(o->time_budget_seconds, 0);
+  ASSERT_FALSE(o->overrides.empty());
+  EXPECT_EQ(o->overrides.back(), "train.lambda_id=0.5");  // the user's come after the quick ones
+  EXPECT_GT(o->overrides.size(), 1u);
+}
+
+TEST(BenchApp, ValidationSettingsLoseToExplicitOptions) {
+  BenchAppOptions a;
+  a.out = "b";
+  a.validation = true;
+  a.identities = 2;
+  a.ks = "3,10";
+  const Result<eval::BenchOptions> o = ResolveBenchOptions(a);
+  ASSERT_TRUE(o.ok()) << o.status().message();
+  EXPECT_TRUE(o->validation);
+  EXPECT_EQ(o->identities, 2);
+  EXPECT_EQ(o->first_identity_seed, eval::kFirstValidationSeed);
+  EXPECT_EQ(o->ks, (std::vector<int>{3, 10}));
+}
+
+TEST(BenchApp, StepsAloneDropTheTimeCap) {
+  BenchAppOptions a;
+  a.out = "b";
+  a.steps = 50;
+  EXPECT_EQ(ResolveBenchOptions(a)->time_budget_seconds, 0);
+  a.time_budget = 30;
+  EXPECT_EQ(ResolveBenchOptions(a)->time_budget_seconds, 30);
+}
+
+TEST(BenchApp, BadListsAndShardsNameTheOption) {
+  BenchAppOptions a;
+  a.out = "b";
+  a.ks = "3,x";
+  EXPECT_NE(ResolveBenchOptions(a).status().message().find("--k"), std::string::npos)
+      << ResolveBenchOptions(a).status().message();
+  a.ks.clear();
+  a.shard = "3/2";
+  EXPECT_FALSE(ResolveBenchOptions(a).ok());
+  a.shard.clear();
+  a.out.clear();
+  EXPECT_NE(a.Validate().message().find("--out"), std::string::npos) << a.Validate().message();
+}
+
+}  // namespace
+}  // namespace icef

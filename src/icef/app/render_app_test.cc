@@ -1,0 +1,50 @@
+// RunRender with --set overrides: inference-only model keys change the render, keys fixed by
+// training are refused before anything is written.
+#include "icef/app/render_app.h"
+
+#include <gtest/gtest.h>
+
+#include <sstream>
+
+#include "icef/app/app_test_util.h"
+#include "icef/io/image.h"
+
+namespace icef {
+namespace {
+
+namespace fs = std::filesystem;
+
+TEST(RenderApp, InferenceOverrideApplies) {
+  const fs::path dir = testing::MakeTempDir("render_app_override");
+  RenderAppOptions o;
+  o.model = testing_app::WriteTinyModelDir(dir / "model");
+  o.out = dir / "out";
+  o.threads = 1;
+  o.overrides = {"model.render_supersample=1", "model.bf16_inference=false"};
+  std::ostringstream out;
+  const Result<std::vector<RenderedFrameInfo>> frames = RunRender(o, out);
+  ASSERT_TRUE(frames.ok()) << frames.status().message();
+  ASSERT_EQ(frames->size(), 1u);
+  const Result<Image> color = ReadImage(o.out / "color_000.png");
+  ASSERT_TRUE(color.ok()) << color.status().message();
+  EXPECT_EQ(color->width, 16);
+  EXPECT_NE(out.str().find("frame 000: delta"), std::string::npos) << out.str();
+}
+
+TEST(RenderApp, ArchitectureOverrideIsRefused) {
+  const fs::path dir = testing::MakeTempDir("render_app_refuse");
+  RenderAppOptions o;
+  o.model = testing_app::WriteTinyModelDir(dir / "model");
+  o.out = dir / "out";
+  o.threads = 1;
+  o.overrides = {"model.grid_log2_table_size=12"};
+  std::ostringstream out;
+  const Status s = RunRender(o, out).status();
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("model.grid_log2_table_size cannot be changed on a trained model"), std::string::npos)
+      << s.message();
+  EXPECT_FALSE(fs::exists(o.out / "color_000.png"));
+}
+
+}  // namespace
+}  // namespace icef

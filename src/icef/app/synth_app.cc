@@ -1,0 +1,69 @@
+#include "icef/app/synth_app.h"
+
+#include <cstdio>
+#include <vector>
+
+#include "icef/core/progress.h"
+#include "icef/io/image.h"
+#include "icef/synth/contact_sheet.h"
+#include "icef/synth/photo_set.h"
+
+namespace icef {
+
+namespace {
+
+Status RunPhotoSet(const SynthAppOptions& o, const Executor& executor, std::ostream& out) {
+  synth::PhotoSetOptions options;
+  options.identity_seed = o.options.identity_seed;
+  options.generic_style = o.options.generic_style;
+  options.num_photos = *o.photos;
+  options.render = o.options.render;
+  options.background_seed = o.background_seed;
+  char x = 0, extra = 0;
+  if (std::sscanf(o.photo_size.c_str(), "%d%c%d%c", &options.width, &x, &options.height, &extra) != 3 ||
+      (x != 'x' && x != 'X'))
+    return Status::Error("--res-photo: expected WxH (e.g. 480x640), got '" + o.photo_size + "'");
+  ICEF_RETURN_IF_ERROR(options.Validate());
+  ICEF_ASSIGN_OR_RETURN(const std::vector<synth::SynthPhoto> photos,
+                        synth::RenderPhotoSet(options, executor));
+  ICEF_RETURN_IF_ERROR(synth::WritePhotoSet(options, photos, o.out));
+  out << "wrote " << o.out.string() << ": " << photos.size() << " photos (" << options.width << "x"
+      << options.height << ") with their truth (" << synth::kPhotoTruthFile << ")\n";
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status SynthAppOptions::Validate() const {
+  if (out.empty()) return Status::Error("--out is required");
+  if (photos && !contact_sheet.empty()) return Status::Error("--contact-sheet needs a dataset, not --photos");
+  return Status::Ok();
+}
+
+Status RunSynth(const SynthAppOptions& o, const Executor& executor, std::ostream& out) {
+  ICEF_RETURN_IF_ERROR(o.Validate());
+  if (o.photos) return RunPhotoSet(o, executor, out);
+  synth::SynthOptions options = o.options;
+  options.out_dir = o.out;
+  ICEF_RETURN_IF_ERROR(options.Validate());
+  ProgressBar progress("synth", synth::SynthImageCount(options), out, o.interactive);
+  Dataset dataset;
+  face::StyleGap gap;
+  ICEF_RETURN_IF_ERROR(synth::SynthesizeDataset(options, executor, &progress, &dataset, &gap));
+  out << "wrote " << o.out.string() << ": " << dataset.train.size() << " train + " << dataset.test.size()
+      << " test frames (" << options.resolution << "x" << options.resolution << ")\n";
+  char mean[32];
+  std::snprintf(mean, sizeof mean, "%.3f", gap.mean);
+  out << "expression style: " << (options.generic_style ? "generic (--generic-style)" : "the identity's own")
+      << "; style gap " << mean << " (landmark deviation from the generic expressions at weight 1, "
+      << "as a fraction of their motion; mean over " << gap.num_measured << " expressions; "
+      << synth::kStyleInfoFile << ")\n";
+  if (!o.contact_sheet.empty()) {
+    ICEF_ASSIGN_OR_RETURN(const Image sheet, synth::MakeContactSheet(dataset));
+    ICEF_RETURN_IF_ERROR(WritePng(o.contact_sheet, sheet));
+    out << "wrote contact sheet " << o.contact_sheet.string() << "\n";
+  }
+  return Status::Ok();
+}
+
+}  // namespace icef
