@@ -90,7 +90,7 @@ done
   echo "# Few-shot priors: leave-one-out ablation"
   echo
   echo "Made by \`scripts/ablate_priors.sh --seeds \"$seeds\" --k $k --res $res --steps $steps\` on $(nproc) cores"
-  echo "($(date -u +%Y-%m-%d)). Each row trains \`icef train --steps $steps\` (method icef) on the synthetic"
+  echo "($(date -u +%Y-%m-%d)). Each row trains \`icef train --steps $steps\` (the default method) on the synthetic"
   echo "subject of each identity seed (K = $k, ${res}x${res}) with one change from the defaults, and reports"
   echo "summary.json's \`psnr_observed\`: mean PSNR over the held-out test views at the training expressions."
   echo

@@ -37,7 +37,7 @@ struct LossWeights {
   double lambda_occlusion = 0.0;
   double lambda_symmetry = 0.0;
   double symmetry_colour = 0.0;      // weight of the colour part of L_sym (model/symmetry_loss.h)
-  int symmetry_max_samples = 16384;  // cap on the samples mirrored by L_sym per batch
+  int symmetry_max_samples = 4096;   // cap on the samples mirrored by L_sym per batch
   double smooth_epsilon = 0.01;      // finite-difference offset of L_smooth, in half-extent units of the aabb
   int smooth_max_samples = 4096;     // cap on boundary samples used by L_smooth per batch
 };
