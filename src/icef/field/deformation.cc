@@ -5,6 +5,15 @@
 
 namespace icef {
 
+namespace {
+// out[i] += k * v[i] for i in [0, n), split over the executor's threads.
+void AddScaled(const Executor& executor, int64_t n, float k, const float* v, float* out) {
+  ParallelFor(executor, n, [&](int64_t i0, int64_t i1, int) {
+    for (int64_t i = i0; i < i1; ++i) out[i] += k * v[i];
+  });
+}
+}  // namespace
+
 void BroadcastExpression(std::span<const float> beta, int64_t n, std::vector<float>* rows) {
   const size_t b = beta.size();
   rows->resize(static_cast<size_t>(n) * b);
@@ -55,19 +64,17 @@ void Deformation::Offsets(const Executor& executor, int64_t n, const float* posi
   ws->residual.resize(3 * n);
   if (kappa > 0.0) {
     residual_->Forward(executor, n, positions, ws->betas.data(), ws->residual.data(), &ws->ctx, false);
-    const float k = static_cast<float>(kappa);
-    for (int64_t i = 0; i < 3 * n; ++i) offsets[i] += k * ws->residual[i];
+    AddScaled(executor, 3 * n, static_cast<float>(kappa), ws->residual.data(), offsets);
   }
   if (kappa < 1.0) {
     const std::vector<float>& anchor = confidence_->observed(near.index);
     BroadcastExpression(anchor, n, &ws->anchors);
-    ws->tangents.resize(ws->betas.size());
-    for (size_t i = 0; i < ws->betas.size(); ++i) ws->tangents[i] = ws->betas[i] - ws->anchors[i];
+    ws->tangents = ws->betas;
+    AddScaled(executor, int64_t(ws->tangents.size()), -1.f, ws->anchors.data(), ws->tangents.data());
     ws->lin.resize(3 * n);
     residual_->LinearizedForward(executor, n, positions, ws->anchors.data(), ws->tangents.data(), ws->lin.data(),
                                  &ws->ctx);
-    const float k = static_cast<float>(1.0 - kappa);
-    for (int64_t i = 0; i < 3 * n; ++i) offsets[i] += k * ws->lin[i];
+    AddScaled(executor, 3 * n, static_cast<float>(1.0 - kappa), ws->lin.data(), offsets);
   }
 }
 

@@ -151,7 +151,9 @@ void AvatarModel::FieldForward(ModelWorkspace& ws, int64_t n, const float* posit
   const float* canonical = positions;
   if (warp_) {
     Fit(ws.canonical, 3 * n);
-    for (int64_t i = 0; i < 3 * n; ++i) ws.canonical[i] = positions[i] + ws.offsets[i];
+    ParallelFor(executor, 3 * n, [&](int64_t i0, int64_t i1, int) {
+      for (int64_t i = i0; i < i1; ++i) ws.canonical[i] = positions[i] + ws.offsets[i];
+    });
     canonical = ws.canonical.data();
   }
   Fit(ws.sigma, n);
@@ -286,26 +288,33 @@ void AvatarModel::Render(std::span<const Ray> rays, std::span<const float> beta,
       const int64_t n = march.round_size();
       Fit(ws.positions, 3 * n);
       Fit(ws.dirs, 3 * n);
-      for (int64_t k = 0; k < march.active(); ++k) {
-        const Vec3f& dir = rays[r0 + march.ray(k)].direction;
-        for (int64_t i = march.round_begin(k); i < march.round_end(k); ++i) {
-          const int64_t s = march.Sample(k, i);
-          for (int a = 0; a < 3; ++a) ws.positions[3 * i + a] = ws.samples.positions[3 * s + a], ws.dirs[3 * i + a] = dir[a];
+      ParallelFor(executor, march.active(), [&](int64_t k0, int64_t k1, int) {
+        for (int64_t k = k0; k < k1; ++k) {
+          const Vec3f& dir = rays[r0 + march.ray(k)].direction;
+          for (int64_t i = march.round_begin(k); i < march.round_end(k); ++i) {
+            const int64_t s = march.Sample(k, i);
+            for (int a = 0; a < 3; ++a) ws.positions[3 * i + a] = ws.samples.positions[3 * s + a], ws.dirs[3 * i + a] = dir[a];
+          }
         }
-      }
+      });
       const float* positions = ws.positions.data();
       if (warp_ || traits_.entangled_beta) BroadcastExpression(beta, n, &ws.betas);
       Fit(ws.offsets, 3 * n);
-      std::fill(ws.offsets.begin(), ws.offsets.end(), 0.f);
-      if (warp_) warp_->Offsets(executor, n, positions, beta, ws.offsets.data(), &ws.warp_ws);
+      if (warp_) {
+        warp_->Offsets(executor, n, positions, beta, ws.offsets.data(), &ws.warp_ws);
+      } else {
+        std::fill(ws.offsets.begin(), ws.offsets.end(), 0.f);
+      }
       FieldForward(ws, n, positions, false, executor);
       Fit(ws.mask_values, n);
-      mask_.EvaluateBatch(positions, n, ws.mask_values.data());
       Fit(ws.extras, 2 * n);
-      for (int64_t i = 0; i < n; ++i) {
-        ws.extras[2 * i] = ws.mask_values[i];
-        ws.extras[2 * i + 1] = Vec3f(ws.offsets[3 * i], ws.offsets[3 * i + 1], ws.offsets[3 * i + 2]).norm();
-      }
+      ParallelFor(executor, n, [&](int64_t i0, int64_t i1, int) {
+        mask_.EvaluateBatch(positions + 3 * i0, i1 - i0, ws.mask_values.data() + i0);
+        for (int64_t i = i0; i < i1; ++i) {
+          ws.extras[2 * i] = ws.mask_values[i];
+          ws.extras[2 * i + 1] = Vec3f(ws.offsets[3 * i], ws.offsets[3 * i + 1], ws.offsets[3 * i + 2]).norm();
+        }
+      });
       march.Composite(ws.samples, ws.sigma.data(), ws.rgb.data(), ws.extras.data(),
                       static_cast<float>(config_.render_transmittance_eps), executor);
       out->samples_evaluated += n;
