@@ -21,14 +21,17 @@ Result<eval::BenchOptions> ResolveBenchOptions(const BenchAppOptions& a) {
     // Options given explicitly win over the validation settings.
     if (a.identities) o.identities = *a.identities;
     if (a.first_seed) o.first_identity_seed = *a.first_seed;
+    if (a.resolution) o.draw_resolution = false;
   }
   if (a.quick) {
     const std::vector<std::string> user = o.overrides;
     o.overrides.clear();
     o.ApplyQuick();
+    if (o.validation) o.methods = {"icef", "icef-prior"}, o.ks = {5};  // the validation suite, tiny
     // Options given explicitly win over the quick settings.
     if (a.identities) o.identities = *a.identities;
     if (a.resolution) o.resolution = *a.resolution;
+    o.draw_resolution = false;  // quick: always the tiny resolution
     if (a.test_views) o.test_views = *a.test_views;
     if (a.novel_per_tier) o.novel_per_tier = *a.novel_per_tier;
     if (a.steps) o.steps = *a.steps;

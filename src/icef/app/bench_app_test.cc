@@ -51,6 +51,38 @@ TEST(BenchApp, ValidationSettingsLoseToExplicitOptions) {
   EXPECT_EQ(o->identities, 2);
   EXPECT_EQ(o->first_identity_seed, eval::kFirstValidationSeed);
   EXPECT_EQ(o->ks, (std::vector<int>{3, 10}));
+  // Diverse scenes with a drawn resolution; the validation methods.
+  EXPECT_TRUE(o->diverse);
+  EXPECT_TRUE(o->draw_resolution);
+  EXPECT_EQ(o->methods, (std::vector<std::string>{"icef", "icef-prior"}));
+  // --res pins the resolution; the scenes stay diverse.
+  a.resolution = 160;
+  const Result<eval::BenchOptions> pinned = ResolveBenchOptions(a);
+  ASSERT_TRUE(pinned.ok());
+  EXPECT_TRUE(pinned->diverse);
+  EXPECT_FALSE(pinned->draw_resolution);
+  EXPECT_EQ(pinned->resolution, 160);
+}
+
+TEST(BenchApp, QuickValidationIsTheValidationSuiteInMiniature) {
+  BenchAppOptions a;
+  a.out = "b";
+  a.validation = true;
+  a.quick = true;
+  const Result<eval::BenchOptions> o = ResolveBenchOptions(a);
+  ASSERT_TRUE(o.ok()) << o.status().message();
+  EXPECT_TRUE(o->diverse);
+  EXPECT_FALSE(o->draw_resolution);
+  EXPECT_EQ(o->resolution, 32);
+  EXPECT_EQ(o->identities, 1);
+  EXPECT_EQ(o->first_identity_seed, eval::kFirstValidationSeed);
+  EXPECT_EQ(o->ks, (std::vector<int>{5}));
+  EXPECT_EQ(o->methods, (std::vector<std::string>{"icef", "icef-prior"}));
+  // A test bench keeps the classic scene.
+  a.validation = false;
+  const Result<eval::BenchOptions> test = ResolveBenchOptions(a);
+  ASSERT_TRUE(test.ok());
+  EXPECT_FALSE(test->diverse);
 }
 
 TEST(BenchApp, StepsAloneDropTheTimeCap) {

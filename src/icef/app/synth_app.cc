@@ -50,8 +50,22 @@ Status RunSynth(const SynthAppOptions& o, const Executor& executor, std::ostream
   Dataset dataset;
   face::StyleGap gap;
   ICEF_RETURN_IF_ERROR(synth::SynthesizeDataset(options, executor, &progress, &dataset, &gap));
+  const synth::SynthOptions resolved = synth::ResolveScene(options);
   out << "wrote " << o.out.string() << ": " << dataset.train.size() << " train + " << dataset.test.size()
-      << " test frames (" << options.resolution << "x" << options.resolution << ")\n";
+      << " test frames (" << resolved.resolution << "x" << resolved.resolution << ")\n";
+  if (options.vary.Any()) {
+    const synth::IdentityParams id = synth::SynthIdentity(options);
+    char line[320];
+    std::snprintf(line, sizeof line,
+                  "scene (drawn: %s): skin [%.2f %.2f %.2f], key %.2f + ambient %.2f%s, specular %.2f, head scale "
+                  "%.2f at [%.2f %.2f %.2f], distance %.2f, focal %.2f x res, yaw <= %.0f, pitch <= %.0f (%s)\n",
+                  options.vary.ToString().c_str(), id.skin_tone[0], id.skin_tone[1], id.skin_tone[2],
+                  resolved.render.diffuse, resolved.render.ambient, resolved.render.fill > 0 ? " + second light" : "",
+                  resolved.render.specular, resolved.head_scale, resolved.head_offset[0], resolved.head_offset[1],
+                  resolved.head_offset[2], resolved.camera_distance, resolved.focal_scale, resolved.max_yaw_deg,
+                  resolved.max_pitch_deg, synth::kSceneInfoFile);
+    out << line;
+  }
   char mean[32];
   std::snprintf(mean, sizeof mean, "%.3f", gap.mean);
   out << "expression style: " << (options.generic_style ? "generic (--generic-style)" : "the identity's own")

@@ -1,5 +1,6 @@
 // icef synth --out DIR [--identity-seed N --generic-style --k K --res R --test-views V
-//   --novel-per-tier N --near T0 --far T1 --threads T --contact-sheet FILE.png]
+//   --novel-per-tier N --near T0 --far T1 --diverse --vary AXES --pin AXES --threads T
+//   --contact-sheet FILE.png]
 // icef synth --photos N --out DIR [--identity-seed N --generic-style --res-photo WxH
 //   --background-seed S --supersample S --threads T]
 // app/synth_app.h.
@@ -18,6 +19,9 @@ CommandFn RegisterSynth(CLI::App& app) {
   auto args = std::make_shared<SynthAppOptions>();
   auto threads = std::make_shared<int>(0);
   auto num_photos = std::make_shared<int>(0);
+  auto diverse = std::make_shared<bool>(false);
+  auto vary = std::make_shared<std::vector<std::string>>();
+  auto pin = std::make_shared<std::vector<std::string>>();
   synth::SynthOptions& o = args->options;
   app.description(
       "Render a synthetic ground-truth dataset from the procedural parametric head: K training "
@@ -41,6 +45,12 @@ CommandFn RegisterSynth(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--near", o.near_threshold, "Tier threshold t0: near = (0, t0]")->capture_default_str();
   app.add_option("--far", o.far_threshold, "Tier threshold t1: moderate = (t0, t1], far > t1")->capture_default_str();
+  app.add_flag("--diverse", *diverse,
+               "Draw every scene axis per identity seed (skin, lighting, placement, camera, views, resolution, "
+               "detail; see scene.json) instead of the classic studio scene; --res pins the resolution");
+  app.add_option("--vary", *vary, "Draw these scene axes per identity seed (comma-separated axis names)")
+      ->delimiter(',');
+  app.add_option("--pin", *pin, "Keep these scene axes at the classic values (with --diverse)")->delimiter(',');
   app.add_option("--supersample", o.render.supersample, "Samples per pixel along each axis")->capture_default_str();
   app.add_option("--threads", *threads, "Worker threads (0 = all cores)")->capture_default_str();
   CLI::Option* contact =
@@ -59,8 +69,15 @@ CommandFn RegisterSynth(CLI::App& app) {
   for (const char* dataset_only : {"--k", "--res", "--test-views", "--novel-per-tier", "--near", "--far"})
     photos->excludes(app.get_option(dataset_only));
   photos->excludes(contact);
-  return [args, photos, threads, num_photos]() -> Status {
+  for (const char* scene : {"--diverse", "--vary", "--pin"}) photos->excludes(app.get_option(scene));
+  CLI::Option* res = app.get_option("--res");
+  return [args, photos, threads, num_photos, diverse, vary, pin, res]() -> Status {
     SynthAppOptions options = *args;
+    synth::SceneAxes& axes = options.options.vary;
+    if (*diverse) axes = synth::SceneAxes::All();
+    for (const std::string& a : *vary) ICEF_RETURN_IF_ERROR(axes.Set(a, true).WithContext("--vary"));
+    for (const std::string& a : *pin) ICEF_RETURN_IF_ERROR(axes.Set(a, false).WithContext("--pin"));
+    if (res->count() > 0) axes.resolution = false;
     if (photos->count() > 0) options.photos = *num_photos;
     options.interactive = StdoutIsTerminal();
     return RunSynth(options, Executor(*threads), std::cout);

@@ -44,6 +44,9 @@ void BenchOptions::ApplyValidation() {
   identities = kDefaultValidationIdentities;
   first_identity_seed = kFirstValidationSeed;
   ks = {5};
+  diverse = true;
+  draw_resolution = true;
+  methods = {"icef", "icef-prior"};
 }
 
 std::string BenchOptions::IdentityRole() const {
@@ -86,7 +89,15 @@ Json BenchOptions::ToJson() const {
   j["validation"] = validation;
   j["ks"] = ks;
   j["methods"] = methods;
-  j["resolution"] = resolution;
+  j["resolution"] = draw_resolution ? Json("drawn per identity, 128-" + std::to_string(kMaxValidationResolution))
+                                    : Json(resolution);
+  if (diverse) {
+    synth::SceneAxes axes = synth::SceneAxes::All();
+    axes.resolution = draw_resolution;
+    j["scenes"] = "diverse (drawn per identity: " + axes.ToString() + ")";
+  } else {
+    j["scenes"] = "classic";
+  }
   j["test_views"] = test_views;
   j["novel_per_tier"] = novel_per_tier;
   j["steps"] = steps;
@@ -160,6 +171,11 @@ Result<Dataset> EnsureDataset(const BenchOptions& o, uint64_t seed, int k, const
   so.resolution = o.resolution;
   so.test_views = o.test_views;
   so.novel_per_tier = o.novel_per_tier;
+  if (o.diverse) {
+    so.vary = synth::SceneAxes::All();
+    so.vary.resolution = o.draw_resolution;
+    so.max_drawn_resolution = kMaxValidationResolution;
+  }
   ICEF_RETURN_IF_ERROR(so.Validate());
   const fs::path stamp = so.out_dir / "synth_options.txt";
   const std::string want = so.ToString() + "\n";

@@ -31,6 +31,8 @@ constexpr double kDefaultBenchTimeBudget = 90.0;
 // prior experiments use).
 constexpr uint64_t kFirstValidationSeed = 101;
 constexpr int kDefaultValidationIdentities = 6;
+// The largest resolution a diverse bench draws (evaluation cost grows with the pixels).
+constexpr int kMaxValidationResolution = 256;
 
 struct BenchOptions {
   // Output directory (created): data/, runs/, plots/, report.md, report.json, bench.json.
@@ -71,8 +73,14 @@ struct BenchOptions {
   // Validation bench: the identities are validation seeds (>= kFirstValidationSeed); otherwise
   // they must all be test seeds (< kFirstValidationSeed).
   bool validation = false;
+  // Diverse scenes (`icef synth --diverse`): every scene axis of synth::SceneAxes drawn per
+  // identity seed (the validation bench's default); draw_resolution: the resolution is drawn too
+  // (up to kMaxValidationResolution) instead of `resolution`.
+  bool diverse = false;
+  bool draw_resolution = false;
 
-  // The --validation settings: validation seeds 101..106, K = 5 (explicit options win).
+  // The --validation settings: validation seeds 101..106, K = 5, diverse scenes with a drawn
+  // resolution, methods icef and icef-prior (explicit options win).
   void ApplyValidation();
   // "test: ..." or "validation: ..." for the report.
   std::string IdentityRole() const;

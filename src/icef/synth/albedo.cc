@@ -43,8 +43,32 @@ Vec3f HeadModel::SkinAlbedo(const Vec3f& p) const {
   const float flush = EllipsoidBump(pm, Vec3f(0.12f, -0.05f, 0.21f), Vec3f::Constant(1.f / 0.08f));
   c = c.cwiseProduct(Vec3f::Ones() + flush * Vec3f(0.05f, -0.09f, -0.08f));
   // Pores: high-frequency darkening at two scales.
-  const float pores = std::max(0.f, ValueNoise(p * 160.f, seed + 2u)) + 0.5f * std::max(0.f, ValueNoise(p * 85.f, seed + 3u));
+  const float pores = std::max(0.f, ValueNoise(p * (160.f * id.pore_scale), seed + 2u)) +
+                      0.5f * std::max(0.f, ValueNoise(p * (85.f * id.pore_scale), seed + 3u));
   c *= 1.f - 0.07f * id.pore_strength * pores;
+  // Fine wrinkles: wavy horizontal lines across the forehead and fans at the outer eye corners.
+  if (id.wrinkle_strength > 0.f && p.z() > 0.1f) {
+    const float forehead = SmoothStep(g.brow_y + 0.02f, g.brow_y + 0.05f, p.y()) *
+                           (1.f - SmoothStep(g.eye_c[0].y() + 0.14f, g.eye_c[0].y() + 0.18f, p.y())) *
+                           (1.f - SmoothStep(0.09f, 0.14f, std::abs(p.x())));
+    const float wave = p.y() * 330.f + 2.5f * ValueNoise(Vec3f(p.x() * 18.f, 0.f, 1.f), seed + 7u);
+    const float line = std::pow(std::max(0.f, std::cos(wave)), 24.f);
+    const Vec3f corner(g.eye_c[1].x() + 0.045f, g.eye_c[1].y(), 0.f);
+    const Vec3f q(std::abs(p.x()) - corner.x(), p.y() - corner.y(), 0.f);
+    const float fan = (1.f - SmoothStep(0.012f, 0.03f, q.norm())) * SmoothStep(0.f, 0.006f, q.x());
+    const float fan_line = std::pow(std::max(0.f, std::cos(std::atan2(q.y(), q.x()) * 22.f)), 12.f);
+    c *= 1.f - id.wrinkle_strength * (0.16f * forehead * line + 0.14f * fan * fan_line);
+  }
+  // Stubble: dense fine dark dots over the upper lip, chin and jaw.
+  if (id.stubble_density > 0.f && p.z() > 0.f) {
+    const float below_nose = 1.f - SmoothStep(g.mouth_y + 0.03f, g.mouth_y + 0.045f, p.y());
+    const float cheek_edge = 1.f - SmoothStep(g.mouth_y + 0.0f, g.mouth_y + 0.06f, p.y() + 0.5f * std::abs(p.x()));
+    const float zone = below_nose * std::max(cheek_edge, 1.f - SmoothStep(0.04f, 0.07f, std::abs(p.x())));
+    if (zone > 0.f) {
+      const float dots = CellSpots(p, 380.f, id.stubble_density * zone, seed + 8u);
+      c = Mix(c, id.hair_color * 0.6f, 0.7f * dots);
+    }
+  }
   // Freckles over the cheeks and the nose.
   const float freckle_zone =
       p.z() > 0.12f ? EllipsoidBump(p, Vec3f(0.f, -0.02f, 0.26f), Vec3f(1.f / 0.19f, 1.f / 0.1f, 1.f / 0.2f)) : 0.f;

@@ -60,17 +60,42 @@ Image Tile(const Image& frame, const Vec3f& background, int tile) {
 }
 
 struct Cell {
+  const Dataset* dataset;
   const Frame* frame;
   std::string label;
 };
+using Rows = std::vector<std::pair<std::string, std::vector<Cell>>>;
+
+// Lays the rows out, one tile per cell, labelled under the tile.
+Result<Image> TileRows(const Rows& rows, const ContactSheetOptions& options) {
+  const int label_h = options.labels ? 12 : 0, gap = 4;
+  const int cell_w = options.tile + gap, cell_h = options.tile + label_h + gap;
+  int columns = 1;
+  for (const auto& r : rows) columns = std::max(columns, std::min<int>(options.max_columns, static_cast<int>(r.second.size())));
+  Image sheet(columns * cell_w + gap, static_cast<int>(rows.size()) * cell_h + gap, 3, 1.f);
+  for (size_t r = 0; r < rows.size(); ++r) {
+    const auto& cells = rows[r].second;
+    for (int c = 0; c < std::min<int>(columns, static_cast<int>(cells.size())); ++c) {
+      ICEF_ASSIGN_OR_RETURN(const Image frame, LoadFrameImage(*cells[c].dataset, *cells[c].frame));
+      const Image tile = Tile(frame, cells[c].dataset->background, options.tile);
+      const int ox = gap + c * cell_w, oy = gap + static_cast<int>(r) * cell_h;
+      for (int y = 0; y < options.tile; ++y)
+        for (int x = 0; x < options.tile; ++x)
+          for (int ch = 0; ch < 3; ++ch) sheet.At(ox + x, oy + y, ch) = tile.At(x, y, ch);
+      if (options.labels) DrawText(sheet, ox + 1, oy + options.tile + 2, cells[c].label, Vec3f(0.1f, 0.1f, 0.1f));
+    }
+  }
+  return sheet;
+}
 
 }  // namespace
 
 Result<Image> MakeContactSheet(const Dataset& dataset, const ContactSheetOptions& options) {
   ICEF_RETURN_IF_ERROR(options.Validate());
-  std::vector<std::pair<std::string, std::vector<Cell>>> rows;
+  Rows rows;
   std::vector<Cell> train;
-  for (size_t i = 0; i < dataset.train.size(); ++i) train.push_back({&dataset.train[i], "train " + std::to_string(i)});
+  for (size_t i = 0; i < dataset.train.size(); ++i)
+    train.push_back({&dataset, &dataset.train[i], "train " + std::to_string(i)});
   rows.push_back({"train", train});
   // Neutral test views (distinct neutral_file_path values, in order of appearance).
   std::vector<Frame> neutrals;
@@ -82,7 +107,7 @@ Result<Image> MakeContactSheet(const Dataset& dataset, const ContactSheetOptions
     neutrals.push_back(n);
   }
   std::vector<Cell> neutral_row;
-  for (size_t i = 0; i < neutrals.size(); ++i) neutral_row.push_back({&neutrals[i], "neutral v" + std::to_string(i)});
+  for (size_t i = 0; i < neutrals.size(); ++i) neutral_row.push_back({&dataset, &neutrals[i], "neutral v" + std::to_string(i)});
   if (!neutral_row.empty()) rows.push_back({"neutral", neutral_row});
   // One tile per distinct test expression, per tier; views taken in turn.
   for (Tier tier : {Tier::kObserved, Tier::kNear, Tier::kModerate, Tier::kFar}) {
@@ -101,28 +126,24 @@ Result<Image> MakeContactSheet(const Dataset& dataset, const ContactSheetOptions
       ++expression_count;
       char label[64];
       std::snprintf(label, sizeof label, "%s d=%.2f", TierName(tier), dataset.test[pick].delta.value_or(0.0));
-      row.push_back({&dataset.test[pick], label});
+      row.push_back({&dataset, &dataset.test[pick], label});
     }
     if (!row.empty()) rows.push_back({TierName(tier), row});
   }
-  const int label_h = options.labels ? 12 : 0, gap = 4;
-  const int cell_w = options.tile + gap, cell_h = options.tile + label_h + gap;
-  int columns = 1;
-  for (const auto& r : rows) columns = std::max(columns, std::min<int>(options.max_columns, static_cast<int>(r.second.size())));
-  Image sheet(columns * cell_w + gap, static_cast<int>(rows.size()) * cell_h + gap, 3, 1.f);
-  for (size_t r = 0; r < rows.size(); ++r) {
-    const auto& cells = rows[r].second;
-    for (int c = 0; c < std::min<int>(columns, static_cast<int>(cells.size())); ++c) {
-      ICEF_ASSIGN_OR_RETURN(const Image frame, LoadFrameImage(dataset, *cells[c].frame));
-      const Image tile = Tile(frame, dataset.background, options.tile);
-      const int ox = gap + c * cell_w, oy = gap + static_cast<int>(r) * cell_h;
-      for (int y = 0; y < options.tile; ++y)
-        for (int x = 0; x < options.tile; ++x)
-          for (int ch = 0; ch < 3; ++ch) sheet.At(ox + x, oy + y, ch) = tile.At(x, y, ch);
-      if (options.labels) DrawText(sheet, ox + 1, oy + options.tile + 2, cells[c].label, Vec3f(0.1f, 0.1f, 0.1f));
-    }
+  return TileRows(rows, options);
+}
+
+Result<Image> MakeTrainingSheet(const std::vector<Dataset>& datasets, const ContactSheetOptions& options) {
+  ICEF_RETURN_IF_ERROR(options.Validate());
+  Rows rows;
+  for (const Dataset& d : datasets) {
+    std::vector<Cell> row;
+    const std::string name = d.root.filename().empty() ? d.root.parent_path().filename().string() : d.root.filename().string();
+    for (size_t i = 0; i < d.train.size(); ++i)
+      row.push_back({&d, &d.train[i], i == 0 ? name : "train " + std::to_string(i)});
+    rows.push_back({name, row});
   }
-  return sheet;
+  return TileRows(rows, options);
 }
 
 }  // namespace icef::synth

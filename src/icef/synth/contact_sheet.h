@@ -4,6 +4,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "icef/core/status.h"
 #include "icef/data/dataset.h"
@@ -25,6 +26,11 @@ struct ContactSheetOptions {
 
 // Loads the frames' images (errors name the file) and tiles them into an RGB image.
 Result<Image> MakeContactSheet(const Dataset& dataset, const ContactSheetOptions& options = ContactSheetOptions());
+
+// One row per dataset of its training frames (the first tile labelled with the dataset's directory
+// name): several subjects side by side, e.g. the scenes of `icef synth --diverse`.
+Result<Image> MakeTrainingSheet(const std::vector<Dataset>& datasets,
+                                const ContactSheetOptions& options = ContactSheetOptions());
 
 // Draws `text` (ASCII, stb_easy_font's ~6x7 pixel font) with its top-left corner at (x, y).
 void DrawText(Image& image, int x, int y, const std::string& text, const Vec3f& color);

@@ -9,6 +9,10 @@ Status RenderOptions::Validate() const {
   if (supersample < 1 || supersample > 8) return Status::Error("supersample: expected 1..8, got " + std::to_string(supersample));
   if (!light_direction.allFinite() || light_direction.norm() < 1e-6f) return Status::Error("light_direction: expected a non-zero finite vector");
   if (!(ambient >= 0.f) || !(diffuse >= 0.f)) return Status::Error("ambient/diffuse: expected values >= 0");
+  if (!(fill >= 0.f) || !(specular >= 0.f)) return Status::Error("fill/specular: expected values >= 0");
+  if (fill > 0.f && (!fill_direction.allFinite() || fill_direction.norm() < 1e-6f))
+    return Status::Error("fill_direction: expected a non-zero finite vector");
+  if (!(shininess >= 1.f && shininess <= 1000.f)) return Status::Error("shininess: expected 1..1000");
   if (max_steps < 8) return Status::Error("max_steps: expected >= 8, got " + std::to_string(max_steps));
   return Status::Ok();
 }
@@ -16,7 +20,10 @@ Status RenderOptions::Validate() const {
 std::string RenderOptions::ToString() const {
   std::ostringstream os;
   os << "RenderOptions(supersample=" << supersample << ", light=[" << light_direction.transpose() << "], ambient=" << ambient
-     << ", diffuse=" << diffuse << ", max_steps=" << max_steps << ")";
+     << ", diffuse=" << diffuse;
+  if (fill > 0.f) os << ", fill=" << fill << "@[" << fill_direction.transpose() << "]";
+  if (specular > 0.f) os << ", specular=" << specular << "^" << shininess;
+  os << ", max_steps=" << max_steps << ")";
   return os.str();
 }
 
@@ -28,6 +35,7 @@ Image RenderGroundTruth(const HeadModel& head, const Camera& camera, const std::
   const face::ExpressionState state = face_model.Prepare(expression);
   const Aabb bounds = face_model.Bounds();
   const Vec3f light = options.light_direction.normalized();
+  const Vec3f fill_light = options.fill > 0.f ? Vec3f(options.fill_direction.normalized()) : Vec3f::Zero();
   const int w = camera.width(), h = camera.height(), ss = options.supersample;
   Image image(w, h, 4);
   ParallelForChunks(executor, h, 2, [&](int64_t row_begin, int64_t row_end) {
@@ -45,8 +53,16 @@ Image RenderGroundTruth(const HeadModel& head, const Camera& camera, const std::
             const Vec3f p = ray.At(t);
             const face::FaceModel::Sample sample = face_model.Evaluate(p, state);
             const Vec3f albedo = head.Albedo(sample, p, state);
-            const float lambert = std::max(0.f, face_model.Normal(p, state).dot(light));
-            sum += albedo * (options.ambient + options.diffuse * lambert);
+            const Vec3f normal = face_model.Normal(p, state);
+            const float lambert = std::max(0.f, normal.dot(light));
+            float shade = options.ambient + options.diffuse * lambert;
+            if (options.fill > 0.f) shade += options.fill * std::max(0.f, normal.dot(fill_light));
+            Vec3f rgb = albedo * shade;
+            if (options.specular > 0.f && sample.material != face::Material::kMouthCavity && lambert > 0.f) {
+              const Vec3f half = (light - ray.direction.normalized()).normalized();
+              rgb += Vec3f::Constant(options.specular * std::pow(std::max(0.f, normal.dot(half)), options.shininess));
+            }
+            sum += rgb;
             ++hits;
           }
         }

@@ -1,5 +1,6 @@
 // Ground-truth rendering of the procedural head: sphere tracing of the warped SDF, Lambertian
-// shading with a light fixed to the head frame plus ambient, 2x2 (configurable) supersampling,
+// shading with a key light fixed to the head frame plus ambient (and optionally a second light and
+// a specular sheen), 2x2 (configurable) supersampling,
 // RGBA output whose alpha is the coverage mask and whose RGB is the covered samples' mean colour
 // (background where nothing is hit), and landmark projection with an occlusion test.
 #pragma once
@@ -24,6 +25,13 @@ struct RenderOptions {
   float ambient = 0.38f;
   // Lambertian (diffuse) light intensity.
   float diffuse = 0.72f;
+  // A second light (fill or rim), head frame, Lambertian with intensity `fill` (0: none).
+  Vec3f fill_direction = Vec3f(0.6f, 0.1f, 0.5f);
+  float fill = 0.f;
+  // A soft white specular sheen on skin, lips, lids and eyes (Blinn-Phong from the key light:
+  // specular * max(0, n.h)^shininess; 0: matte). It depends on the view, as real skin does.
+  float specular = 0.f;
+  float shininess = 24.f;
   // Background RGB where no surface is hit (RGB of alpha-0 pixels).
   Vec3f background = Vec3f::Ones();
   // Maximum sphere-tracing steps per ray.

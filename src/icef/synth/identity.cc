@@ -1,6 +1,7 @@
 #include "icef/synth/identity.h"
 
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 
 #include "icef/core/rng.h"
@@ -89,6 +90,48 @@ IdentityParams IdentityParams::FromSeed(uint64_t seed) {
   return p;
 }
 
+float SpreadUnit(uint64_t seed, double step, Rng& rng) {
+  const double x = static_cast<double>(seed % 1000003) * step + rng.Uniform(-0.05, 0.05);
+  return static_cast<float>(std::clamp(x - std::floor(x), 0.0, 0.999999));
+}
+
+void DrawDiverseSkin(uint64_t seed, IdentityParams* p) {
+  Rng rng(seed, StreamId("synth.scene.skin"));
+  auto u = [&](double lo, double hi) { return static_cast<float>(rng.Uniform(lo, hi)); };
+  // Five anchors from very light to very dark; the tone is uniform along them.
+  const Vec3f anchors[] = {{0.96f, 0.82f, 0.74f}, {0.90f, 0.72f, 0.60f}, {0.74f, 0.53f, 0.40f},
+                           {0.46f, 0.30f, 0.21f}, {0.24f, 0.15f, 0.105f}};
+  // The spread's ends (within 0.06 of 0 and 1) map to the palette's ends, so six seeds reach them.
+  const float tone = std::clamp((SpreadUnit(seed, 0.6180339887, rng) - 0.06f) / 0.84f, 0.f, 1.f);
+  const float at = tone * 4.f;
+  const int i = std::min(3, static_cast<int>(at));
+  const Vec3f skin = Mix(anchors[i], anchors[i + 1], at - static_cast<float>(i));
+  const float tint = u(-0.025, 0.025);
+  p->skin_tone = (skin + Vec3f(tint, 0.f, -tint)).cwiseMax(0.f).cwiseMin(1.f);
+  // Lips: redder on light skin, darker and browner on dark skin; always darker than the skin.
+  const Vec3f lip_factor = Mix(Vec3f(0.88f, 0.52f, 0.56f), Vec3f(0.78f, 0.58f, 0.62f), tone);
+  p->lip_color = (p->skin_tone.cwiseProduct(lip_factor) + (1.f - tone) * Vec3f(u(0.02, 0.08), 0.f, 0.01f)).cwiseMin(1.f);
+  // Hair and brows: any colour on light skin, dark on dark skin (brows keep a contrast of at
+  // least ~2.5x the skin's luminance either way).
+  const Vec3f hairs[] = {{0.05f, 0.04f, 0.035f}, {0.18f, 0.11f, 0.06f}, {0.42f, 0.28f, 0.15f},
+                         {0.68f, 0.52f, 0.30f}, {0.48f, 0.19f, 0.07f}};
+  const int hair = tone > 0.6f ? static_cast<int>(rng.Below(2)) : static_cast<int>(rng.Below(5));
+  p->hair_color = hairs[hair];
+  const float skin_luma = p->skin_tone.dot(Vec3f(0.2126f, 0.7152f, 0.0722f));
+  const Vec3f brow = 0.5f * p->hair_color + Vec3f(0.03f, 0.02f, 0.015f);
+  const float brow_luma = brow.dot(Vec3f(0.2126f, 0.7152f, 0.0722f));
+  p->brow_color = brow_luma * 2.5f > skin_luma ? brow * (skin_luma / (2.5f * brow_luma)) : brow;
+}
+
+void DrawFineDetail(uint64_t seed, IdentityParams* p) {
+  Rng rng(seed, StreamId("synth.scene.detail"));
+  auto u = [&](double lo, double hi) { return static_cast<float>(rng.Uniform(lo, hi)); };
+  p->pore_scale = u(1.2, 2.4);
+  p->pore_strength = u(0.8, 1.8);
+  p->wrinkle_strength = u(0.2, 1.0);
+  p->stubble_density = rng.UniformDouble() < 0.5 ? 0.f : u(0.25, 0.8);
+}
+
 std::string IdentityParams::ToString() const {
   std::ostringstream os;
   const face::ShapeParams& s = shape;
@@ -96,7 +139,9 @@ std::string IdentityParams::ToString() const {
      << ", chin=" << s.chin_length << ", nose=" << s.nose_length << "/" << s.nose_width << "/" << s.nose_bridge
      << ", eyes=" << s.eye_spacing << ", lips=" << s.lip_thickness << ", brows=" << s.brow_height
      << ", cheeks=" << s.cheek_fullness << ", mouth=" << s.mouth_width << ", skin=[" << skin_tone.transpose()
-     << "], freckles=" << freckle_density << ", moles=" << num_moles << ", " << style.ToString() << ")";
+     << "], freckles=" << freckle_density << ", moles=" << num_moles << ", pores=" << pore_strength << "@"
+     << pore_scale << ", wrinkles=" << wrinkle_strength << ", stubble=" << stubble_density << ", "
+     << style.ToString() << ")";
   return os.str();
 }
 

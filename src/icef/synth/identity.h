@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <string>
 
+#include "icef/core/rng.h"
 #include "icef/face/expression_style.h"
 #include "icef/face/shape_params.h"
 #include "icef/math/types.h"
@@ -32,6 +33,10 @@ struct IdentityParams {
   int num_moles = 3;             // moles on the face
   float hairline = 0.0f;         // hairline offset (head units, + = higher forehead)
   uint32_t detail_seed = 1;      // key of every noise pattern (pores, freckles, moles, strands)
+  // Fine detail at the pixel scale (the `detail` scene axis; the defaults are the classic head):
+  float pore_scale = 1.0f;       // pore frequency multiplier (2 = pores half the size)
+  float wrinkle_strength = 0.0f; // forehead lines and crow's feet, 0..1
+  float stubble_density = 0.0f;  // beard stubble dots over the lower face, 0..1
 
   // The average head with the generic style and the default albedo (expression tests use it as a
   // fixed subject).
@@ -48,5 +53,19 @@ struct IdentityParams {
 // smile-corner and brow-window offsets of a few hundredths of a head unit. The ranges and why the
 // caps sit where they do are in docs/face_model.md.
 face::ExpressionStyle DrawExpressionStyle(uint64_t seed);
+
+// A value in [0, 1) for a scene axis that spreads consecutive seeds over the whole range: the
+// fractional part of seed * step (an irrational step, one per axis, so axes do not move together)
+// plus a small jitter from `rng`. Any six consecutive seeds (e.g. the validation identities) then
+// span each axis, where independent uniform draws often leave an end out.
+float SpreadUnit(uint64_t seed, double step, Rng& rng);
+
+// The `skin` scene axis: redraws skin tone from very light to very dark (a wider palette than
+// FromSeed's) with lips, brows and hair whose contrast matches the tone, from Rng(seed,
+// "synth.scene.skin").
+void DrawDiverseSkin(uint64_t seed, IdentityParams* identity);
+// The `detail` scene axis: denser fine albedo detail (smaller and stronger pores, forehead
+// wrinkles and crow's feet, stubble on some subjects), from Rng(seed, "synth.scene.detail").
+void DrawFineDetail(uint64_t seed, IdentityParams* identity);
 
 }  // namespace icef::synth

@@ -8,11 +8,54 @@
 #include "icef/core/rng.h"
 #include "icef/face/expression.h"
 #include "icef/io/atomic_file.h"
+#include "icef/face/face_model.h"
 #include "icef/synth/head_model.h"
 
 namespace icef::synth {
 
 namespace fs = std::filesystem;
+
+SceneAxes SceneAxes::All() {
+  SceneAxes a;
+  a.skin = a.lighting = a.placement = a.camera = a.views = a.resolution = a.detail = true;
+  return a;
+}
+
+bool SceneAxes::Any() const { return skin || lighting || placement || camera || views || resolution || detail; }
+
+const std::vector<std::string>& SceneAxes::Names() {
+  static const std::vector<std::string> kNames = {"skin", "lighting", "placement", "camera", "views", "resolution", "detail"};
+  return kNames;
+}
+
+namespace {
+bool* AxisField(SceneAxes& a, const std::string& name) {
+  bool* fields[] = {&a.skin, &a.lighting, &a.placement, &a.camera, &a.views, &a.resolution, &a.detail};
+  const auto& names = SceneAxes::Names();
+  for (size_t i = 0; i < names.size(); ++i)
+    if (names[i] == name) return fields[i];
+  return nullptr;
+}
+}  // namespace
+
+Status SceneAxes::Set(const std::string& name, bool value) {
+  bool* field = AxisField(*this, name);
+  if (!field) {
+    std::string known;
+    for (const std::string& n : Names()) known += (known.empty() ? "" : ", ") + n;
+    return Status::Error("unknown scene axis '" + name + "' (expected one of " + known + ")");
+  }
+  *field = value;
+  return Status::Ok();
+}
+
+std::string SceneAxes::ToString() const {
+  std::string out;
+  SceneAxes copy = *this;
+  for (const std::string& n : Names())
+    if (*AxisField(copy, n)) out += (out.empty() ? "" : ",") + n;
+  return out.empty() ? "none" : out;
+}
 
 Status SynthOptions::Validate() const {
   if (out_dir.empty()) return Status::Error("out_dir: required");
@@ -28,6 +71,17 @@ Status SynthOptions::Validate() const {
   if (!(focal_scale > 0.1)) return Status::Error("focal_scale: expected > 0.1, got " + std::to_string(focal_scale));
   if (!(max_yaw_deg >= 0.0 && max_yaw_deg <= 80.0)) return Status::Error("max_yaw_deg: expected 0..80");
   if (!(max_pitch_deg >= 0.0 && max_pitch_deg <= 60.0)) return Status::Error("max_pitch_deg: expected 0..60");
+  if (!(max_drawn_resolution >= 128 && max_drawn_resolution <= 4096))
+    return Status::Error("max_drawn_resolution: expected 128..4096, got " + std::to_string(max_drawn_resolution));
+  if (!(head_scale >= 0.25 && head_scale <= 4.0)) return Status::Error("head_scale: expected 0.25..4, got " + std::to_string(head_scale));
+  if (!head_offset.allFinite()) return Status::Error("head_offset: expected finite values");
+  const Aabb head = face::FaceModel(face::ShapeParams()).Bounds();
+  for (int a = 0; a < 3; ++a) {
+    const double lo = head_scale * head.min[a] + head_offset[a], hi = head_scale * head.max[a] + head_offset[a];
+    if (lo < -1.0 || hi > 1.0)
+      return Status::Error("head_scale/head_offset: the head (axis " + std::to_string(a) + ": " + std::to_string(lo) +
+                           ".." + std::to_string(hi) + ") leaves the dataset's box [-1, 1]");
+  }
   return render.Validate().WithContext("render");
 }
 
@@ -37,15 +91,106 @@ std::string SynthOptions::ToString() const {
      << ", generic_style=" << (generic_style ? "true" : "false") << ", k=" << num_train
      << ", res=" << resolution << ", test_views=" << test_views << ", novel_per_tier=" << novel_per_tier
      << ", thresholds=[" << near_threshold << ", " << far_threshold << "], distance=" << camera_distance
-     << ", focal_scale=" << focal_scale << ", yaw<=" << max_yaw_deg << ", pitch<=" << max_pitch_deg << ", "
-     << render.ToString() << ")";
+     << ", focal_scale=" << focal_scale << ", yaw<=" << max_yaw_deg << ", pitch<=" << max_pitch_deg << ", ";
+  if (vary.Any()) os << "vary=" << vary.ToString() << " (max_res " << max_drawn_resolution << "), ";
+  if (head_scale != 1.0 || !head_offset.isZero())
+    os << "head_scale=" << head_scale << ", head_offset=[" << head_offset.transpose() << "], ";
+  os << render.ToString() << ")";
   return os.str();
+}
+
+SynthOptions ResolveScene(const SynthOptions& options) {
+  SynthOptions o = options;
+  const uint64_t seed = o.identity_seed;
+  if (o.vary.lighting) {
+    Rng rng(seed, StreamId("synth.scene.lighting"));
+    // Key light anywhere over the front, from 70 degrees left to right and from slightly below
+    // to high above; strength and ambient (the fill ratio) vary independently.
+    const double azimuth = (-70.0 + 140.0 * SpreadUnit(seed, 0.7182818285, rng)) * M_PI / 180.0, elevation = rng.Uniform(-10.0, 60.0) * M_PI / 180.0;
+    o.render.light_direction = Vec3f(static_cast<float>(std::sin(azimuth) * std::cos(elevation)),
+                                     static_cast<float>(std::sin(elevation)),
+                                     static_cast<float>(std::cos(azimuth) * std::cos(elevation)));
+    o.render.diffuse = static_cast<float>(rng.Uniform(0.5, 0.95));
+    o.render.ambient = static_cast<float>(rng.Uniform(0.12, 0.45));
+    // A second light on the other side (a fill or, from behind, a rim) for half the subjects.
+    if (rng.UniformDouble() < 0.5) {
+      const double a2 = -std::copysign(1.0, azimuth) * rng.Uniform(40.0, 130.0) * M_PI / 180.0;
+      const double e2 = rng.Uniform(-10.0, 40.0) * M_PI / 180.0;
+      o.render.fill_direction = Vec3f(static_cast<float>(std::sin(a2) * std::cos(e2)), static_cast<float>(std::sin(e2)),
+                                      static_cast<float>(std::cos(a2) * std::cos(e2)));
+      o.render.fill = static_cast<float>(rng.Uniform(0.1, 0.4));
+    }
+    o.render.specular = static_cast<float>(rng.Uniform(0.0, 0.14));
+    o.render.shininess = static_cast<float>(rng.Uniform(12.0, 48.0));
+  }
+  if (o.vary.placement) {
+    // Scale 0.75-1.2, and an offset anywhere the head still fits the box with a 0.03 margin.
+    Rng rng(seed, StreamId("synth.scene.placement"));
+    o.head_scale = 0.75 + 0.45 * SpreadUnit(seed, 0.4142135624, rng);
+    const Aabb head = face::FaceModel(face::ShapeParams()).Bounds();
+    for (int a = 0; a < 3; ++a) {
+      const double lo = -0.97 - o.head_scale * head.min[a], hi = 0.97 - o.head_scale * head.max[a];
+      o.head_offset[a] = lo < hi ? rng.Uniform(lo, hi) : 0.5 * (lo + hi);
+    }
+  }
+  if (o.vary.camera) {
+    // Distance 2.8-6 head units; the focal length puts the head at 50-85 % of the image height
+    // (the classic 3.5 / 3.6 is ~80 %).
+    Rng rng(seed, StreamId("synth.scene.camera"));
+    o.camera_distance = rng.Uniform(2.8, 6.0);
+    o.focal_scale = 3.6 * (o.camera_distance / 3.5) * ((0.5 + 0.35 * SpreadUnit(seed, 0.7320508076, rng)) / 0.8);
+  }
+  if (o.vary.views) {
+    Rng rng(seed, StreamId("synth.scene.views"));
+    o.max_yaw_deg = 15.0 + 30.0 * SpreadUnit(seed, 0.2360679775, rng);
+    o.max_pitch_deg = rng.Uniform(5.0, 20.0);
+  }
+  if (o.vary.resolution) {
+    Rng rng(seed, StreamId("synth.scene.resolution"));
+    std::vector<int> sizes;
+    for (int r : {128, 160, 192, 256, 320, 384, 448, 512})
+      if (r <= o.max_drawn_resolution) sizes.push_back(r);
+    o.resolution = sizes[rng.Below(sizes.size())];
+  }
+  return o;
 }
 
 IdentityParams SynthIdentity(const SynthOptions& options) {
   IdentityParams identity = IdentityParams::FromSeed(options.identity_seed);
   if (options.generic_style) identity.style = face::ExpressionStyle::Generic();
+  if (options.vary.skin) DrawDiverseSkin(options.identity_seed, &identity);
+  if (options.vary.detail) DrawFineDetail(options.identity_seed, &identity);
   return identity;
+}
+
+Json SceneInfoJson(const SynthOptions& o, const IdentityParams& id) {
+  auto vec = [](const auto& v) {
+    Json a = Json::array();
+    for (int i = 0; i < 3; ++i) a.push_back(static_cast<double>(v[i]));
+    return a;
+  };
+  Json doc = Json::object();
+  doc["note"] = "The scene of this synthetic dataset (icef synth; not part of the dataset format).";
+  doc["identity_seed"] = o.identity_seed;
+  doc["drawn_axes"] = o.vary.ToString();
+  doc["lighting"] = Json{{"key_direction", vec(o.render.light_direction)}, {"key", o.render.diffuse},
+                         {"ambient", o.render.ambient}, {"fill_direction", vec(o.render.fill_direction)},
+                         {"fill", o.render.fill}, {"specular", o.render.specular}, {"shininess", o.render.shininess}};
+  doc["placement"] = Json{{"head_scale", o.head_scale}, {"head_offset", vec(o.head_offset)}};
+  doc["camera"] = Json{{"distance", o.camera_distance}, {"focal_scale", o.focal_scale}};
+  doc["views"] = Json{{"max_yaw_deg", o.max_yaw_deg}, {"max_pitch_deg", o.max_pitch_deg}};
+  doc["resolution"] = o.resolution;
+  doc["skin"] = Json{{"skin_tone", vec(id.skin_tone)}, {"lip_color", vec(id.lip_color)},
+                     {"brow_color", vec(id.brow_color)}, {"hair_color", vec(id.hair_color)}};
+  doc["detail"] = Json{{"pore_strength", id.pore_strength}, {"pore_scale", id.pore_scale},
+                       {"wrinkle_strength", id.wrinkle_strength}, {"stubble_density", id.stubble_density}};
+  return doc;
+}
+
+Camera WorldFromHead(const SynthOptions& options, const Camera& head_camera) {
+  Mat4d m = head_camera.world_from_cam();
+  m.block<3, 1>(0, 3) = options.head_scale * m.block<3, 1>(0, 3) + options.head_offset;
+  return Camera(head_camera.intrinsics(), m);
 }
 
 Json StyleInfoJson(const SynthOptions& options, const IdentityParams& identity, const face::StyleGap& gap) {
@@ -155,9 +300,12 @@ std::vector<float> NovelCandidate(Tier tier, const std::vector<std::vector<float
 
 }  // namespace
 
-Result<SynthPlan> PlanSynthesis(const SynthOptions& o) {
-  ICEF_RETURN_IF_ERROR(o.Validate());
+Result<SynthPlan> PlanSynthesis(const SynthOptions& options) {
+  ICEF_RETURN_IF_ERROR(options.Validate());
   SynthPlan plan;
+  plan.resolved = ResolveScene(options);
+  const SynthOptions& o = plan.resolved;
+  ICEF_RETURN_IF_ERROR(o.Validate().WithContext("the drawn scene"));
   Intrinsics& in = plan.intrinsics;
   in.width = in.height = o.resolution;
   in.fl_x = in.fl_y = o.focal_scale * o.resolution;
@@ -189,6 +337,10 @@ Result<SynthPlan> PlanSynthesis(const SynthOptions& o) {
     }
     plan.test_cameras.push_back(best);
   }
+  for (const auto* cameras : {&plan.train_cameras, &plan.test_cameras})
+    for (const Camera& c : *cameras)
+      if (WorldFromHead(o, c).Center().cwiseAbs().maxCoeff() <= 1.0)
+        return Status::Error("camera_distance/head_scale/head_offset: a camera lies inside the dataset's box [-1, 1]^3");
   // Test expressions: every training expression (observed), then novel ones per tier.
   for (const auto& beta : plan.train_expressions) plan.test_expressions.push_back({beta, 0.0, Tier::kObserved});
   for (Tier tier : {Tier::kNear, Tier::kModerate, Tier::kFar}) {
@@ -215,15 +367,20 @@ Result<SynthPlan> PlanSynthesis(const SynthOptions& o) {
 
 namespace {
 
-Frame MakeFrame(const HeadModel& head, const Camera& camera, const std::vector<float>& beta, std::string file_path) {
+// A frame seen by `camera` (head frame); its camera and 3D landmarks are stored in the world frame.
+Frame MakeFrame(const SynthOptions& o, const HeadModel& head, const Camera& camera, const std::vector<float>& beta,
+                std::string file_path) {
   Frame f;
   f.file_path = std::move(file_path);
-  f.camera = camera;
+  f.camera = WorldFromHead(o, camera);
   f.expression = beta;
   const LandmarkView lv = ProjectLandmarks(head, camera, beta);
   f.landmarks_2d = lv.landmarks_2d;
   f.landmarks_2d_visible = lv.visible;
-  f.landmarks_3d = lv.landmarks_3d;
+  std::vector<Vec3f> world;
+  for (const Vec3f& p : lv.landmarks_3d)
+    world.push_back((o.head_scale * p.cast<double>() + o.head_offset).cast<float>());
+  f.landmarks_3d = world;
   return f;
 }
 
@@ -239,9 +396,10 @@ int64_t SynthImageCount(const SynthOptions& o) {
   return o.num_train + o.test_views + int64_t(o.num_train + 3 * o.novel_per_tier) * o.test_views;
 }
 
-Status SynthesizeDataset(const SynthOptions& options, const Executor& executor, ProgressBar* progress,
+Status SynthesizeDataset(const SynthOptions& requested, const Executor& executor, ProgressBar* progress,
                          Dataset* written, face::StyleGap* style_gap) {
-  ICEF_ASSIGN_OR_RETURN(const SynthPlan plan, PlanSynthesis(options));
+  ICEF_ASSIGN_OR_RETURN(const SynthPlan plan, PlanSynthesis(requested));
+  const SynthOptions& options = plan.resolved;
   std::error_code ec;
   fs::create_directories(options.out_dir / "images", ec);
   if (ec) return Status::Error((options.out_dir / "images").string() + ": cannot create directory: " + ec.message());
@@ -259,39 +417,44 @@ Status SynthesizeDataset(const SynthOptions& options, const Executor& executor, 
 
   const int num_views = static_cast<int>(plan.test_cameras.size());
   int64_t done = 0;
-  auto render = [&](Frame frame) -> Result<Frame> {
-    const Image image = RenderGroundTruth(head, frame.camera, frame.expression, executor, options.render);
+  // Renders in the head frame (the ground-truth renderer's), through the camera the frame was made from.
+  auto render = [&](Frame frame, const Camera& head_camera) -> Result<Frame> {
+    const Image image = RenderGroundTruth(head, head_camera, frame.expression, executor, options.render);
     ICEF_RETURN_IF_ERROR(WritePng(ds.root / frame.file_path, image));
     if (progress) progress->Update(++done, frame.file_path);
     return frame;
   };
   for (int k = 0; k < options.num_train; ++k) {
-    ICEF_ASSIGN_OR_RETURN(Frame f, render(MakeFrame(head, plan.train_cameras[k], plan.train_expressions[k],
-                                                    Numbered("train", k))));
+    ICEF_ASSIGN_OR_RETURN(Frame f, render(MakeFrame(options, head, plan.train_cameras[k], plan.train_expressions[k],
+                                                    Numbered("train", k)),
+                                          plan.train_cameras[k]));
     ds.train.push_back(std::move(f));
   }
   const std::vector<float> neutral(face::kNumExpressions, 0.f);
   std::vector<Frame> neutral_frames;  // [V]: their landmarks go into the test frames of the view
   for (int v = 0; v < num_views; ++v) {
-    ICEF_ASSIGN_OR_RETURN(Frame f, render(MakeFrame(head, plan.test_cameras[v], neutral, Numbered("test_neutral", v))));
+    ICEF_ASSIGN_OR_RETURN(Frame f, render(MakeFrame(options, head, plan.test_cameras[v], neutral,
+                                                    Numbered("test_neutral", v)),
+                                          plan.test_cameras[v]));
     neutral_frames.push_back(std::move(f));
   }
   int index = 0;
   for (const TestExpression& t : plan.test_expressions) {
     for (int v = 0; v < num_views; ++v) {
-      Frame frame = MakeFrame(head, plan.test_cameras[v], t.beta, Numbered("test", index++));
+      Frame frame = MakeFrame(options, head, plan.test_cameras[v], t.beta, Numbered("test", index++));
       frame.delta = t.delta;
       frame.tier = t.tier;
       frame.neutral_file_path = neutral_frames[v].file_path;
       frame.neutral_landmarks_2d = neutral_frames[v].landmarks_2d;
       frame.neutral_landmarks_3d = neutral_frames[v].landmarks_3d;
-      ICEF_ASSIGN_OR_RETURN(Frame f, render(std::move(frame)));
+      ICEF_ASSIGN_OR_RETURN(Frame f, render(std::move(frame), plan.test_cameras[v]));
       ds.test.push_back(std::move(f));
     }
   }
   ICEF_RETURN_IF_ERROR(SaveDataset(ds));
   ICEF_RETURN_IF_ERROR(
       WriteFileAtomic(options.out_dir / kStyleInfoFile, FormatJson(StyleInfoJson(options, identity, gap))));
+  ICEF_RETURN_IF_ERROR(WriteFileAtomic(options.out_dir / kSceneInfoFile, FormatJson(SceneInfoJson(options, identity))));
   if (style_gap) *style_gap = gap;
   if (progress) progress->Finish(std::to_string(ds.train.size()) + " train, " + std::to_string(ds.test.size()) + " test frames");
   if (written) *written = std::move(ds);

@@ -25,6 +25,32 @@
 
 namespace icef::synth {
 
+// The scene axes `icef synth --diverse` draws per identity seed, each from its own stream
+// Rng(seed, "synth.scene.<axis>") so that pinning one leaves the others' draws unchanged. An axis
+// not drawn keeps the classic studio values of SynthOptions (the datasets of every committed
+// report): one key light, a light-to-mid skin palette, the head centred in the box at scale 1.
+// The main value of each axis (skin tone, key azimuth, head scale, head size in the image, yaw
+// spread) is spread over consecutive seeds (SpreadUnit), so six consecutive seeds span it.
+struct SceneAxes {
+  bool skin = false;        // very light to very dark skin, lips/brows/hair to match (identity.h)
+  bool lighting = false;    // key direction and strength, fill ratio, a second light, specular sheen
+  bool placement = false;   // the head's scale and offset inside the dataset's aabb
+  bool camera = false;      // camera distance and focal length (the head's size in the image)
+  bool views = false;       // view spread: largest yaw 15-45 degrees, largest pitch 5-20
+  bool resolution = false;  // image resolution, 128 up to SynthOptions::max_drawn_resolution
+  bool detail = false;      // denser fine albedo detail: pores, wrinkles, stubble (identity.h)
+
+  static SceneAxes All();
+  bool Any() const;
+  bool operator==(const SceneAxes&) const = default;
+  // "skin,lighting,..." of the drawn axes ("none" when none is).
+  std::string ToString() const;
+  // The axis names in order.
+  static const std::vector<std::string>& Names();
+  // Sets the named axis (one of Names()) to `value`; an error names the unknown axis.
+  Status Set(const std::string& name, bool value);
+};
+
 struct SynthOptions {
   // Output directory (created; existing files of the same names are replaced).
   std::filesystem::path out_dir;
@@ -51,8 +77,16 @@ struct SynthOptions {
   // Largest |yaw| and |pitch| of the training views, degrees.
   double max_yaw_deg = 35.0;
   double max_pitch_deg = 15.0;
+  // The head's placement in the world (dataset) frame: x_world = head_scale * x_head +
+  // head_offset. The dataset's aabb stays [-1, 1]^3; Validate() requires the head inside it.
+  double head_scale = 1.0;
+  Vec3d head_offset = Vec3d::Zero();
   // Ground-truth renderer settings.
   RenderOptions render;
+  // Axes drawn per identity seed (ResolveScene); drawn values replace the fields above.
+  SceneAxes vary;
+  // Largest resolution the resolution axis draws (from 128, 160, 192, 256, 320, 384, 448, 512).
+  int max_drawn_resolution = 512;
 
   Status Validate() const;
   std::string ToString() const;
@@ -65,9 +99,19 @@ struct TestExpression {
   Tier tier = Tier::kObserved;
 };
 
+// The options with every axis of `vary` drawn for identity_seed (lighting, placement, camera,
+// views, resolution; skin and detail are identity fields, drawn by SynthIdentity). Pure function.
+SynthOptions ResolveScene(const SynthOptions& options);
+
 // The subject a dataset is rendered with: IdentityParams::FromSeed(identity_seed), with the
-// generic expression style when generic_style is set.
+// generic expression style when generic_style is set, and the skin and detail axes drawn when
+// `vary` asks for them.
 IdentityParams SynthIdentity(const SynthOptions& options);
+
+// The file SynthesizeDataset writes beside the transforms that records the scene: the drawn axes
+// and their values (lighting, placement, camera, views, resolution, skin, detail).
+inline constexpr char kSceneInfoFile[] = "scene.json";
+Json SceneInfoJson(const SynthOptions& resolved, const IdentityParams& identity);
 
 // The file SynthesizeDataset writes beside the transforms, and its contents: the seed, the
 // identity's expression style (every ExpressionStyle field) and its StyleGap at weight 1.
@@ -75,7 +119,10 @@ inline constexpr char kStyleInfoFile[] = "style.json";
 Json StyleInfoJson(const SynthOptions& options, const IdentityParams& identity, const face::StyleGap& gap);
 
 // Everything drawn for a dataset before rendering (cheap; used by the tests and the writer).
+// PlanSynthesis resolves the scene first (ResolveScene); cameras are in the head frame, which the
+// dataset's world frame is after WorldFromHead.
 struct SynthPlan {
+  SynthOptions resolved;  // ResolveScene(options)
   Intrinsics intrinsics;
   std::vector<Camera> train_cameras;                 // [K]
   std::vector<std::vector<float>> train_expressions;  // [K][face::kNumExpressions]
@@ -92,6 +139,10 @@ Tier TierForDelta(double delta, double near_threshold, double far_threshold);
 // A camera at `distance` from the origin at (yaw, pitch) degrees looking at the origin (yaw 0,
 // pitch 0 looks at the face along -z).
 Camera OrbitCamera(const Intrinsics& intrinsics, double distance, double yaw_deg, double pitch_deg);
+
+// The camera of the dataset's world frame that sees the head at options.head_scale/head_offset
+// exactly as `head_camera` sees it at scale 1 in the head frame (same rotation and intrinsics).
+Camera WorldFromHead(const SynthOptions& options, const Camera& head_camera);
 
 // Number of images SynthesizeDataset writes (the progress total): K + V + (K + 3 n) V.
 int64_t SynthImageCount(const SynthOptions& options);

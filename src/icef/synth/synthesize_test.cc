@@ -105,7 +105,7 @@ TEST(SynthesizeTest, WritesALoadableDeterministicDataset) {
     if (rel.extension() == ".png") differing += *ReadFile(entry.path()) != *ReadFile(c / rel);
   }
   const int images = static_cast<int>(SynthImageCount(Tiny(a, 5)));
-  EXPECT_EQ(files, images + 3);  // + transforms_train.json, transforms_test.json, style.json
+  EXPECT_EQ(files, images + 4);  // + transforms_train.json, transforms_test.json, style.json, scene.json
   EXPECT_EQ(differing, images);
 
   const Result<Dataset> loaded = LoadDataset(a);
@@ -139,6 +139,11 @@ TEST(SynthesizeTest, WritesALoadableDeterministicDataset) {
   const Result<Image> sheet = MakeContactSheet(ds, ContactSheetOptions());
   ASSERT_TRUE(sheet.ok()) << sheet.status().message();
   EXPECT_GT(sheet->width, 3 * 96);
+  // Several datasets: one row of training frames each.
+  const Result<Image> rows = MakeTrainingSheet({ds, ds}, ContactSheetOptions{.tile = 32});
+  ASSERT_TRUE(rows.ok()) << rows.status().message();
+  EXPECT_EQ(rows->height, 4 + 2 * (32 + 12 + 4));
+  EXPECT_EQ(rows->width, 4 + 3 * (32 + 4));
   fs::remove_all(a), fs::remove_all(b), fs::remove_all(c);
 }
 
