@@ -29,6 +29,9 @@ grep -q "lpips: unavailable" "$WORK/out.txt" || fail "LPIPS not reported as unav
 test -s "$WORK/eval/metrics.json" || fail "no metrics.json"
 [ "$(ls "$WORK/eval/renders" | grep -c '^test_.*\.png$')" = 6 ] || fail "expected 6 renders"
 test -s "$WORK/eval/renders/neutral_000.png" || fail "no neutral render"
+[ "$(ls "$WORK/eval/renders" | grep -c '^fit_train_.*\.png$')" = 3 ] || fail "expected 3 training-view renders"
+grep -Eq "^training-view fit: face-region PSNR [0-9.]+ dB \(worst [0-9.]+, 3 views\), full image [0-9.]+ dB$" \
+  "$WORK/out.txt" || fail "no training-view fit line"
 
 # Schema: every frame and tier key present; LPIPS null; PSNR/SSIM numbers; identity numbers
 # whenever the face-identity model is installed (the dataset has landmarks).
@@ -58,6 +61,13 @@ for t, v in m["tiers"].items():
     frames = [f for f in m["frames"] if f["tier"] == t]
     assert abs(v["psnr"] - sum(f["psnr"] for f in frames) / len(frames)) < 1e-9
     assert v["lpips"] is None
+fit = m["train_fit"]
+assert fit["count"] == 3 and fit["face_count"] == 3 and len(fit["frames"]) == 3, fit
+for f in fit["frames"]:
+    assert isinstance(f["face_psnr"], float) and isinstance(f["psnr"], float) and f["face_pixels"] > 0, f
+    assert os.path.exists(os.path.join(os.path.dirname(sys.argv[1]), f["render"])), f
+assert abs(fit["face_psnr"] - sum(f["face_psnr"] for f in fit["frames"]) / 3) < 1e-9
+assert fit["face_psnr_min"] == min(f["face_psnr"] for f in fit["frames"])
 print("metrics.json ok; identity available:", m["identity_available"])
 PY
 

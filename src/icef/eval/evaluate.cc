@@ -1,5 +1,6 @@
 #include "icef/eval/evaluate.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -239,6 +240,91 @@ std::array<TierMetrics, kNumTiers> AggregateTiers(const std::vector<FrameMetrics
   return out;
 }
 
+Json TrainFrameFit::ToJson() const {
+  Json j;
+  j["file_path"] = file_path;
+  j["face_psnr"] = OptionalJson(face_psnr);
+  j["face_pixels"] = face_pixels;
+  j["psnr"] = OptionalJson(psnr);
+  j["render"] = render_path;
+  return j;
+}
+
+Result<TrainFrameFit> TrainFrameFit::FromJson(const Json& j, const std::string& where) {
+  if (!j.is_object()) return Status::Error(where + ": expected an object, got " + JsonTypeDescription(j));
+  TrainFrameFit f;
+  const auto path = j.find("file_path");
+  if (path == j.end() || !path->is_string()) return Status::Error(where + ".file_path: expected a string");
+  f.file_path = path->get<std::string>();
+  ICEF_ASSIGN_OR_RETURN(f.face_psnr, OptionalNumber(j, where, "face_psnr"));
+  ICEF_ASSIGN_OR_RETURN(f.psnr, OptionalNumber(j, where, "psnr"));
+  if (j.contains("face_pixels") && j["face_pixels"].is_number_integer()) f.face_pixels = j["face_pixels"].get<int>();
+  f.render_path = OptionalString(j, "render");
+  return f;
+}
+
+TrainingFit TrainingFit::Of(std::vector<TrainFrameFit> frames) {
+  TrainingFit fit;
+  fit.count = static_cast<int>(frames.size());
+  double face_sum = 0, psnr_sum = 0;
+  int psnr_n = 0;
+  for (const TrainFrameFit& f : frames) {
+    if (f.face_psnr) {
+      face_sum += *f.face_psnr, ++fit.face_count;
+      fit.face_psnr_min = std::min(fit.face_psnr_min.value_or(*f.face_psnr), *f.face_psnr);
+    }
+    if (f.psnr) psnr_sum += *f.psnr, ++psnr_n;
+  }
+  if (fit.face_count > 0) fit.face_psnr = face_sum / fit.face_count;
+  if (psnr_n > 0) fit.psnr = psnr_sum / psnr_n;
+  fit.frames = std::move(frames);
+  return fit;
+}
+
+Json TrainingFit::ToJson() const {
+  Json j;
+  j["count"] = count;
+  j["face_count"] = face_count;
+  j["face_psnr"] = OptionalJson(face_psnr);
+  j["face_psnr_min"] = OptionalJson(face_psnr_min);
+  j["psnr"] = OptionalJson(psnr);
+  Json frames_json = Json::array();
+  for (const TrainFrameFit& f : frames) frames_json.push_back(f.ToJson());
+  j["frames"] = std::move(frames_json);
+  return j;
+}
+
+Result<TrainingFit> TrainingFit::FromJson(const Json& j, const std::string& where) {
+  if (!j.is_object()) return Status::Error(where + ": expected an object, got " + JsonTypeDescription(j));
+  TrainingFit fit;
+  ICEF_ASSIGN_OR_RETURN(const double count, RequiredNumber(j, where, "count"));
+  if (count < 0 || count != std::floor(count)) return Status::Error(where + ".count: expected a count");
+  fit.count = static_cast<int>(count);
+  if (j.contains("face_count") && j["face_count"].is_number_integer()) fit.face_count = j["face_count"].get<int>();
+  ICEF_ASSIGN_OR_RETURN(fit.face_psnr, OptionalNumber(j, where, "face_psnr"));
+  ICEF_ASSIGN_OR_RETURN(fit.face_psnr_min, OptionalNumber(j, where, "face_psnr_min"));
+  ICEF_ASSIGN_OR_RETURN(fit.psnr, OptionalNumber(j, where, "psnr"));
+  const auto frames = j.find("frames");
+  if (frames == j.end() || !frames->is_array()) return Status::Error(where + ".frames: expected an array");
+  for (size_t i = 0; i < frames->size(); ++i) {
+    ICEF_ASSIGN_OR_RETURN(TrainFrameFit f,
+                          TrainFrameFit::FromJson((*frames)[i], where + ".frames[" + std::to_string(i) + "]"));
+    fit.frames.push_back(std::move(f));
+  }
+  return fit;
+}
+
+std::string TrainingFit::Summary() const {
+  if (count == 0) return "training-view fit: unavailable (no training frame rendered)";
+  const std::string all = std::to_string(count) + " views";
+  if (!face_psnr)
+    return "training-view fit: face-region PSNR unavailable (no landmarks_2d), full image " + Fmt(psnr, "%.2f") +
+           " dB (" + all + ")";
+  const std::string views = face_count == count ? all : std::to_string(face_count) + " of " + all;
+  return "training-view fit: face-region PSNR " + Fmt(face_psnr, "%.2f") + " dB (worst " +
+         Fmt(face_psnr_min, "%.2f") + ", " + views + "), full image " + Fmt(psnr, "%.2f") + " dB";
+}
+
 Json EvalResult::ToJson() const {
   Json j;
   j["method"] = method;
@@ -253,6 +339,7 @@ Json EvalResult::ToJson() const {
   Json tiers_json = Json::object();
   for (Tier t : AllTiers()) tiers_json[TierName(t)] = tiers[TierIndex(t)].ToJson();
   j["tiers"] = std::move(tiers_json);
+  j["train_fit"] = train_fit.ToJson();
   return j;
 }
 
@@ -285,6 +372,10 @@ Result<EvalResult> EvalResult::FromJson(const Json& j, const std::string& origin
     if (it == tiers->end()) return Status::Error(origin + ": tiers." + TierName(t) + ": missing");
     ICEF_ASSIGN_OR_RETURN(r.tiers[TierIndex(t)],
                           TierMetrics::FromJson(*it, origin + ": tiers." + std::string(TierName(t))));
+  }
+  // Metrics files from before the training-view fit have none: it stays empty.
+  if (const auto fit = j.find("train_fit"); fit != j.end() && !fit->is_null()) {
+    ICEF_ASSIGN_OR_RETURN(r.train_fit, TrainingFit::FromJson(*fit, origin + ": train_fit"));
   }
   return r;
 }
@@ -323,6 +414,7 @@ std::string EvalResult::Table() const {
   s << "id_*: face-descriptor distance/cosine of each render to the model's own neutral render (same view); "
        "id_dist_gt: to the ground truth; gt_ref: the ground truth's own distance to its neutral; "
        "id_excess = id_dist - gt_ref (negative: the render moves less than the truth)\n";
+  s << train_fit.Summary() << "\n";
   if (!lpips_available) s << "lpips: unavailable (no weights file given; see docs/evaluation.md)\n";
   if (!identity_available)
     s << "identity: unavailable" << (identity_note.empty() ? "" : " (" + identity_note + ")") << "\n";
@@ -343,13 +435,16 @@ Result<EvalResult> ReadMetricsFile(const fs::path& path) {
 Status EvalOptions::Validate() const {
   if (!std::isfinite(expression_scale))
     return Status::Error("expression_scale: must be a finite number, got " + std::to_string(expression_scale));
+  if (train_fit_frames < 0)
+    return Status::Error("train_fit_frames: must be >= 0, got " + std::to_string(train_fit_frames));
   return Status::Ok();
 }
 
 std::string EvalOptions::ToString() const {
   return "EvalOptions(out_dir=" + out_dir.string() + ", write_neutral_renders=" +
          (write_neutral_renders ? "true" : "false") + ", expression_scale=" + std::to_string(expression_scale) +
-         ", occupancy=" + (occupancy == RenderOccupancyMode::kExpression ? "expression" : "training") + ")";
+         ", occupancy=" + (occupancy == RenderOccupancyMode::kExpression ? "expression" : "training") +
+         ", train_fit_frames=" + std::to_string(train_fit_frames) + ")";
 }
 
 namespace {
@@ -462,8 +557,49 @@ Status MeasureExpressionMetrics(const Frame& frame, const Image& render, const I
   return Status::Ok();
 }
 
-std::string RenderName(const std::string& file_path) {
-  return "renders/" + fs::path(file_path).stem().string() + ".png";
+std::string RenderName(const std::string& file_path, const std::string& prefix = "") {
+  return "renders/" + prefix + fs::path(file_path).stem().string() + ".png";
+}
+
+// The frame's image composited over the background; errors: unreadable, or not the camera's size.
+Result<Image> LoadTruth(const Dataset& dataset, const Frame& frame, const std::string& where) {
+  ICEF_ASSIGN_OR_RETURN(const Image raw, LoadFrameImage(dataset, frame));
+  Image gt = CompositeOver(raw, dataset.background);
+  if (gt.width != frame.camera.width() || gt.height != frame.camera.height())
+    return Status::Error(where + ": image is " + std::to_string(gt.width) + "x" + std::to_string(gt.height) +
+                         ", camera says " + std::to_string(frame.camera.width()) + "x" +
+                         std::to_string(frame.camera.height()));
+  return gt;
+}
+
+std::vector<float> ScaledExpression(const Frame& frame, double scale) {
+  std::vector<float> beta = frame.expression;
+  for (float& v : beta) v = static_cast<float>(scale * v);
+  return beta;
+}
+
+// Indices of up to `max_count` of `n` items, evenly spaced, ascending (all of them when n <= max_count).
+std::vector<size_t> EvenlySpaced(size_t n, int max_count) {
+  const size_t m = std::min(n, static_cast<size_t>(std::max(max_count, 0)));
+  std::vector<size_t> out(m);
+  for (size_t i = 0; i < m; ++i) out[i] = i * n / m;
+  return out;
+}
+
+// The training-view fit of one training frame: full-image PSNR, and PSNR inside the face region
+// (the hull of its landmarks) when it has landmarks.
+Result<TrainFrameFit> MeasureTrainFrame(const Frame& frame, const Image& render, const Image& truth) {
+  TrainFrameFit f;
+  f.file_path = frame.file_path;
+  ICEF_ASSIGN_OR_RETURN(const double psnr, Psnr(render, truth));
+  f.psnr = Finite(psnr);
+  if (!frame.landmarks_2d) return f;
+  const Image face = FaceRegion(truth.width, truth.height, *frame.landmarks_2d);
+  for (float v : face.pixels) f.face_pixels += v > 0.5f;
+  if (f.face_pixels == 0) return f;
+  ICEF_ASSIGN_OR_RETURN(const double face_psnr, Psnr(render, truth, &face));
+  f.face_psnr = Finite(face_psnr);
+  return f;
 }
 
 }  // namespace
@@ -494,15 +630,9 @@ Result<EvalResult> EvaluateModel(const AvatarModel& model, const Dataset& datase
   for (size_t i = 0; i < dataset.test.size(); ++i) {
     const Frame& frame = dataset.test[i];
     const std::string where = dataset.root.string() + ": test frame " + std::to_string(i) + " (" + frame.file_path + ")";
-    ICEF_ASSIGN_OR_RETURN(const Image gt_raw, LoadFrameImage(dataset, frame));
-    const Image gt = CompositeOver(gt_raw, background);
-    if (gt.width != frame.camera.width() || gt.height != frame.camera.height())
-      return Status::Error(where + ": image is " + std::to_string(gt.width) + "x" + std::to_string(gt.height) +
-                           ", camera says " + std::to_string(frame.camera.width()) + "x" +
-                           std::to_string(frame.camera.height()));
-    std::vector<float> beta = frame.expression;
-    for (float& v : beta) v = static_cast<float>(options.expression_scale * v);
-    const RenderedImage render = RenderImage(model, frame.camera, beta, background, executor, options.occupancy);
+    ICEF_ASSIGN_OR_RETURN(const Image gt, LoadTruth(dataset, frame, where));
+    const RenderedImage render = RenderImage(model, frame.camera, ScaledExpression(frame, options.expression_scale),
+                                             background, executor, options.occupancy);
 
     FrameMetrics m;
     m.file_path = frame.file_path;
@@ -573,6 +703,29 @@ Result<EvalResult> EvaluateModel(const AvatarModel& model, const Dataset& datase
     }
   }
   result.tiers = AggregateTiers(result.frames);
+
+  // The training-view fit: training frames rendered back exactly as the test frames.
+  const std::vector<size_t> fit_indices = EvenlySpaced(dataset.train.size(), options.train_fit_frames);
+  std::vector<TrainFrameFit> fits;
+  for (size_t n = 0; n < fit_indices.size(); ++n) {
+    const Frame& frame = dataset.train[fit_indices[n]];
+    const std::string where = dataset.root.string() + ": training frame " + std::to_string(fit_indices[n]) + " (" +
+                              frame.file_path + ")";
+    if (progress)
+      progress->Update(static_cast<int64_t>(dataset.test.size()),
+                       "training view " + std::to_string(n + 1) + "/" + std::to_string(fit_indices.size()));
+    ICEF_ASSIGN_OR_RETURN(const Image gt, LoadTruth(dataset, frame, where));
+    const RenderedImage render = RenderImage(model, frame.camera, ScaledExpression(frame, options.expression_scale),
+                                             background, executor, options.occupancy);
+    Result<TrainFrameFit> fit = MeasureTrainFrame(frame, render.color, gt);
+    if (!fit.ok()) return fit.status().WithContext(where);
+    if (write) {
+      fit->render_path = RenderName(frame.file_path, "fit_");
+      ICEF_RETURN_IF_ERROR(WritePng(out_root / fit->render_path, render.color));
+    }
+    fits.push_back(std::move(*fit));
+  }
+  result.train_fit = TrainingFit::Of(std::move(fits));
   if (progress) progress->Finish();
   return result;
 }

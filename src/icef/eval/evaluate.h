@@ -7,8 +7,13 @@
 // Results are aggregated per tier and written as metrics.json:
 //   {"method", "frames": [{"file_path", "tier", "delta", "psnr", "ssim", "lpips", "id_cosine",
 //    "id_distance", "id_distance_gt", ...extras}], "tiers": {"observed": {"count", "psnr", "ssim",
-//    "lpips", "id_cosine", "id_distance", "id_distance_gt", "id_share_under_0_6", ...}, "near", ...}}
+//    "lpips", "id_cosine", "id_distance", "id_distance_gt", "id_share_under_0_6", ...}, "near", ...},
+//    "train_fit": {"count", "face_count", "face_psnr", "face_psnr_min", "psnr", "frames": [{"file_path",
+//    "face_psnr", "face_pixels", "psnr", "render"}]}}
 // with null wherever a value could not be computed (no LPIPS weights, no face found, ...).
+// train_fit: every training frame rendered back at its own camera and expression, PSNR inside the
+// face region of its landmarks and over the full image: a model that cannot reproduce its own
+// training views is underfitting, whatever its batch PSNR says.
 #pragma once
 
 #include <array>
@@ -101,12 +106,45 @@ struct TierMetrics {
 // Per-tier means of frame metrics (plain arithmetic means in frame order).
 std::array<TierMetrics, kNumTiers> AggregateTiers(const std::vector<FrameMetrics>& frames);
 
+// How well the model reproduces one of its own training frames, rendered back at the frame's camera
+// and expression and compared with its image composited over the background.
+struct TrainFrameFit {
+  std::string file_path;            // the training image, relative to the dataset
+  // PSNR inside the face region (FaceRegion of the frame's landmarks_2d, eval/expression_fidelity.h),
+  // dB; null without landmarks (face_pixels 0) or when infinite (a pixel-perfect face).
+  std::optional<double> face_psnr;
+  int face_pixels = 0;              // pixels in the face region
+  std::optional<double> psnr;       // full image, dB (null only when infinite)
+  std::string render_path;          // relative to the output directory (empty when not written)
+
+  Json ToJson() const;
+  static Result<TrainFrameFit> FromJson(const Json& json, const std::string& where);
+};
+
+// The training-view fit: per-frame values and their means (over the frames with a value).
+struct TrainingFit {
+  std::vector<TrainFrameFit> frames;
+  int count = 0;                        // training frames rendered (0: not measured, e.g. an old metrics.json)
+  int face_count = 0;                   // frames with a face_psnr (in its mean and minimum)
+  std::optional<double> face_psnr;      // mean face-region PSNR, dB
+  std::optional<double> face_psnr_min;  // the worst frame's
+  std::optional<double> psnr;           // mean full-image PSNR, dB
+
+  // Means and minimum of `frames`, in frame order.
+  static TrainingFit Of(std::vector<TrainFrameFit> frames);
+  Json ToJson() const;
+  static Result<TrainingFit> FromJson(const Json& json, const std::string& where);
+  // "training-view fit: face-region PSNR X dB (worst Y, N views), full image Z dB", or why not.
+  std::string Summary() const;
+};
+
 // One model evaluated on one dataset: the content of metrics.json.
 struct EvalResult {
   std::string method;
   double expression_scale = 1;       // every frame was rendered at expression_scale * beta
   std::vector<FrameMetrics> frames;
   std::array<TierMetrics, kNumTiers> tiers;
+  TrainingFit train_fit;             // empty when not measured (metrics files from before it)
   bool identity_available = false;   // the face-descriptor network was loaded
   bool lpips_available = false;      // LPIPS weights were given
   int identity_missing = 0;          // frames whose identity could not be measured (no face)
@@ -133,6 +171,9 @@ struct EvalOptions {
   // Samples placed by the grid of the rendered expression (default) or by the training grid
   // (training expressions only, cut to the training visual hull): `icef eval --training-occupancy`.
   RenderOccupancyMode occupancy = RenderOccupancyMode::kExpression;
+  // Training frames rendered back for EvalResult::train_fit: all of them up to this many, else this
+  // many evenly spaced (few-shot datasets have 3-10; a NerFace video has thousands); 0: none.
+  int train_fit_frames = 64;
   Status Validate() const;
   std::string ToString() const;
 };
@@ -146,10 +187,12 @@ struct EvalNetworks {
 
 // Evaluates `model` on the test frames of `dataset` (expression fidelity needs the frames' 2D
 // landmarks and neutral images; the neutral's landmarks come from neutral_landmarks_2d, else from a
-// dataset frame of the neutral image, else the frame's own hull stands alone). A frame without a tier gets one from its
-// delta (the model's when the frame has none) and the dataset's tier thresholds. Errors:
+// dataset frame of the neutral image, else the frame's own hull stands alone). A frame without a
+// tier gets one from its delta (the model's when the frame has none) and the dataset's tier
+// thresholds. Then renders the training frames back (at expression_scale too; written as
+// renders/fit_<stem>.png) for the training-view fit; their face region needs landmarks_2d. Errors:
 // unreadable images, size mismatches, an expression dimension other than the model's.
-// progress (may be null) counts frames.
+// progress (may be null) counts test frames; its status names the training view being rendered.
 Result<EvalResult> EvaluateModel(const AvatarModel& model, const Dataset& dataset, const EvalOptions& options,
                                  const EvalNetworks& networks, const Executor& executor, ProgressBar* progress);
 

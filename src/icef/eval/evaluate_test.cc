@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
+#include <memory>
 
 #include "icef/eval/expression_fidelity.h"
 #include "icef/eval/metrics.h"
@@ -134,10 +137,67 @@ TEST(EvaluateTest, MetricsFileErrorsNameTheField) {
   fs::remove_all(dir);
 }
 
-// A tiny model trained for a few steps on a tiny synthetic dataset, evaluated end to end.
-TEST(EvaluateTest, EvaluatesTinyTrainedModel) {
-  const fs::path dir = TempDir("model");
-  const Executor executor(2);
+TEST(EvaluateTest, TrainingFitRoundTripsAndOldFilesHaveNone) {
+  // A metrics file from before the training-view fit: it parses, with an empty fit.
+  const Result<EvalResult> old = EvalResult::FromJson(Json::parse(kHandMade), "old.json");
+  ASSERT_TRUE(old.ok()) << old.status().message();
+  EXPECT_EQ(old->train_fit.count, 0);
+  EXPECT_TRUE(old->train_fit.frames.empty());
+  EXPECT_FALSE(old->train_fit.face_psnr.has_value());
+  EXPECT_NE(old->Table().find("training-view fit: unavailable"), std::string::npos) << old->Table();
+  Json null_fit = Json::parse(kHandMade);
+  null_fit["train_fit"] = nullptr;
+  EXPECT_TRUE(EvalResult::FromJson(null_fit, "null.json").ok());
+
+  // Means over the frames with a value; the frame without landmarks has no face PSNR.
+  EvalResult result = *old;
+  result.train_fit =
+      TrainingFit::Of({TrainFrameFit{"images/train_000.png", 32.0, 400, 24.0, "renders/fit_train_000.png"},
+                       TrainFrameFit{"images/train_001.png", 28.0, 380, 26.0, ""},
+                       TrainFrameFit{"images/train_002.png", std::nullopt, 0, 25.0, ""}});
+  const TrainingFit& fit = result.train_fit;
+  EXPECT_EQ(fit.count, 3);
+  EXPECT_EQ(fit.face_count, 2);
+  EXPECT_DOUBLE_EQ(*fit.face_psnr, 30.0);
+  EXPECT_DOUBLE_EQ(*fit.face_psnr_min, 28.0);
+  EXPECT_DOUBLE_EQ(*fit.psnr, 25.0);
+  EXPECT_NE(result.Table().find(
+                "training-view fit: face-region PSNR 30.00 dB (worst 28.00, 2 of 3 views), full image 25.00 dB"),
+            std::string::npos)
+      << result.Table();
+
+  const Json json = result.ToJson();
+  const Json& j = json["train_fit"];
+  EXPECT_EQ(j["count"], 3);
+  EXPECT_EQ(j["face_count"], 2);
+  EXPECT_DOUBLE_EQ(j["face_psnr"].get<double>(), 30.0);
+  EXPECT_DOUBLE_EQ(j["face_psnr_min"].get<double>(), 28.0);
+  ASSERT_EQ(j["frames"].size(), 3u);
+  EXPECT_EQ(j["frames"][0]["file_path"], "images/train_000.png");
+  EXPECT_EQ(j["frames"][0]["render"], "renders/fit_train_000.png");
+  EXPECT_EQ(j["frames"][0]["face_pixels"], 400);
+  EXPECT_TRUE(j["frames"][2]["face_psnr"].is_null());
+  const Result<EvalResult> again = EvalResult::FromJson(json, "new.json");
+  ASSERT_TRUE(again.ok()) << again.status().message();
+  EXPECT_EQ(again->ToJson(), json);
+  EXPECT_EQ(again->train_fit.frames[1].file_path, "images/train_001.png");
+
+  // Errors name the field.
+  Json bad = json;
+  bad["train_fit"]["frames"][1]["psnr"] = "x";
+  Result<EvalResult> r = EvalResult::FromJson(bad, "bad.json");
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.status().message().find("bad.json: train_fit.frames[1].psnr"), std::string::npos)
+      << r.status().message();
+  bad = json;
+  bad["train_fit"].erase("count");
+  r = EvalResult::FromJson(bad, "bad.json");
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.status().message().find("train_fit.count"), std::string::npos) << r.status().message();
+}
+
+// A tiny synthetic dataset (3 training frames, 32 px) in dir/data.
+Dataset TinySyntheticDataset(const fs::path& dir, const Executor& executor) {
   synth::SynthOptions so;
   so.out_dir = dir / "data";
   so.num_train = 3;
@@ -146,10 +206,13 @@ TEST(EvaluateTest, EvaluatesTinyTrainedModel) {
   so.novel_per_tier = 1;
   so.render.supersample = 1;
   Dataset written;
-  ASSERT_TRUE(synth::SynthesizeDataset(so, executor, nullptr, &written).ok());
-  Result<Dataset> dataset = LoadDataset(so.out_dir);
-  ASSERT_TRUE(dataset.ok()) << dataset.status().message();
+  const Status synthesized = synth::SynthesizeDataset(so, executor, nullptr, &written);
+  ICEF_CHECK(synthesized.ok(), synthesized.message());
+  return LoadDataset(so.out_dir).value();
+}
 
+// A tiny icef model trained for `steps` steps on `dataset` (0: as initialised).
+std::unique_ptr<Trainer> TinyTrainer(const Dataset& dataset, const fs::path& dir, int steps) {
   RunConfig config;
   config.model.method = "icef";
   config.model.grid_levels = 4;
@@ -160,32 +223,43 @@ TEST(EvaluateTest, EvaluatesTinyTrainedModel) {
   config.model.deform_hidden = {16, 16};
   config.model.samples_per_ray = 16;
   config.model.occupancy_resolution = 16;
-  config.train.steps = 5;
+  config.train.steps = std::max(steps, 1);  // 0: created, not trained
   config.train.batch_rays = 256;
   config.train.checkpoint_every = 0;
   config.train.threads = 2;
-  Result<std::unique_ptr<Trainer>> trainer = Trainer::Create(*dataset, dir / "model", config);
-  ASSERT_TRUE(trainer.ok()) << trainer.status().message();
-  ASSERT_TRUE((*trainer)->Run(nullptr, nullptr).ok());
-  const AvatarModel& model = (*trainer)->model();
+  std::unique_ptr<Trainer> trainer = Trainer::Create(dataset, dir / "model", config).value();
+  if (steps > 0) {
+    const Result<TrainSummary> trained = trainer->Run(nullptr, nullptr);
+    ICEF_CHECK(trained.ok(), trained.status().message());
+  }
+  return trainer;
+}
+
+// A tiny model trained for a few steps on a tiny synthetic dataset, evaluated end to end.
+TEST(EvaluateTest, EvaluatesTinyTrainedModel) {
+  const fs::path dir = TempDir("model");
+  const Executor executor(2);
+  const Dataset dataset = TinySyntheticDataset(dir, executor);
+  const std::unique_ptr<Trainer> trainer = TinyTrainer(dataset, dir, 5);
+  const AvatarModel& model = trainer->model();
 
   EvalOptions options;
   options.out_dir = dir / "eval";
   EvalNetworks networks;  // no identity network, no LPIPS: those metrics must be null
   networks.identity_note = "test";
-  const Result<EvalResult> result = EvaluateModel(model, *dataset, options, networks, executor, nullptr);
+  const Result<EvalResult> result = EvaluateModel(model, dataset, options, networks, executor, nullptr);
   ASSERT_TRUE(result.ok()) << result.status().message();
   EXPECT_EQ(result->method, "icef");
-  ASSERT_EQ(result->frames.size(), dataset->test.size());
+  ASSERT_EQ(result->frames.size(), dataset.test.size());
   int total = 0;
   for (Tier t : AllTiers()) total += result->tiers[TierIndex(t)].count;
-  EXPECT_EQ(total, static_cast<int>(dataset->test.size()));
+  EXPECT_EQ(total, static_cast<int>(dataset.test.size()));
   EXPECT_EQ(result->tiers[TierIndex(Tier::kObserved)].count, 3);
   EXPECT_EQ(result->tiers[TierIndex(Tier::kFar)].count, 1);
   EXPECT_FALSE(result->identity_available);
   for (size_t i = 0; i < result->frames.size(); ++i) {
     const FrameMetrics& f = result->frames[i];
-    const Frame& frame = dataset->test[i];
+    const Frame& frame = dataset.test[i];
     EXPECT_EQ(f.file_path, frame.file_path);
     EXPECT_EQ(f.tier, *frame.tier);
     EXPECT_DOUBLE_EQ(f.delta, *frame.delta);
@@ -195,8 +269,8 @@ TEST(EvaluateTest, EvaluatesTinyTrainedModel) {
     ASSERT_TRUE(f.ssim.has_value());
     EXPECT_TRUE(fs::exists(options.out_dir / f.render_path)) << f.render_path;
     // The same numbers from an independent render at the frame's camera and expression.
-    const RenderedImage r = RenderImage(model, frame.camera, frame.expression, dataset->background, executor);
-    const Image gt = CompositeOver(*LoadFrameImage(*dataset, frame), dataset->background);
+    const RenderedImage r = RenderImage(model, frame.camera, frame.expression, dataset.background, executor);
+    const Image gt = CompositeOver(*LoadFrameImage(dataset, frame), dataset.background);
     EXPECT_DOUBLE_EQ(*f.psnr, *Psnr(r.color, gt));
     EXPECT_DOUBLE_EQ(*f.ssim, *Ssim(r.color, gt));
     EXPECT_NEAR(f.model_delta, *frame.delta, 1e-5);
@@ -211,12 +285,40 @@ TEST(EvaluateTest, EvaluatesTinyTrainedModel) {
   }
   const TierMetrics& far = result->tiers[TierIndex(Tier::kFar)];
   EXPECT_EQ(far.expr_count + far.expr_negligible, far.count);
+  // The training-view fit: every training frame rendered back, with finite values equal to an
+  // independent render's; the face region is the hull of the frame's landmarks.
+  const TrainingFit& fit = result->train_fit;
+  ASSERT_EQ(fit.count, static_cast<int>(dataset.train.size()));
+  ASSERT_EQ(fit.frames.size(), dataset.train.size());
+  EXPECT_EQ(fit.face_count, fit.count);
+  ASSERT_TRUE(fit.face_psnr && fit.face_psnr_min && fit.psnr);
+  EXPECT_LE(*fit.face_psnr_min, *fit.face_psnr);
+  for (size_t i = 0; i < fit.frames.size(); ++i) {
+    const TrainFrameFit& f = fit.frames[i];
+    const Frame& frame = dataset.train[i];
+    EXPECT_EQ(f.file_path, frame.file_path);
+    ASSERT_TRUE(f.psnr && f.face_psnr) << f.file_path;
+    EXPECT_TRUE(std::isfinite(*f.psnr) && std::isfinite(*f.face_psnr));
+    const RenderedImage r = RenderImage(model, frame.camera, frame.expression, dataset.background, executor);
+    const Image gt = CompositeOver(*LoadFrameImage(dataset, frame), dataset.background);
+    const Image face = FaceRegion(gt.width, gt.height, *frame.landmarks_2d);
+    int pixels = 0;
+    for (float v : face.pixels) pixels += v > 0.5f;
+    EXPECT_EQ(f.face_pixels, pixels);
+    EXPECT_GT(f.face_pixels, 0);
+    EXPECT_LT(f.face_pixels, gt.width * gt.height);
+    EXPECT_DOUBLE_EQ(*f.psnr, *Psnr(r.color, gt));
+    EXPECT_DOUBLE_EQ(*f.face_psnr, *Psnr(r.color, gt, &face));
+    EXPECT_EQ(f.render_path, "renders/fit_" + fs::path(frame.file_path).stem().string() + ".png");
+    EXPECT_TRUE(fs::exists(options.out_dir / f.render_path)) << f.render_path;
+  }
+  EXPECT_TRUE(fs::exists(options.out_dir / "renders" / "fit_train_000.png"));
 
   // A model that renders no expression (every frame at 0 x beta): its change against its own neutral
   // is exactly zero, so it reproduces none of the expression, and scores the render's neutral PSNR.
   EvalOptions still;
   still.expression_scale = 0;
-  const Result<EvalResult> zero = EvaluateModel(model, *dataset, still, networks, executor, nullptr);
+  const Result<EvalResult> zero = EvaluateModel(model, dataset, still, networks, executor, nullptr);
   ASSERT_TRUE(zero.ok()) << zero.status().message();
   EXPECT_EQ(zero->expression_scale, 0.0);
   int gains = 0;
@@ -244,12 +346,12 @@ TEST(EvaluateTest, EvaluatesTinyTrainedModel) {
     EXPECT_EQ(ComparePair(aggregate, 3, tier, "warp", "icef").outcome, Outcome::kUnderExpresses) << TierName(tier);
 
   // Frames without a stored tier get it from their delta and the dataset's thresholds.
-  Dataset untiered = *dataset;
+  Dataset untiered = dataset;
   for (Frame& f : untiered.test) f.tier.reset();
   EvalOptions no_renders;
   const Result<EvalResult> derived = EvaluateModel(model, untiered, no_renders, networks, executor, nullptr);
   ASSERT_TRUE(derived.ok()) << derived.status().message();
-  for (size_t i = 0; i < derived->frames.size(); ++i) EXPECT_EQ(derived->frames[i].tier, *dataset->test[i].tier) << i;
+  for (size_t i = 0; i < derived->frames.size(); ++i) EXPECT_EQ(derived->frames[i].tier, dataset.test[i].tier) << i;
 
   // With the face-identity network (when installed): identity metrics on every frame where a
   // face chip could be made (the dataset has landmarks, so all of them).
@@ -257,7 +359,7 @@ TEST(EvaluateTest, EvaluatesTinyTrainedModel) {
   if (identity.ok()) {
     networks.identity = &*identity;
     options.out_dir.clear();
-    const Result<EvalResult> with_id = EvaluateModel(model, *dataset, options, networks, executor, nullptr);
+    const Result<EvalResult> with_id = EvaluateModel(model, dataset, options, networks, executor, nullptr);
     ASSERT_TRUE(with_id.ok()) << with_id.status().message();
     EXPECT_TRUE(with_id->identity_available);
     for (const FrameMetrics& f : with_id->frames) {
@@ -278,6 +380,48 @@ TEST(EvaluateTest, EvaluatesTinyTrainedModel) {
                   with_id->tiers[2].id_count + with_id->tiers[3].id_count,
               static_cast<int>(with_id->frames.size()));
   }
+  fs::remove_all(dir);
+}
+
+// The training-view fit measures the face where the face is: ground truth that equals the model's
+// render inside each training frame's landmark hull and differs strongly outside it scores a face
+// PSNR limited only by the 8-bit PNG (about 59 dB), while the full-image PSNR is low. Were the face
+// region the whole image, both would be low.
+TEST(EvaluateTest, TrainingFitFaceRegionIsTheLandmarkHull) {
+  const fs::path dir = TempDir("fit");
+  const Executor executor(2);
+  const Dataset original = TinySyntheticDataset(dir, executor);
+  const std::unique_ptr<Trainer> trainer = TinyTrainer(original, dir, 0);
+  const AvatarModel& model = trainer->model();
+
+  fs::copy(dir / "data", dir / "fake", fs::copy_options::recursive);
+  Result<Dataset> fake = LoadDataset(dir / "fake");
+  ASSERT_TRUE(fake.ok()) << fake.status().message();
+  for (const Frame& frame : fake->train) {
+    Image image = RenderImage(model, frame.camera, frame.expression, fake->background, executor).color;
+    const Image face = FaceRegion(image.width, image.height, *frame.landmarks_2d);
+    for (int y = 0; y < image.height; ++y)
+      for (int x = 0; x < image.width; ++x)
+        if (face.At(x, y, 0) < 0.5f)
+          for (int c = 0; c < 3; ++c) image.At(x, y, c) = image.At(x, y, c) < 0.5f ? 1.f : 0.f;
+    ASSERT_TRUE(WritePng(fake->ImagePath(frame), image).ok());
+  }
+  EvalOptions options;  // no renders written
+  const Result<EvalResult> result = EvaluateModel(model, *fake, options, EvalNetworks{}, executor, nullptr);
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  ASSERT_EQ(result->train_fit.frames.size(), fake->train.size());
+  for (const TrainFrameFit& f : result->train_fit.frames) {
+    EXPECT_GT(f.face_pixels, 0);
+    EXPECT_TRUE(f.render_path.empty());
+    ASSERT_TRUE(f.psnr.has_value());
+    EXPECT_LT(*f.psnr, 15.0) << f.file_path;  // at least 0.5 off on every channel outside the hull
+    if (f.face_psnr) EXPECT_GT(*f.face_psnr, 50.0) << f.file_path;  // null: identical (infinite)
+  }
+  // Only the training views were changed: the test frames' numbers are those of the original.
+  const Result<EvalResult> reference = EvaluateModel(model, original, options, EvalNetworks{}, executor, nullptr);
+  ASSERT_TRUE(reference.ok()) << reference.status().message();
+  EXPECT_EQ(result->frames[0].psnr, reference->frames[0].psnr);
+  EXPECT_GT(*reference->train_fit.psnr, *result->train_fit.psnr);
   fs::remove_all(dir);
 }
 

@@ -91,6 +91,19 @@ Image ExpressionRegion(int width, int height, const std::vector<Vec2f>& frame_la
   return region;
 }
 
+Image FaceRegion(int width, int height, const std::vector<Vec2f>& landmarks) {
+  Image region(width, height, 1, 0.f);
+  std::vector<Vec2d> points;
+  for (const Vec2f& l : landmarks)
+    if (std::isfinite(l.x()) && std::isfinite(l.y())) points.emplace_back(l.x(), l.y());
+  const std::vector<Vec2d> hull = ConvexHull(std::move(points));
+  if (hull.size() < 3) return region;
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x)
+      if (InDilatedHull(hull, Vec2d(x + 0.5, y + 0.5), 0.0)) region.At(x, y, 0) = 1.f;
+  return region;
+}
+
 Result<ExpressionFidelity> MeasureExpression(const Image& render, const Image& render_neutral, const Image& truth,
                                              const Image& truth_neutral, const Image& region) {
   for (const Image* image : {&render, &render_neutral, &truth, &truth_neutral}) {

@@ -11,6 +11,8 @@
 //     expr_corr = <m, t> / (|m| |t|) (cosine; null when the model's change is exactly zero)
 // - A frame whose true change is negligible (RMS of t over the region below
 //   kNegligibleExpressionRms) gets no gain or cosine: they would divide by nearly nothing.
+// - Face region (FaceRegion): the filled hull of all 68 landmarks, for the training-view fit
+//   (eval/evaluate.h).
 #pragma once
 
 #include <optional>
@@ -35,6 +37,13 @@ int DefaultRegionDilation(int width);
 // frame's hull alone). Landmarks are in pixel coordinates (pixel centres at +0.5).
 Image ExpressionRegion(int width, int height, const std::vector<Vec2f>& frame_landmarks,
                        const std::vector<Vec2f>& neutral_landmarks, int dilation);
+
+// 1-channel mask (1 inside, 0 outside) of the face region: the pixels whose centres (+0.5) lie in
+// or on the filled 2D convex hull of all finite landmarks (the 68 points, jaw line included;
+// visibility flags are not consulted: an occluded point still projects onto the face). Points
+// outside the image still shape the hull, which the image then clips. Fewer than three
+// non-collinear points: an empty mask.
+Image FaceRegion(int width, int height, const std::vector<Vec2f>& landmarks);
 
 struct ExpressionFidelity {
   int pixels = 0;             // pixels in the region

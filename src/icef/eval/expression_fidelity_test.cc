@@ -43,6 +43,35 @@ TEST(ExpressionFidelityTest, RegionIsTheDilatedHullOfBothLandmarkSets) {
   EXPECT_EQ(alone.At(21, 21, 0), 0.f);
 }
 
+int Count(const Image& mask) {
+  int n = 0;
+  for (float v : mask.pixels) n += v > 0.5f;
+  return n;
+}
+
+TEST(ExpressionFidelityTest, FaceRegionIsTheFilledLandmarkHull) {
+  // A square [2, 10]^2 of landmarks (corners, edge midpoints, the centre), plus unusable points.
+  const float nan = std::nanf("");
+  const std::vector<Vec2f> square = {{2, 2}, {10, 2}, {10, 10}, {2, 10}, {6, 2}, {6, 6}, {nan, 3}, {4, INFINITY}};
+  const Image region = FaceRegion(16, 12, square);
+  ASSERT_EQ(region.width, 16);
+  ASSERT_EQ(region.height, 12);
+  EXPECT_EQ(Count(region), 64);  // pixel centres 2.5 .. 9.5: 8 x 8
+  EXPECT_EQ(region.At(2, 2, 0), 1.f);
+  EXPECT_EQ(region.At(9, 9, 0), 1.f);
+  EXPECT_EQ(region.At(10, 5, 0), 0.f);
+  EXPECT_EQ(region.At(1, 5, 0), 0.f);
+  // Not a bounding box: a right triangle (0,0), (8,0), (0,8) holds the 36 centres with x + y <= 7.
+  EXPECT_EQ(Count(FaceRegion(16, 12, {{0, 0}, {8, 0}, {0, 8}})), 36);
+  // Points outside the image shape the hull; the image clips it.
+  EXPECT_EQ(Count(FaceRegion(16, 12, {{-4, -4}, {4, -4}, {4, 4}, {-4, 4}})), 16);
+  EXPECT_EQ(Count(FaceRegion(16, 12, {{-10, -10}, {30, -10}, {30, 30}, {-10, 30}})), 16 * 12);
+  // Fewer than three usable or non-collinear points: nothing.
+  EXPECT_EQ(Count(FaceRegion(16, 12, {})), 0);
+  EXPECT_EQ(Count(FaceRegion(16, 12, {{2, 2}, {10, 10}, {nan, nan}})), 0);
+  EXPECT_EQ(Count(FaceRegion(16, 12, {{2, 2}, {6, 6}, {10, 10}})), 0);
+}
+
 TEST(ExpressionFidelityTest, KnownGains) {
   const Image region = ExpressionRegion(32, 32, BoxLandmarks(8, 8, 24, 24), {}, 0);
   const Image truth_neutral = Pattern(0.3f, 0.f);

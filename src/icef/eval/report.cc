@@ -163,6 +163,24 @@ const AggregateCell* Aggregate::Find(int k, const std::string& method, Tier tier
   return nullptr;
 }
 
+const TrainFitCell* Aggregate::FindTrainFit(int k, const std::string& method) const {
+  for (const TrainFitCell& c : train_fit)
+    if (c.k == k && c.method == method) return &c;
+  return nullptr;
+}
+
+Json TrainFitCell::ToJson() const {
+  auto spread = [](const std::optional<Spread>& v) { return v ? v->ToJson() : Json(nullptr); };
+  return Json{{"k", k},
+              {"method", method},
+              {"runs", runs},
+              {"face_psnr", spread(face_psnr)},
+              {"face_psnr_min", spread(face_psnr_min)},
+              {"psnr", spread(psnr)}};
+}
+
+bool ReportContext::PerIdentity() const { return per_identity || identity_role.rfind("validation", 0) == 0; }
+
 namespace {
 
 int MethodOrder(const std::string& name) {
@@ -259,6 +277,27 @@ Aggregate AggregateRuns(const std::vector<RunRecord>& runs) {
         for (int m = 0; m < kNumMetrics; ++m) cell.metrics[m] = Spread::Of(values[m]);
         a.cells.push_back(std::move(cell));
       }
+    }
+
+  for (int k : a.ks)
+    for (const std::string& method : a.methods) {
+      const auto it = by_cell.find({k, method});
+      if (it == by_cell.end()) continue;
+      TrainFitCell cell;
+      cell.k = k;
+      cell.method = method;
+      std::vector<double> face, face_min, psnr;
+      for (const RunRecord* r : it->second) {
+        const TrainingFit& fit = r->metrics.train_fit;
+        if (fit.count > 0) ++cell.runs;
+        if (fit.face_psnr) face.push_back(*fit.face_psnr);
+        if (fit.face_psnr_min) face_min.push_back(*fit.face_psnr_min);
+        if (fit.psnr) psnr.push_back(*fit.psnr);
+      }
+      cell.face_psnr = Spread::Of(face);
+      cell.face_psnr_min = Spread::Of(face_min);
+      cell.psnr = Spread::Of(psnr);
+      a.train_fit.push_back(std::move(cell));
     }
 
   // Far tier: icef against every other method, per K, on PSNR and identity similarity.
@@ -405,6 +444,87 @@ std::vector<std::string> Verdict(const Aggregate& a) {
   return lines;
 }
 
+namespace {
+
+std::string Opt(const std::optional<double>& v, const char* format) {
+  if (!v) return "-";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, format, *v);
+  return buf;
+}
+
+// One run's row of the per-identity table.
+struct IdentityRow {
+  const RunRecord* run = nullptr;
+  std::optional<double> train_face_psnr, observed_psnr, far_psnr, observed_region_psnr, observed_id_distance_gt,
+      far_expr_gain;
+};
+
+// The rows of every run, by identity, K and method.
+std::vector<IdentityRow> IdentityRows(const std::vector<RunRecord>& runs) {
+  std::vector<IdentityRow> rows;
+  for (const RunRecord& r : runs) {
+    const TierMetrics& obs = r.metrics.tiers[TierIndex(Tier::kObserved)];
+    const TierMetrics& far = r.metrics.tiers[TierIndex(Tier::kFar)];
+    rows.push_back(IdentityRow{&r, r.metrics.train_fit.face_psnr, obs.psnr, far.psnr, obs.region_psnr,
+                               obs.id_distance_gt, far.expr_gain});
+  }
+  std::stable_sort(rows.begin(), rows.end(), [](const IdentityRow& x, const IdentityRow& y) {
+    const RunId &a = x.run->id, &b = y.run->id;
+    if (a.identity_seed != b.identity_seed) return a.identity_seed < b.identity_seed;
+    if (a.k != b.k) return a.k < b.k;
+    return MethodLess(a.method, b.method);
+  });
+  return rows;
+}
+
+// The identity whose runs have the lowest mean of one value, and its run with the lowest value.
+struct WorstIdentity {
+  uint64_t seed = 0;
+  double mean = 0;
+  int runs = 0;                       // its runs with a value
+  const RunRecord* worst_run = nullptr;
+  double worst_value = 0;
+  Json ToJson() const {
+    return Json{{"identity_seed", seed}, {"mean", mean}, {"runs", runs}, {"worst_run", worst_run->id.Name()},
+                {"worst_value", worst_value}};
+  }
+};
+
+std::optional<WorstIdentity> FindWorstIdentity(const std::vector<IdentityRow>& rows,
+                                               std::optional<double> IdentityRow::*value) {
+  std::map<uint64_t, std::pair<double, int>> sums;  // seed -> (sum, count)
+  for (const IdentityRow& row : rows)
+    if (const std::optional<double>& v = row.*value) {
+      auto& [sum, n] = sums[row.run->id.identity_seed];
+      sum += *v, ++n;
+    }
+  std::optional<WorstIdentity> worst;
+  for (const auto& [seed, sum_n] : sums) {
+    const double mean = sum_n.first / sum_n.second;
+    if (!worst || mean < worst->mean) worst = WorstIdentity{seed, mean, sum_n.second};
+  }
+  if (!worst) return std::nullopt;
+  for (const IdentityRow& row : rows) {
+    const std::optional<double>& v = row.*value;
+    if (row.run->id.identity_seed != worst->seed || !v) continue;
+    if (!worst->worst_run || *v < worst->worst_value) worst->worst_run = row.run, worst->worst_value = *v;
+  }
+  return worst;
+}
+
+std::string WorstIdentityLine(const std::optional<WorstIdentity>& w, const std::string& what) {
+  if (!w) return "**Worst identity by " + what + "**: no values.";
+  char buf[320];
+  std::snprintf(buf, sizeof buf,
+                "**Worst identity by %s**: seed %llu (mean %.2f dB over its %d run%s; lowest run `%s`, %.2f dB).",
+                what.c_str(), static_cast<unsigned long long>(w->seed), w->mean, w->runs, w->runs == 1 ? "" : "s",
+                w->worst_run->id.Name().c_str(), w->worst_value);
+  return buf;
+}
+
+}  // namespace
+
 std::string ReportMarkdown(const Aggregate& a, const std::vector<RunRecord>& runs, const ReportContext& ctx,
                            const std::vector<std::string>& plots) {
   std::ostringstream s;
@@ -469,7 +589,11 @@ std::string ReportMarkdown(const Aggregate& a, const std::vector<RunRecord>& run
     << "compares it with the ground-truth image; `id_distance_reference` is the same measure on the ground truth "
     << "(ground-truth frame vs ground-truth neutral, same chips), i.e. the drift a perfect model would show. "
     << "0.6 is the network's same-person threshold. For scale: "
-    << "different real people have a median cosine of about 0.84 on this network, the same person 0.93-0.99.\n";
+    << "different real people have a median cosine of about 0.84 on this network, the same person 0.93-0.99.\n"
+    << "- Training-view fit: every training frame rendered back at its own camera and expression; `face_psnr` "
+    << "is the PSNR inside the hull of its 68 landmarks (the run's mean over its views; `face_psnr_min` its worst "
+    << "view), `psnr` over the full image. A model that cannot reproduce its own training views is underfitting, "
+    << "whatever its batch PSNR says.\n";
   bool lpips = false;
   for (const RunRecord& r : runs) lpips = lpips || r.metrics.lpips_available;
   if (!lpips) s << "- LPIPS: unavailable (no weights file given), reported as `-` / null.\n";
@@ -512,17 +636,45 @@ std::string ReportMarkdown(const Aggregate& a, const std::vector<RunRecord>& run
           s << "\n";
         }
     }
+    std::string fit_rows;
+    for (const std::string& method : a.methods) {
+      const TrainFitCell* c = a.FindTrainFit(k, method);
+      if (!c || c->runs == 0) continue;
+      fit_rows += "| `" + method + "` | " + std::to_string(c->runs) + " | " + Pm(c->face_psnr, "%.2f") + " | " +
+                  Pm(c->face_psnr_min, "%.2f") + " | " + Pm(c->psnr, "%.2f") + " |\n";
+    }
+    if (!fit_rows.empty())
+      s << "\n### K = " << k << ", training-view fit\n\n| method | runs | face_psnr | face_psnr_min | psnr |\n"
+        << "|---|---|---|---|---|\n" << fit_rows;
+  }
+  if (ctx.PerIdentity() && !runs.empty()) {
+    const std::vector<IdentityRow> rows = IdentityRows(runs);
+    s << "\n## Per identity\n\nEvery run: the training-view fit (mean face-region PSNR over its training views) "
+      << "beside its observed- and far-tier numbers, to find the identity that fails and see whether it already "
+      << "fails on its own training views.\n\n"
+      << "| identity | method | K | train face_psnr | observed psnr | far psnr | observed region_psnr | "
+      << "observed id_distance_gt | far expr_gain |\n|---|---|---|---|---|---|---|---|---|\n";
+    for (const IdentityRow& row : rows)
+      s << "| " << row.run->id.identity_seed << " | `" << row.run->id.method << "` | " << row.run->id.k << " | "
+        << Opt(row.train_face_psnr, "%.2f") << " | " << Opt(row.observed_psnr, "%.2f") << " | "
+        << Opt(row.far_psnr, "%.2f") << " | " << Opt(row.observed_region_psnr, "%.2f") << " | "
+        << Opt(row.observed_id_distance_gt, "%.3f") << " | " << Opt(row.far_expr_gain, "%.3f") << " |\n";
+    const auto worst_fit = FindWorstIdentity(rows, &IdentityRow::train_face_psnr);
+    const auto worst_psnr = FindWorstIdentity(rows, &IdentityRow::observed_psnr);
+    s << "\n- " << WorstIdentityLine(worst_fit, "training-view face PSNR") << "\n- "
+      << WorstIdentityLine(worst_psnr, "observed PSNR") << "\n";
   }
   if (!plots.empty()) {
     s << "\n## Plots\n\nEach metric against delta (x = mean delta of each tier), one line per method, error bars "
       << "= std over identities; one panel per K. SVG versions beside the PNGs.\n\n";
     for (const std::string& p : plots) s << "![" << p << "](" << p << ")\n\n";
   }
-  s << "\n## Runs\n\n| run | steps | train | eval | frames | no face |\n|---|---|---|---|---|---|\n";
+  s << "\n## Runs\n\n| run | steps | train | eval | frames | no face | train face_psnr |\n"
+    << "|---|---|---|---|---|---|---|\n";
   for (const RunRecord& r : runs)
     s << "| " << r.id.Name() << " | " << r.train_steps << " | " << ProgressBar::FormatDuration(r.train_seconds)
       << " | " << ProgressBar::FormatDuration(r.eval_seconds) << " | " << r.metrics.frames.size() << " | "
-      << r.metrics.identity_missing << " |\n";
+      << r.metrics.identity_missing << " | " << Opt(r.metrics.train_fit.face_psnr, "%.2f") << " |\n";
   return s.str();
 }
 
@@ -553,6 +705,16 @@ Json ReportJson(const Aggregate& a, const std::vector<RunRecord>& runs, const Re
   Json verdicts = Json::array();
   for (const PairVerdict& v : a.verdicts) verdicts.push_back(v.ToJson());
   j["pair_verdicts"] = std::move(verdicts);
+  Json fits = Json::array();
+  for (const TrainFitCell& c : a.train_fit) fits.push_back(c.ToJson());
+  j["train_fit"] = std::move(fits);
+  if (ctx.PerIdentity()) {
+    const std::vector<IdentityRow> rows = IdentityRows(runs);
+    const auto worst_fit = FindWorstIdentity(rows, &IdentityRow::train_face_psnr);
+    const auto worst_psnr = FindWorstIdentity(rows, &IdentityRow::observed_psnr);
+    j["worst_identity"] = Json{{"train_fit_face_psnr", worst_fit ? worst_fit->ToJson() : Json(nullptr)},
+                               {"observed_psnr", worst_psnr ? worst_psnr->ToJson() : Json(nullptr)}};
+  }
   if (!ctx.identity_role.empty()) j["identity_role"] = ctx.identity_role;
   if (ctx.tier_thresholds) j["tier_thresholds"] = *ctx.tier_thresholds;
   j["verdict"] = Verdict(a);
@@ -565,7 +727,9 @@ Json ReportJson(const Aggregate& a, const std::vector<RunRecord>& runs, const Re
                       {"train_steps", r.train_steps},
                       {"train_seconds", r.train_seconds},
                       {"eval_seconds", r.eval_seconds},
-                      {"identity_missing", r.metrics.identity_missing}});
+                      {"identity_missing", r.metrics.identity_missing},
+                      {"train_fit_face_psnr", r.metrics.train_fit.face_psnr ? Json(*r.metrics.train_fit.face_psnr)
+                                                                            : Json(nullptr)}});
   j["runs"] = std::move(rj);
   return j;
 }

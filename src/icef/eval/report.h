@@ -3,7 +3,8 @@
 // verdict on the paper's claim (does icef beat the baselines in the far tier on identity
 // similarity and PSNR?) derived from those numbers; written as report.md + report.json, and plots
 // of each metric against delta (one line per method, mean +- std over identities) drawn by gnuplot
-// as PNG + SVG.
+// as PNG + SVG. Beside them, per K and method, the training-view fit (how well the models reproduce
+// their own training views), and for validation benches a table of every run per identity.
 #pragma once
 
 #include <array>
@@ -115,6 +116,18 @@ struct PairVerdict {
 PairVerdict ComparePair(const struct Aggregate& aggregate, int k, Tier tier, const std::string& method,
                         const std::string& other);
 
+// The training-view fit (EvalResult::train_fit) of one (K, method): spreads over the runs
+// (identities) that measured it.
+struct TrainFitCell {
+  int k = 0;
+  std::string method;
+  int runs = 0;                          // runs that measured the fit
+  std::optional<Spread> face_psnr;       // of the runs' mean face-region PSNR
+  std::optional<Spread> face_psnr_min;   // of the runs' worst training view
+  std::optional<Spread> psnr;            // of the runs' mean full-image PSNR
+  Json ToJson() const;
+};
+
 struct Aggregate {
   std::vector<int> ks;                     // ascending
   std::vector<std::string> methods;        // in AllMethods() order, then others by name
@@ -122,7 +135,9 @@ struct Aggregate {
   std::vector<AggregateCell> cells;        // k-major, then method, then tier
   std::vector<Comparison> far_comparisons;  // icef vs every other method, far tier, per K, per metric
   std::vector<PairVerdict> verdicts;        // icef and icef-prior vs every other method, per K, near/moderate/far
+  std::vector<TrainFitCell> train_fit;      // k-major, then method (every (K, method) with runs)
   const AggregateCell* Find(int k, const std::string& method, Tier tier) const;
+  const TrainFitCell* FindTrainFit(int k, const std::string& method) const;
 };
 
 Aggregate AggregateRuns(const std::vector<RunRecord>& runs);
@@ -137,6 +152,11 @@ struct ReportContext {
   std::string identity_role;
   // The tiers' delta thresholds [near/moderate, moderate/far] (nullopt: not shown).
   std::optional<std::array<double, 2>> tier_thresholds;
+  // A per-identity table (training-view fit, observed and far numbers of every run) and the worst
+  // identity: for validation benches, where one identity that fails is the finding. Also on when
+  // identity_role starts with "validation".
+  bool per_identity = false;
+  bool PerIdentity() const;
 };
 
 // The verdict lines (markdown bullets): per novel tier, icef against the baselines (warp, nerface)

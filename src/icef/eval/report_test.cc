@@ -230,6 +230,81 @@ TEST(ReportTest, WritesMarkdownJsonAndPlots) {
   fs::remove_all(dir);
 }
 
+// `run` with a training-view fit of two views: face PSNR face_psnr -+ 1, full image face_psnr - 5.
+RunRecord WithTrainFit(RunRecord run, double face_psnr) {
+  run.metrics.train_fit =
+      TrainingFit::Of({TrainFrameFit{"images/train_000.png", face_psnr - 1, 300, face_psnr - 5, ""},
+                       TrainFrameFit{"images/train_001.png", face_psnr + 1, 300, face_psnr - 5, ""}});
+  return run;
+}
+
+TEST(ReportTest, TrainingViewFitAndPerIdentityTable) {
+  // Identity 2 fits its training views worst (mean 28.5 over its two runs); identity 1 has the lowest
+  // observed PSNR (30 and 31).
+  std::vector<RunRecord> runs = ThreeIdentities();
+  const double fit[] = {30, 33, 35, 32, 24, 34};  // icef 1, 2, 3, then warp 1, 2, 3
+  for (size_t i = 0; i < runs.size(); ++i) runs[i] = WithTrainFit(runs[i], fit[i]);
+  const Aggregate a = AggregateRuns(runs);
+  const TrainFitCell* icef = a.FindTrainFit(3, "icef");
+  ASSERT_NE(icef, nullptr);
+  EXPECT_EQ(icef->runs, 3);
+  EXPECT_NEAR(icef->face_psnr->mean, 98.0 / 3.0, 1e-12);
+  EXPECT_DOUBLE_EQ(icef->face_psnr_min->min, 29.0);
+  EXPECT_DOUBLE_EQ(icef->psnr->max, 30.0);
+
+  ReportContext validation;
+  validation.identity_role = "validation identities: for tuning";
+  const std::string md = ReportMarkdown(a, runs, validation, {});
+  EXPECT_NE(md.find("### K = 3, training-view fit\n\n| method | runs | face_psnr | face_psnr_min | psnr |"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("| `icef` | 3 | 32.67 ± 2.52 [30.00, 35.00] | 31.67 ± 2.52 [29.00, 34.00] |"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("| id2_k3_warp | 100 | 2.0s | 0.5s | 2 | 0 | 24.00 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("## Per identity"), std::string::npos) << md;
+  EXPECT_NE(md.find("| identity | method | K | train face_psnr | observed psnr | far psnr | observed region_psnr | "
+                    "observed id_distance_gt | far expr_gain |"),
+            std::string::npos)
+      << md;
+  // Seed 2, warp: far PSNR 23 (observed 33), no region PSNR, id_distance_gt 0.2 observed, gain 0.8.
+  EXPECT_NE(md.find("| 2 | `warp` | 3 | 24.00 | 33.00 | 23.00 | - | 0.200 | 0.800 |"), std::string::npos) << md;
+  EXPECT_LT(md.find("| 1 | `icef` |"), md.find("| 1 | `warp` |"));
+  EXPECT_LT(md.find("| 1 | `warp` |"), md.find("| 2 | `icef` |"));
+  EXPECT_NE(md.find("**Worst identity by training-view face PSNR**: seed 2 (mean 28.50 dB over its 2 runs; "
+                    "lowest run `id2_k3_warp`, 24.00 dB)."),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("**Worst identity by observed PSNR**: seed 1 (mean 30.50 dB over its 2 runs; lowest run "
+                    "`id1_k3_icef`, 30.00 dB)."),
+            std::string::npos)
+      << md;
+  const Json json = ReportJson(a, runs, validation);
+  ASSERT_EQ(json["train_fit"].size(), 2u);
+  EXPECT_EQ(json["train_fit"][1]["method"], "warp");
+  EXPECT_DOUBLE_EQ(json["train_fit"][1]["face_psnr"]["min"].get<double>(), 24.0);
+  EXPECT_EQ(json["worst_identity"]["train_fit_face_psnr"]["identity_seed"], 2);
+  EXPECT_EQ(json["worst_identity"]["observed_psnr"]["worst_run"], "id1_k3_icef");
+  EXPECT_DOUBLE_EQ(json["runs"][0]["train_fit_face_psnr"].get<double>(), 30.0);
+
+  // A test bench: the training-view fit table, no per-identity table; a flag turns it on.
+  ReportContext test;
+  test.identity_role = "test identities";
+  const std::string test_md = ReportMarkdown(a, runs, test, {});
+  EXPECT_NE(test_md.find("### K = 3, training-view fit"), std::string::npos);
+  EXPECT_EQ(test_md.find("## Per identity"), std::string::npos);
+  EXPECT_FALSE(ReportJson(a, runs, test).contains("worst_identity"));
+  test.per_identity = true;
+  EXPECT_NE(ReportMarkdown(a, runs, test, {}).find("## Per identity"), std::string::npos);
+
+  // Runs from before the training-view fit: no fit table, '-' in the run and identity tables.
+  const std::vector<RunRecord> old = ThreeIdentities();
+  const std::string old_md = ReportMarkdown(AggregateRuns(old), old, validation, {});
+  EXPECT_EQ(old_md.find("training-view fit\n\n| method"), std::string::npos) << old_md;
+  EXPECT_NE(old_md.find("| id2_k3_warp | 100 | 2.0s | 0.5s | 2 | 0 | - |"), std::string::npos) << old_md;
+  EXPECT_NE(old_md.find("**Worst identity by training-view face PSNR**: no values."), std::string::npos) << old_md;
+}
+
 TEST(ReportTest, RunRecordErrors) {
   const fs::path dir = TempDir("errors");
   RunRecord r = MakeRun(1, 3, "icef", 20, 0.3);
