@@ -55,6 +55,7 @@ TEST(BenchApp, ValidationSettingsLoseToExplicitOptions) {
   EXPECT_TRUE(o->diverse);
   EXPECT_TRUE(o->draw_resolution);
   EXPECT_EQ(o->methods, (std::vector<std::string>{"icef", "icef-prior"}));
+  EXPECT_EQ(o->time_budget_seconds, 0.0);  // steps only: reproducible
   // --res pins the resolution; the scenes stay diverse.
   a.resolution = 160;
   const Result<eval::BenchOptions> pinned = ResolveBenchOptions(a);

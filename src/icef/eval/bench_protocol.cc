@@ -47,6 +47,9 @@ void BenchOptions::ApplyValidation() {
   diverse = true;
   draw_resolution = true;
   methods = {"icef", "icef-prior"};
+  // A pure step budget: tuning compares runs, which a wall-clock cap on a busy machine would not
+  // make reproducible.
+  time_budget_seconds = 0;
 }
 
 std::string BenchOptions::IdentityRole() const {
@@ -295,7 +298,10 @@ Status RunBench(const BenchOptions& o, std::ostream& log, bool interactive) {
   for (const RunId& id : runs)
     if (!fs::exists(o.out_dir / "runs" / id.Name() / "metrics.json", ec)) todo.push_back(id);
   log << "bench: " << runs.size() << " runs in shard " << o.shard_index << "/" << o.shard_count << " ("
-      << runs.size() - todo.size() << " already done), " << o.resolution << "x" << o.resolution << ", "
+      << runs.size() - todo.size() << " already done), "
+      << (o.draw_resolution ? "resolution drawn per identity (128-" + std::to_string(kMaxValidationResolution) + ")"
+                            : std::to_string(o.resolution) + "x" + std::to_string(o.resolution))
+      << (o.diverse ? ", diverse scenes" : "") << ", "
       << (o.time_budget_seconds > 0 ? "time budget " + ProgressBar::FormatDuration(o.time_budget_seconds) + ", up to "
                                     : std::string())
       << o.steps << " steps per run\n";
@@ -334,6 +340,7 @@ Status RunBench(const BenchOptions& o, std::ostream& log, bool interactive) {
   ReportContext context;
   context.settings = o.ToJson();
   context.identity_role = o.IdentityRole();
+  context.per_identity = o.validation;
   {
     const synth::SynthOptions defaults;
     context.tier_thresholds = std::array<double, 2>{defaults.near_threshold, defaults.far_threshold};
@@ -399,6 +406,7 @@ Status MergeBench(const std::vector<fs::path>& inputs, const fs::path& out_dir, 
     BenchOptions role;
     role.validation = settings->value("validation", false);
     context.identity_role = role.IdentityRole();
+    context.per_identity = role.validation;
   }
   {
     const synth::SynthOptions defaults;

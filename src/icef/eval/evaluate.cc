@@ -245,6 +245,7 @@ Json TrainFrameFit::ToJson() const {
   j["file_path"] = file_path;
   j["face_psnr"] = OptionalJson(face_psnr);
   j["face_pixels"] = face_pixels;
+  j["face_detail"] = OptionalJson(face_detail);
   j["psnr"] = OptionalJson(psnr);
   j["render"] = render_path;
   return j;
@@ -259,6 +260,9 @@ Result<TrainFrameFit> TrainFrameFit::FromJson(const Json& j, const std::string& 
   ICEF_ASSIGN_OR_RETURN(f.face_psnr, OptionalNumber(j, where, "face_psnr"));
   ICEF_ASSIGN_OR_RETURN(f.psnr, OptionalNumber(j, where, "psnr"));
   if (j.contains("face_pixels") && j["face_pixels"].is_number_integer()) f.face_pixels = j["face_pixels"].get<int>();
+  if (j.contains("face_detail")) {
+    ICEF_ASSIGN_OR_RETURN(f.face_detail, OptionalNumber(j, where, "face_detail"));
+  }
   f.render_path = OptionalString(j, "render");
   return f;
 }
@@ -266,9 +270,10 @@ Result<TrainFrameFit> TrainFrameFit::FromJson(const Json& j, const std::string& 
 TrainingFit TrainingFit::Of(std::vector<TrainFrameFit> frames) {
   TrainingFit fit;
   fit.count = static_cast<int>(frames.size());
-  double face_sum = 0, psnr_sum = 0;
-  int psnr_n = 0;
+  double face_sum = 0, psnr_sum = 0, detail_sum = 0;
+  int psnr_n = 0, detail_n = 0;
   for (const TrainFrameFit& f : frames) {
+    if (f.face_detail) detail_sum += *f.face_detail, ++detail_n;
     if (f.face_psnr) {
       face_sum += *f.face_psnr, ++fit.face_count;
       fit.face_psnr_min = std::min(fit.face_psnr_min.value_or(*f.face_psnr), *f.face_psnr);
@@ -277,6 +282,7 @@ TrainingFit TrainingFit::Of(std::vector<TrainFrameFit> frames) {
   }
   if (fit.face_count > 0) fit.face_psnr = face_sum / fit.face_count;
   if (psnr_n > 0) fit.psnr = psnr_sum / psnr_n;
+  if (detail_n > 0) fit.face_detail = detail_sum / detail_n;
   fit.frames = std::move(frames);
   return fit;
 }
@@ -288,6 +294,7 @@ Json TrainingFit::ToJson() const {
   j["face_psnr"] = OptionalJson(face_psnr);
   j["face_psnr_min"] = OptionalJson(face_psnr_min);
   j["psnr"] = OptionalJson(psnr);
+  j["face_detail"] = OptionalJson(face_detail);
   Json frames_json = Json::array();
   for (const TrainFrameFit& f : frames) frames_json.push_back(f.ToJson());
   j["frames"] = std::move(frames_json);
@@ -304,6 +311,9 @@ Result<TrainingFit> TrainingFit::FromJson(const Json& j, const std::string& wher
   ICEF_ASSIGN_OR_RETURN(fit.face_psnr, OptionalNumber(j, where, "face_psnr"));
   ICEF_ASSIGN_OR_RETURN(fit.face_psnr_min, OptionalNumber(j, where, "face_psnr_min"));
   ICEF_ASSIGN_OR_RETURN(fit.psnr, OptionalNumber(j, where, "psnr"));
+  if (j.contains("face_detail")) {
+    ICEF_ASSIGN_OR_RETURN(fit.face_detail, OptionalNumber(j, where, "face_detail"));
+  }
   const auto frames = j.find("frames");
   if (frames == j.end() || !frames->is_array()) return Status::Error(where + ".frames: expected an array");
   for (size_t i = 0; i < frames->size(); ++i) {
@@ -322,7 +332,8 @@ std::string TrainingFit::Summary() const {
            " dB (" + all + ")";
   const std::string views = face_count == count ? all : std::to_string(face_count) + " of " + all;
   return "training-view fit: face-region PSNR " + Fmt(face_psnr, "%.2f") + " dB (worst " +
-         Fmt(face_psnr_min, "%.2f") + ", " + views + "), full image " + Fmt(psnr, "%.2f") + " dB";
+         Fmt(face_psnr_min, "%.2f") + ", " + views + "), full image " + Fmt(psnr, "%.2f") +
+         " dB, face detail " + Fmt(face_detail, "%.2f") + " x the truth's";
 }
 
 Json EvalResult::ToJson() const {
@@ -599,6 +610,8 @@ Result<TrainFrameFit> MeasureTrainFrame(const Frame& frame, const Image& render,
   if (f.face_pixels == 0) return f;
   ICEF_ASSIGN_OR_RETURN(const double face_psnr, Psnr(render, truth, &face));
   f.face_psnr = Finite(face_psnr);
+  Result<double> detail = DetailRatio(render, truth, &face);
+  if (detail.ok()) f.face_detail = Finite(*detail);
   return f;
 }
 

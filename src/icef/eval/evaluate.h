@@ -114,6 +114,10 @@ struct TrainFrameFit {
   // dB; null without landmarks (face_pixels 0) or when infinite (a pixel-perfect face).
   std::optional<double> face_psnr;
   int face_pixels = 0;              // pixels in the face region
+  // Fine detail of the render in the face region relative to the truth's (eval/metrics.h
+  // DetailRatio: 1 = as much pixel-scale detail, below 1 = blurred away, above = extra edges);
+  // null without a face region.
+  std::optional<double> face_detail;
   std::optional<double> psnr;       // full image, dB (null only when infinite)
   std::string render_path;          // relative to the output directory (empty when not written)
 
@@ -129,6 +133,7 @@ struct TrainingFit {
   std::optional<double> face_psnr;      // mean face-region PSNR, dB
   std::optional<double> face_psnr_min;  // the worst frame's
   std::optional<double> psnr;           // mean full-image PSNR, dB
+  std::optional<double> face_detail;    // mean face-region detail ratio
 
   // Means and minimum of `frames`, in frame order.
   static TrainingFit Of(std::vector<TrainFrameFit> frames);

@@ -152,17 +152,18 @@ TEST(EvaluateTest, TrainingFitRoundTripsAndOldFilesHaveNone) {
   // Means over the frames with a value; the frame without landmarks has no face PSNR.
   EvalResult result = *old;
   result.train_fit =
-      TrainingFit::Of({TrainFrameFit{"images/train_000.png", 32.0, 400, 24.0, "renders/fit_train_000.png"},
-                       TrainFrameFit{"images/train_001.png", 28.0, 380, 26.0, ""},
-                       TrainFrameFit{"images/train_002.png", std::nullopt, 0, 25.0, ""}});
+      TrainingFit::Of({TrainFrameFit{"images/train_000.png", 32.0, 400, 0.8, 24.0, "renders/fit_train_000.png"},
+                       TrainFrameFit{"images/train_001.png", 28.0, 380, 0.6, 26.0, ""},
+                       TrainFrameFit{"images/train_002.png", std::nullopt, 0, std::nullopt, 25.0, ""}});
   const TrainingFit& fit = result.train_fit;
   EXPECT_EQ(fit.count, 3);
   EXPECT_EQ(fit.face_count, 2);
   EXPECT_DOUBLE_EQ(*fit.face_psnr, 30.0);
   EXPECT_DOUBLE_EQ(*fit.face_psnr_min, 28.0);
   EXPECT_DOUBLE_EQ(*fit.psnr, 25.0);
-  EXPECT_NE(result.Table().find(
-                "training-view fit: face-region PSNR 30.00 dB (worst 28.00, 2 of 3 views), full image 25.00 dB"),
+  EXPECT_DOUBLE_EQ(*fit.face_detail, 0.7);
+  EXPECT_NE(result.Table().find("training-view fit: face-region PSNR 30.00 dB (worst 28.00, 2 of 3 views), full "
+                                "image 25.00 dB, face detail 0.70 x the truth's"),
             std::string::npos)
       << result.Table();
 
@@ -309,6 +310,8 @@ TEST(EvaluateTest, EvaluatesTinyTrainedModel) {
     EXPECT_LT(f.face_pixels, gt.width * gt.height);
     EXPECT_DOUBLE_EQ(*f.psnr, *Psnr(r.color, gt));
     EXPECT_DOUBLE_EQ(*f.face_psnr, *Psnr(r.color, gt, &face));
+    ASSERT_TRUE(f.face_detail.has_value());
+    EXPECT_DOUBLE_EQ(*f.face_detail, *DetailRatio(r.color, gt, &face));
     EXPECT_EQ(f.render_path, "renders/fit_" + fs::path(frame.file_path).stem().string() + ".png");
     EXPECT_TRUE(fs::exists(options.out_dir / f.render_path)) << f.render_path;
   }

@@ -64,6 +64,29 @@ Result<double> Psnr(const Image& a, const Image& b, const Image* mask, double da
   return 10.0 * std::log10(data_range * data_range / mse);
 }
 
+Result<double> DetailRatio(const Image& render, const Image& truth, const Image* mask) {
+  ICEF_ASSIGN_OR_RETURN(const int channels, CheckPair(render, truth, mask, "detail ratio"));
+  auto grey = [&](const Image& im, int x, int y) {
+    double v = 0.0;
+    for (int c = 0; c < channels; ++c) v += im.At(x, y, c);
+    return v / channels;
+  };
+  auto laplacian = [&](const Image& im, int x, int y) {
+    return grey(im, x - 1, y) + grey(im, x + 1, y) + grey(im, x, y - 1) + grey(im, x, y + 1) - 4.0 * grey(im, x, y);
+  };
+  double e_render = 0.0, e_truth = 0.0;
+  size_t count = 0;
+  for (int y = 1; y + 1 < truth.height; ++y)
+    for (int x = 1; x + 1 < truth.width; ++x) {
+      if (!InMask(mask, x, y)) continue;
+      const double lr = laplacian(render, x, y), lt = laplacian(truth, x, y);
+      e_render += lr * lr, e_truth += lt * lt, ++count;
+    }
+  if (count == 0) return Status::Error("detail ratio: the mask selects no interior pixel");
+  if (e_truth == 0.0) return Status::Error("detail ratio: the ground truth has no detail in the mask");
+  return std::sqrt(e_render / e_truth);
+}
+
 Status SsimOptions::Validate() const {
   if (!(sigma > 0.0)) return Status::Error("ssim.sigma: must be > 0");
   if (radius < 1) return Status::Error("ssim.radius: must be >= 1");

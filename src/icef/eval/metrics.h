@@ -35,4 +35,11 @@ struct SsimOptions {
 // 2 * radius + 1 pixels in each dimension; a mask with no pixel in that interior is an error.
 Result<double> Ssim(const Image& a, const Image& b, const SsimOptions& options = {}, const Image* mask = nullptr);
 
+// Fine detail of `render` relative to `truth`: sqrt(E(render) / E(truth)), E the mean squared
+// Laplacian (4-neighbour, of the mean over compared channels) over the masked pixels at least one
+// pixel from the border. 1: as much pixel-scale detail as the truth; below 1: detail blurred away
+// (0.5: half the amplitude); above 1: more edges than the truth (blocks, noise). Errors: a size
+// mismatch, no masked interior pixel, or a truth without detail (E = 0).
+Result<double> DetailRatio(const Image& render, const Image& truth, const Image* mask = nullptr);
+
 }  // namespace icef::eval

@@ -98,5 +98,43 @@ TEST(MetricsTest, ErrorsNameTheProblem) {
   EXPECT_FALSE(Ssim(a, a, bad).ok());
 }
 
+// A textured "face" (fine noise over a smooth gradient), the same blurred (detail lost), and the
+// same with extra pixel noise (more edges than the truth).
+TEST(MetricsTest, DetailRatioSeesBlurAndNoise) {
+  const int n = 64;
+  Image truth(n, n, 3), blurred(n, n, 3), noisy(n, n, 3);
+  Rng rng(3, StreamId("metrics_test.detail"));
+  std::vector<float> noise(n * n);
+  for (float& v : noise) v = static_cast<float>(rng.Uniform(-0.08, 0.08));
+  auto base = [&](int x, int y) { return 0.3f + 0.4f * x / n; };
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) {
+      float sum = 0.f;
+      int count = 0;
+      for (int dy = -2; dy <= 2; ++dy)
+        for (int dx = -2; dx <= 2; ++dx) {
+          const int xx = std::clamp(x + dx, 0, n - 1), yy = std::clamp(y + dy, 0, n - 1);
+          sum += noise[yy * n + xx], ++count;
+        }
+      const float extra = static_cast<float>(rng.Uniform(-0.08, 0.08));
+      for (int c = 0; c < 3; ++c) {
+        truth.At(x, y, c) = base(x, y) + noise[y * n + x];
+        blurred.At(x, y, c) = base(x, y) + sum / count;
+        noisy.At(x, y, c) = truth.At(x, y, c) + extra;
+      }
+    }
+  EXPECT_DOUBLE_EQ(*DetailRatio(truth, truth), 1.0);
+  const double blur = *DetailRatio(blurred, truth);
+  EXPECT_LT(blur, 0.3);
+  EXPECT_GT(*DetailRatio(noisy, truth), 1.3);  // independent noise of the same amplitude: ~sqrt(2)
+  // Masked: only the left half counts.
+  Image mask(n, n, 1, 0.f);
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n / 2; ++x) mask.At(x, y, 0) = 1.f;
+  EXPECT_NEAR(*DetailRatio(blurred, truth, &mask), blur, 0.1);
+  EXPECT_FALSE(DetailRatio(truth, Image(n, n, 3, 0.5f)).ok());  // a flat truth has no detail
+  EXPECT_FALSE(DetailRatio(truth, Image(n / 2, n, 3)).ok());
+}
+
 }  // namespace
 }  // namespace icef::eval

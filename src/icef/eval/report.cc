@@ -457,7 +457,7 @@ std::string Opt(const std::optional<double>& v, const char* format) {
 struct IdentityRow {
   const RunRecord* run = nullptr;
   std::optional<double> train_face_psnr, observed_psnr, far_psnr, observed_region_psnr, observed_id_distance_gt,
-      far_expr_gain;
+      far_expr_gain, train_face_psnr_min, train_face_detail;
 };
 
 // The rows of every run, by identity, K and method.
@@ -467,7 +467,8 @@ std::vector<IdentityRow> IdentityRows(const std::vector<RunRecord>& runs) {
     const TierMetrics& obs = r.metrics.tiers[TierIndex(Tier::kObserved)];
     const TierMetrics& far = r.metrics.tiers[TierIndex(Tier::kFar)];
     rows.push_back(IdentityRow{&r, r.metrics.train_fit.face_psnr, obs.psnr, far.psnr, obs.region_psnr,
-                               obs.id_distance_gt, far.expr_gain});
+                               obs.id_distance_gt, far.expr_gain, r.metrics.train_fit.face_psnr_min,
+                               r.metrics.train_fit.face_detail});
   }
   std::stable_sort(rows.begin(), rows.end(), [](const IdentityRow& x, const IdentityRow& y) {
     const RunId &a = x.run->id, &b = y.run->id;
@@ -649,14 +650,16 @@ std::string ReportMarkdown(const Aggregate& a, const std::vector<RunRecord>& run
   }
   if (ctx.PerIdentity() && !runs.empty()) {
     const std::vector<IdentityRow> rows = IdentityRows(runs);
-    s << "\n## Per identity\n\nEvery run: the training-view fit (mean face-region PSNR over its training views) "
+    s << "\n## Per identity\n\nEvery run: the training-view fit (mean face-region PSNR over its training views, "
+      << "its worst view, and the face's fine detail relative to the truth's: 1 = as sharp, below 1 = blurred) "
       << "beside its observed- and far-tier numbers, to find the identity that fails and see whether it already "
       << "fails on its own training views.\n\n"
-      << "| identity | method | K | train face_psnr | observed psnr | far psnr | observed region_psnr | "
-      << "observed id_distance_gt | far expr_gain |\n|---|---|---|---|---|---|---|---|---|\n";
+      << "| identity | method | K | train face_psnr | worst view | face detail | observed psnr | far psnr | "
+      << "observed region_psnr | observed id_distance_gt | far expr_gain |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const IdentityRow& row : rows)
       s << "| " << row.run->id.identity_seed << " | `" << row.run->id.method << "` | " << row.run->id.k << " | "
-        << Opt(row.train_face_psnr, "%.2f") << " | " << Opt(row.observed_psnr, "%.2f") << " | "
+        << Opt(row.train_face_psnr, "%.2f") << " | " << Opt(row.train_face_psnr_min, "%.2f") << " | "
+        << Opt(row.train_face_detail, "%.2f") << " | " << Opt(row.observed_psnr, "%.2f") << " | "
         << Opt(row.far_psnr, "%.2f") << " | " << Opt(row.observed_region_psnr, "%.2f") << " | "
         << Opt(row.observed_id_distance_gt, "%.3f") << " | " << Opt(row.far_expr_gain, "%.3f") << " |\n";
     const auto worst_fit = FindWorstIdentity(rows, &IdentityRow::train_face_psnr);

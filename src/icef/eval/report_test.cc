@@ -233,8 +233,8 @@ TEST(ReportTest, WritesMarkdownJsonAndPlots) {
 // `run` with a training-view fit of two views: face PSNR face_psnr -+ 1, full image face_psnr - 5.
 RunRecord WithTrainFit(RunRecord run, double face_psnr) {
   run.metrics.train_fit =
-      TrainingFit::Of({TrainFrameFit{"images/train_000.png", face_psnr - 1, 300, face_psnr - 5, ""},
-                       TrainFrameFit{"images/train_001.png", face_psnr + 1, 300, face_psnr - 5, ""}});
+      TrainingFit::Of({TrainFrameFit{"images/train_000.png", face_psnr - 1, 300, 0.9, face_psnr - 5, ""},
+                       TrainFrameFit{"images/train_001.png", face_psnr + 1, 300, 0.9, face_psnr - 5, ""}});
   return run;
 }
 
@@ -263,12 +263,12 @@ TEST(ReportTest, TrainingViewFitAndPerIdentityTable) {
       << md;
   EXPECT_NE(md.find("| id2_k3_warp | 100 | 2.0s | 0.5s | 2 | 0 | 24.00 |"), std::string::npos) << md;
   EXPECT_NE(md.find("## Per identity"), std::string::npos) << md;
-  EXPECT_NE(md.find("| identity | method | K | train face_psnr | observed psnr | far psnr | observed region_psnr | "
-                    "observed id_distance_gt | far expr_gain |"),
+  EXPECT_NE(md.find("| identity | method | K | train face_psnr | worst view | face detail | observed psnr | far psnr | "
+                    "observed region_psnr | observed id_distance_gt | far expr_gain |"),
             std::string::npos)
       << md;
   // Seed 2, warp: far PSNR 23 (observed 33), no region PSNR, id_distance_gt 0.2 observed, gain 0.8.
-  EXPECT_NE(md.find("| 2 | `warp` | 3 | 24.00 | 33.00 | 23.00 | - | 0.200 | 0.800 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| 2 | `warp` | 3 | 24.00 | 23.00 | 0.90 | 33.00 | 23.00 | - | 0.200 | 0.800 |"), std::string::npos) << md;
   EXPECT_LT(md.find("| 1 | `icef` |"), md.find("| 1 | `warp` |"));
   EXPECT_LT(md.find("| 1 | `warp` |"), md.find("| 2 | `icef` |"));
   EXPECT_NE(md.find("**Worst identity by training-view face PSNR**: seed 2 (mean 28.50 dB over its 2 runs; "
