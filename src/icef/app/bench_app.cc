@@ -22,6 +22,7 @@ Result<eval::BenchOptions> ResolveBenchOptions(const BenchAppOptions& a) {
     if (a.identities) o.identities = *a.identities;
     if (a.first_seed) o.first_identity_seed = *a.first_seed;
     if (a.resolution) o.draw_resolution = false;
+    if (a.steps) o.steps = *a.steps;
     if (a.time_budget) o.time_budget_seconds = *a.time_budget;
   }
   if (a.quick) {

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include "icef/train/train_config.h"
+
 namespace icef {
 namespace {
 
@@ -56,6 +58,7 @@ TEST(BenchApp, ValidationSettingsLoseToExplicitOptions) {
   EXPECT_TRUE(o->draw_resolution);
   EXPECT_EQ(o->methods, (std::vector<std::string>{"icef", "icef-prior"}));
   EXPECT_EQ(o->time_budget_seconds, 0.0);  // steps only: reproducible
+  EXPECT_EQ(o->steps, TrainConfig().steps);  // as `icef train` trains
   // --res pins the resolution; the scenes stay diverse.
   a.resolution = 160;
   const Result<eval::BenchOptions> pinned = ResolveBenchOptions(a);

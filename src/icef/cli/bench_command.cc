@@ -49,7 +49,7 @@ CommandFn RegisterBench(CLI::App& app) {
                "Validation bench: validation identities (seeds 101 and up, 6 by default) at K=5 in diverse scenes "
                "(skin, lighting, head placement, camera, view spread, resolution 128-256 and fine detail drawn per "
                "identity, as `icef synth --diverse`; --res pins the resolution), methods icef and icef-prior, "
-               "--steps 1000 with no time cap (reproducible), for tuning and prior experiments. Without it the identities are test seeds (below 101) in the classic "
+               "icef train's default steps (2000) with no time cap (reproducible), for tuning and prior experiments. Without it the identities are test seeds (below 101) in the classic "
                "scene, which are only reported, never tuned on");
   app.add_option("--shard", args->app.shard, "Run only shard i of n (i/n, 0-based): runs i, i+n, ... of the stable order");
   app.add_option("--threads", o.threads, "Worker threads (0 = all cores)")->capture_default_str();

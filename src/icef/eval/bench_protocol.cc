@@ -47,8 +47,9 @@ void BenchOptions::ApplyValidation() {
   diverse = true;
   draw_resolution = true;
   methods = {"icef", "icef-prior"};
-  // A pure step budget: tuning compares runs, which a wall-clock cap on a busy machine would not
-  // make reproducible.
+  // A pure step budget of `icef train`'s default (the model as a user trains it): tuning compares
+  // runs, which a wall-clock cap on a busy machine would not make reproducible.
+  steps = TrainConfig().steps;
   time_budget_seconds = 0;
 }
 

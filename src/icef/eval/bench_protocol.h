@@ -80,8 +80,8 @@ struct BenchOptions {
   bool draw_resolution = false;
 
   // The --validation settings: validation seeds 101..106, K = 5, diverse scenes with a drawn
-  // resolution, methods icef and icef-prior, no time cap (a pure step budget; explicit options
-  // win).
+  // resolution, methods icef and icef-prior, `icef train`'s default steps with no time cap (a pure
+  // step budget; explicit options win).
   void ApplyValidation();
   // "test: ..." or "validation: ..." for the report.
   std::string IdentityRole() const;
