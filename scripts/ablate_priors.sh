@@ -5,10 +5,12 @@
 # psnr_observed) and the wall time of each run.
 #
 #   scripts/ablate_priors.sh [--icef build/icef] [--out DIR] [--seeds "101 102 103"] [--k 5] [--res 128]
-#                            [--steps 1000] [--threads 0] [--only "default no-symmetry ..."]
+#                            [--steps 1000] [--threads 0] [--only "default no-symmetry ..."] [--diverse]
 #
 # Tuning uses validation identities only: the seeds must be 101 and up (the bench's test
-# identities are below 101 and are never tuned on). Writes DIR/priors.md (and keeps each run's
+# identities are below 101 and are never tuned on). --diverse renders the subjects in the
+# validation bench's diverse scenes (`icef synth --diverse`, the resolution pinned by --res).
+# Writes DIR/priors.md (and keeps each run's
 # model directory under DIR/runs/). docs/results/priors_validation.md was made by this script.
 set -euo pipefail
 
@@ -20,6 +22,7 @@ k=5
 res=128
 steps=1000
 threads=0
+diverse=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --icef) icef=$2; shift 2 ;;
@@ -30,6 +33,7 @@ while [ $# -gt 0 ]; do
     --steps) steps=$2; shift 2 ;;
     --threads) threads=$2; shift 2 ;;
     --only) only=$2; shift 2 ;;
+    --diverse) diverse=(--diverse); shift ;;
     -h|--help) sed -n 2,14p "$0"; exit 0 ;;
     *) echo "ablate_priors.sh: unknown option $1" >&2; exit 1 ;;
   esac
@@ -65,7 +69,7 @@ rows=()
 for seed in $seeds; do
   data="$out/data/seed${seed}_k${k}_${res}"
   [ -f "$data/transforms_train.json" ] ||
-    "$icef" synth --out "$data" --identity-seed "$seed" --k "$k" --res "$res" --threads "$threads" >/dev/null
+    "$icef" synth --out "$data" --identity-seed "$seed" --k "$k" --res "$res" --threads "$threads" "${diverse[@]}" >/dev/null
 done
 for v in "${variants[@]}"; do
   IFS='|' read -r name what sets <<<"$v"
@@ -89,7 +93,7 @@ done
 {
   echo "# Few-shot priors: leave-one-out ablation"
   echo
-  echo "Made by \`scripts/ablate_priors.sh --seeds \"$seeds\" --k $k --res $res --steps $steps\` on $(nproc) cores"
+  echo "Made by \`scripts/ablate_priors.sh --seeds \"$seeds\" --k $k --res $res --steps $steps ${diverse[*]}\` on $(nproc) cores"
   echo "($(date -u +%Y-%m-%d)). Each row trains \`icef train --steps $steps\` (the default method) on the synthetic"
   echo "subject of each identity seed (K = $k, ${res}x${res}) with one change from the defaults, and reports"
   echo "summary.json's \`psnr_observed\`: mean PSNR over the held-out test views at the training expressions."
