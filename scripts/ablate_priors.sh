@@ -34,7 +34,7 @@ while [ $# -gt 0 ]; do
     --threads) threads=$2; shift 2 ;;
     --only) only=$2; shift 2 ;;
     --diverse) diverse=(--diverse); shift ;;
-    -h|--help) sed -n 2,15p "$0"; exit 0 ;;
+    -h|--help) sed -n 2,14p "$0"; exit 0 ;;
     *) echo "ablate_priors.sh: unknown option $1" >&2; exit 1 ;;
   esac
 done
