@@ -589,6 +589,18 @@ std::vector<float> ScaledExpression(const Frame& frame, double scale) {
   return beta;
 }
 
+// [a | b] (RGB; same height), for comparing a render with its truth.
+Image SideBySide(const Image& a, const Image& b) {
+  Image out(a.width + b.width, std::max(a.height, b.height), 3, 1.f);
+  for (int y = 0; y < a.height; ++y)
+    for (int x = 0; x < a.width; ++x)
+      for (int c = 0; c < 3; ++c) out.At(x, y, c) = a.Rgb(x, y)[c];
+  for (int y = 0; y < b.height; ++y)
+    for (int x = 0; x < b.width; ++x)
+      for (int c = 0; c < 3; ++c) out.At(a.width + x, y, c) = b.Rgb(x, y)[c];
+  return out;
+}
+
 // Indices of up to `max_count` of `n` items, evenly spaced, ascending (all of them when n <= max_count).
 std::vector<size_t> EvenlySpaced(size_t n, int max_count) {
   const size_t m = std::min(n, static_cast<size_t>(std::max(max_count, 0)));
@@ -735,6 +747,9 @@ Result<EvalResult> EvaluateModel(const AvatarModel& model, const Dataset& datase
     if (write) {
       fit->render_path = RenderName(frame.file_path, "fit_");
       ICEF_RETURN_IF_ERROR(WritePng(out_root / fit->render_path, render.color));
+      // The truth and the render side by side, to look at what the numbers say.
+      const std::string pair = fs::path(fit->render_path).replace_extension().string() + "_vs_truth.png";
+      ICEF_RETURN_IF_ERROR(WritePng(out_root / pair, SideBySide(gt, render.color)));
     }
     fits.push_back(std::move(*fit));
   }

@@ -314,6 +314,10 @@ TEST(EvaluateTest, EvaluatesTinyTrainedModel) {
     EXPECT_DOUBLE_EQ(*f.face_detail, *DetailRatio(r.color, gt, &face));
     EXPECT_EQ(f.render_path, "renders/fit_" + fs::path(frame.file_path).stem().string() + ".png");
     EXPECT_TRUE(fs::exists(options.out_dir / f.render_path)) << f.render_path;
+    const Result<Image> pair = ReadImage(options.out_dir / ("renders/fit_" + fs::path(frame.file_path).stem().string() +
+                                                            "_vs_truth.png"));
+    ASSERT_TRUE(pair.ok()) << pair.status().message();
+    EXPECT_EQ(pair->width, 2 * gt.width);  // truth | render
   }
   EXPECT_TRUE(fs::exists(options.out_dir / "renders" / "fit_train_000.png"));
 
