@@ -32,7 +32,8 @@ void ModelConfig::Bind(ConfigSchema& s) {
   s.Number("transmittance_eps", &transmittance_eps,
            "training: stop compositing a ray once its transmittance is below this (renders: render_transmittance_eps)");
   s.Int("render_supersample", &render_supersample,
-        "image renders average s x s rays per pixel (anti-aliasing; photos and the synthetic data integrate over the pixel)");
+        "image renders average s x s rays per pixel (1 = the pixel centre: with train.pixel_jitter the field already "
+        "returns each pixel's average, and averaging again blurs)");
   s.Number("render_transmittance_eps", &render_transmittance_eps,
            "renders and evaluation: stop a ray once its transmittance is below this (what is left behind can change "
            "a pixel by at most this fraction: 1e-2 is at most 2.5/255); training composites to transmittance_eps");
