@@ -29,8 +29,10 @@ grep -q "lpips: unavailable" "$WORK/out.txt" || fail "LPIPS not reported as unav
 test -s "$WORK/eval/metrics.json" || fail "no metrics.json"
 [ "$(ls "$WORK/eval/renders" | grep -c '^test_.*\.png$')" = 6 ] || fail "expected 6 renders"
 test -s "$WORK/eval/renders/neutral_000.png" || fail "no neutral render"
-[ "$(ls "$WORK/eval/renders" | grep -c '^fit_train_.*\.png$')" = 3 ] || fail "expected 3 training-view renders"
-grep -Eq "^training-view fit: face-region PSNR [0-9.]+ dB \(worst [0-9.]+, 3 views\), full image [0-9.]+ dB$" \
+[ "$(ls "$WORK/eval/renders" | grep -c '^fit_train_[0-9]*\.png$')" = 3 ] || fail "expected 3 training-view renders"
+[ "$(ls "$WORK/eval/renders" | grep -c '^fit_train_[0-9]*_vs_truth\.png$')" = 3 ] \
+  || fail "expected 3 training views beside their truth"
+grep -Eq "^training-view fit: face-region PSNR [0-9.]+ dB \(worst [0-9.]+, 3 views\), full image [0-9.]+ dB, face detail [0-9.]+ x the truth's$" \
   "$WORK/out.txt" || fail "no training-view fit line"
 
 # Schema: every frame and tier key present; LPIPS null; PSNR/SSIM numbers; identity numbers
