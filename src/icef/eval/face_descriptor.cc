@@ -10,12 +10,12 @@ namespace {
 constexpr float kMeanRgb[3] = {122.782f, 117.001f, 104.298f};
 constexpr float kInputScale = 1.f / 256.f;  // dlib's input_rgb_image divides by 256
 
-Status Take(const TensorMap& tensors, const std::string& source, const std::string& name,
+Status Take(const infer::TensorMap& tensors, const std::string& source, const std::string& name,
             const std::vector<int>& shape, std::vector<float>& out) {
   const auto it = tensors.find(name);
   if (it == tensors.end()) return Status::Error(source + ": missing tensor '" + name + "'");
   if (it->second.shape != shape) {
-    NamedTensor expected{shape, {}};
+    infer::NamedTensor expected{shape, {}};
     return Status::Error(source + ": tensor '" + name + "' has shape " + it->second.ToString() + ", expected " +
                          expected.ToString());
   }
@@ -23,7 +23,7 @@ Status Take(const TensorMap& tensors, const std::string& source, const std::stri
   return Status::Ok();
 }
 
-Status TakeConvAffine(const TensorMap& tensors, const std::string& source, const std::string& prefix, int k,
+Status TakeConvAffine(const infer::TensorMap& tensors, const std::string& source, const std::string& prefix, int k,
                       int cin, int cout, ConvAffine& layer) {
   layer.conv.kh = layer.conv.kw = k;
   layer.conv.cin = cin;
@@ -59,29 +59,29 @@ std::filesystem::path ResolveFaceIdModelDir(const std::string& explicit_dir) {
   return kDefaultFaceIdModelDir;
 }
 
-Tensor3 ApplyConvAffine(const Tensor3& x, const ConvAffine& layer, int stride, const Padding& pad, bool relu) {
-  Tensor3 out = Conv2d(x, layer.conv, stride, pad);
-  ChannelAffine(out, layer.scale, layer.shift);
-  if (relu) Relu(out);
+infer::Tensor3 ApplyConvAffine(const infer::Tensor3& x, const ConvAffine& layer, int stride, const infer::Padding& pad, bool relu) {
+  infer::Tensor3 out = infer::Conv2d(x, layer.conv, stride, pad);
+  infer::ChannelAffine(out, layer.scale, layer.shift);
+  if (relu) infer::Relu(out);
   return out;
 }
 
-Tensor3 ResidualBlock(const Tensor3& x, const ResidualBlockWeights& weights, bool down) {
+infer::Tensor3 ResidualBlock(const infer::Tensor3& x, const ResidualBlockWeights& weights, bool down) {
   if (!down) {
-    Tensor3 out = ApplyConvAffine(x, weights.conv1, 1, Padding::Uniform(1), true);
-    out = ApplyConvAffine(out, weights.conv2, 1, Padding::Uniform(1), false);
-    AddInPlace(out, x);
-    Relu(out);
+    infer::Tensor3 out = ApplyConvAffine(x, weights.conv1, 1, infer::Padding::Uniform(1), true);
+    out = ApplyConvAffine(out, weights.conv2, 1, infer::Padding::Uniform(1), false);
+    infer::AddInPlace(out, x);
+    infer::Relu(out);
     return out;
   }
-  Tensor3 branch = ApplyConvAffine(x, weights.conv1, 2, Padding::Valid(), true);
-  branch = ApplyConvAffine(branch, weights.conv2, 1, Padding::Uniform(1), false);
-  Tensor3 out = AddZeroExtended(AvgPool(x, 2, 2), branch);
-  Relu(out);
+  infer::Tensor3 branch = ApplyConvAffine(x, weights.conv1, 2, infer::Padding::Valid(), true);
+  branch = ApplyConvAffine(branch, weights.conv2, 1, infer::Padding::Uniform(1), false);
+  infer::Tensor3 out = infer::AddZeroExtended(infer::AvgPool(x, 2, 2), branch);
+  infer::Relu(out);
   return out;
 }
 
-Result<FaceDescriptorNet> FaceDescriptorNet::FromTensors(const TensorMap& tensors, const std::string& source) {
+Result<FaceDescriptorNet> FaceDescriptorNet::FromTensors(const infer::TensorMap& tensors, const std::string& source) {
   FaceDescriptorNet net;
   net.source_ = source;
   ICEF_RETURN_IF_ERROR(TakeConvAffine(tensors, source, "conv32_down", 7, 3, 32, net.stem_));
@@ -120,24 +120,24 @@ Result<FaceDescriptorNet> FaceDescriptorNet::Load(const std::filesystem::path& d
                          ": face-identity model not found (install it with scripts/install-deps.sh, or point "
                          "--faceid-model / ICEF_FACEID_MODEL at a directory holding " +
                          kFaceIdManifestName + " and face_recognition_model.bin from @vladmandic/face-api@1.7.15)");
-  ICEF_ASSIGN_OR_RETURN(const TensorMap tensors, ReadTfjsWeights(manifest));
+  ICEF_ASSIGN_OR_RETURN(const infer::TensorMap tensors, infer::ReadTfjsWeights(manifest));
   return FromTensors(tensors, manifest.string());
 }
 
-Tensor3 FaceDescriptorNet::Preprocess(const Image& chip) {
+infer::Tensor3 FaceDescriptorNet::Preprocess(const Image& chip) {
   ICEF_CHECK(chip.channels >= 3, "face chip must be RGB");
-  Tensor3 input(chip.height, chip.width, 3);
+  infer::Tensor3 input(chip.height, chip.width, 3);
   for (int y = 0; y < chip.height; ++y)
     for (int x = 0; x < chip.width; ++x)
       for (int c = 0; c < 3; ++c) input.At(y, x, c) = (chip.At(x, y, c) * 255.f - kMeanRgb[c]) * kInputScale;
   return input;
 }
 
-std::vector<float> FaceDescriptorNet::Forward(const Tensor3& input) const {
-  Tensor3 x = ApplyConvAffine(input, stem_, 2, Padding::Valid(), true);
-  x = MaxPool(x, 3, 2);
+std::vector<float> FaceDescriptorNet::Forward(const infer::Tensor3& input) const {
+  infer::Tensor3 x = ApplyConvAffine(input, stem_, 2, infer::Padding::Valid(), true);
+  x = infer::MaxPool(x, 3, 2);
   for (const Stage& stage : stages_) x = ResidualBlock(x, stage.weights, stage.down);
-  return FullyConnected(GlobalMean(x), fc_, kFaceDescriptorDim);
+  return infer::FullyConnected(infer::GlobalMean(x), fc_, kFaceDescriptorDim);
 }
 
 FaceDescriptor FaceDescriptorNet::Compute(const Image& chip) const {

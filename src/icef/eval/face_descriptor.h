@@ -24,8 +24,8 @@
 #include <vector>
 
 #include "icef/core/status.h"
-#include "icef/eval/cnn_layers.h"
-#include "icef/eval/tfjs_weights.h"
+#include "icef/infer/cnn_layers.h"
+#include "icef/infer/tfjs_weights.h"
 #include "icef/io/image.h"
 
 namespace icef::eval {
@@ -49,7 +49,7 @@ std::filesystem::path ResolveFaceIdModelDir(const std::string& explicit_dir = ""
 
 // conv + bias, then the per-channel affine (`scale/weights`, `scale/biases`).
 struct ConvAffine {
-  ConvWeights conv;
+  infer::ConvWeights conv;
   std::vector<float> scale;  // [cout]
   std::vector<float> shift;  // [cout]
 };
@@ -60,9 +60,9 @@ struct ResidualBlockWeights {
 };
 
 // Applies conv + bias + affine (+ ReLU when `relu`), 3x3: stride 1 'same' or stride 2 'valid'.
-Tensor3 ApplyConvAffine(const Tensor3& x, const ConvAffine& layer, int stride, const Padding& pad, bool relu);
+infer::Tensor3 ApplyConvAffine(const infer::Tensor3& x, const ConvAffine& layer, int stride, const infer::Padding& pad, bool relu);
 // The residual block (down = false) and the down-sampling block (down = true) described above.
-Tensor3 ResidualBlock(const Tensor3& x, const ResidualBlockWeights& weights, bool down);
+infer::Tensor3 ResidualBlock(const infer::Tensor3& x, const ResidualBlockWeights& weights, bool down);
 
 class FaceDescriptorNet {
  public:
@@ -70,14 +70,14 @@ class FaceDescriptorNet {
   // or file gives an error that says how to install the model.
   static Result<FaceDescriptorNet> Load(const std::filesystem::path& dir);
   // From decoded tensors; every expected name must be present with the expected shape.
-  static Result<FaceDescriptorNet> FromTensors(const TensorMap& tensors, const std::string& source);
+  static Result<FaceDescriptorNet> FromTensors(const infer::TensorMap& tensors, const std::string& source);
 
   // chip: kFaceChipSize x kFaceChipSize RGB (or RGBA, alpha ignored), values in [0, 1].
   FaceDescriptor Compute(const Image& chip) const;
   // The normalised input tensor [150, 150, 3] of a chip.
-  static Tensor3 Preprocess(const Image& chip);
+  static infer::Tensor3 Preprocess(const Image& chip);
   // The network on an already normalised input of any size big enough for every layer.
-  std::vector<float> Forward(const Tensor3& input) const;
+  std::vector<float> Forward(const infer::Tensor3& input) const;
 
   const std::string& source() const { return source_; }
   std::string ToString() const;

@@ -4,18 +4,16 @@
 
 #include <chrono>
 #include <cmath>
-#include <cstring>
 #include <filesystem>
 #include <fstream>
 
-#include "icef/eval/cnn_test_util.h"
+#include "icef/infer/cnn_test_util.h"
 #include "icef/eval/face_identity.h"
-#include "icef/io/atomic_file.h"
 
 namespace icef::eval {
 namespace {
 
-using namespace ::icef::eval::testing;
+using namespace ::icef::infer::testing;
 namespace fs = std::filesystem;
 
 ConvAffine RandomConvAffine(int cin, int cout, uint64_t item) {
@@ -29,7 +27,7 @@ ConvAffine RandomConvAffine(int cin, int cout, uint64_t item) {
   return layer;
 }
 
-Tensor3 NaiveAffine(Tensor3 x, const ConvAffine& l, bool relu) {
+infer::Tensor3 NaiveAffine(infer::Tensor3 x, const ConvAffine& l, bool relu) {
   for (int y = 0; y < x.h; ++y)
     for (int i = 0; i < x.w; ++i)
       for (int c = 0; c < x.c; ++c) {
@@ -40,10 +38,10 @@ Tensor3 NaiveAffine(Tensor3 x, const ConvAffine& l, bool relu) {
 }
 
 TEST(FaceDescriptorTest, ResidualBlockMatchesNaiveReference) {
-  const Tensor3 x = RandomTensor(7, 7, 4, 100);
+  const infer::Tensor3 x = RandomTensor(7, 7, 4, 100);
   ResidualBlockWeights w{RandomConvAffine(4, 4, 101), RandomConvAffine(4, 4, 102)};
-  Tensor3 ref = NaiveAffine(NaiveConv(x, w.conv1.conv, 1, Padding::Uniform(1)), w.conv1, true);
-  ref = NaiveAffine(NaiveConv(ref, w.conv2.conv, 1, Padding::Uniform(1)), w.conv2, false);
+  infer::Tensor3 ref = NaiveAffine(NaiveConv(x, w.conv1.conv, 1, infer::Padding::Uniform(1)), w.conv1, true);
+  ref = NaiveAffine(NaiveConv(ref, w.conv2.conv, 1, infer::Padding::Uniform(1)), w.conv2, false);
   for (size_t i = 0; i < ref.data.size(); ++i) ref.data[i] = std::max(ref.data[i] + x.data[i], 0.f);
   ExpectNear(ResidualBlock(x, w, false), ref, 1e-4);
 }
@@ -53,12 +51,12 @@ TEST(FaceDescriptorTest, DownBlockMatchesNaiveReference) {
   // zero-padded at the bottom/right, and the shortcut's channels 3..5 are zero (as in conv256_down).
   for (int size : {8, 9, 7}) {
     SCOPED_TRACE("input " + std::to_string(size));
-    const Tensor3 x = RandomTensor(size, size, 3, 110 + size);
+    const infer::Tensor3 x = RandomTensor(size, size, 3, 110 + size);
     ResidualBlockWeights w{RandomConvAffine(3, 6, 111), RandomConvAffine(6, 6, 112)};
-    Tensor3 branch = NaiveAffine(NaiveConv(x, w.conv1.conv, 2, Padding::Valid()), w.conv1, true);
-    branch = NaiveAffine(NaiveConv(branch, w.conv2.conv, 1, Padding::Uniform(1)), w.conv2, false);
+    infer::Tensor3 branch = NaiveAffine(NaiveConv(x, w.conv1.conv, 2, infer::Padding::Valid()), w.conv1, true);
+    branch = NaiveAffine(NaiveConv(branch, w.conv2.conv, 1, infer::Padding::Uniform(1)), w.conv2, false);
     const int ph = size / 2;
-    Tensor3 ref(ph, ph, 6);
+    infer::Tensor3 ref(ph, ph, 6);
     for (int y = 0; y < ph; ++y)
       for (int i = 0; i < ph; ++i)
         for (int c = 0; c < 6; ++c) {
@@ -84,41 +82,9 @@ TEST(FaceDescriptorTest, DistanceAndCosine) {
   EXPECT_DOUBLE_EQ(DescriptorDistance(a, a), 0.0);
 }
 
-// Writes a tiny TF.js manifest + shard: one float32 tensor and one uint8-quantised tensor.
-fs::path WriteTinyTfjs(const fs::path& dir, size_t truncate_by = 0) {
-  fs::create_directories(dir);
-  const std::string manifest = R"([{"paths": ["w.bin"], "weights": [
-    {"name": "a", "shape": [2, 2], "dtype": "float32"},
-    {"name": "b", "shape": [3], "dtype": "float32",
-     "quantization": {"dtype": "uint8", "scale": 0.5, "min": -1.0}}]}])";
-  std::string bin(4 * 4 + 3, '\0');
-  const float a[4] = {1.f, -2.f, 3.5f, 0.25f};
-  std::memcpy(bin.data(), a, sizeof(a));
-  bin[16] = char(0);
-  bin[17] = char(4);
-  bin[18] = char(255);
-  bin.resize(bin.size() - truncate_by);
-  EXPECT_TRUE(WriteFileAtomic(dir / "m.json", manifest).ok());
-  EXPECT_TRUE(WriteFileAtomic(dir / "w.bin", bin).ok());
-  return dir / "m.json";
-}
-
-TEST(TfjsWeightsTest, DecodesFloatAndQuantisedTensors) {
-  const fs::path dir = fs::path(::testing::TempDir()) / "icef_tfjs_ok";
-  const Result<TensorMap> tensors = ReadTfjsWeights(WriteTinyTfjs(dir));
-  ASSERT_TRUE(tensors.ok()) << tensors.status().message();
-  ASSERT_EQ(tensors->size(), 2u);
-  EXPECT_EQ(tensors->at("a").shape, (std::vector<int>{2, 2}));
-  EXPECT_EQ(tensors->at("a").values, (std::vector<float>{1.f, -2.f, 3.5f, 0.25f}));
-  EXPECT_EQ(tensors->at("b").values, (std::vector<float>{-1.f, 1.f, 126.5f}));
-}
-
-TEST(TfjsWeightsTest, TruncatedShardAndMissingTensorAreErrors) {
-  const fs::path dir = fs::path(::testing::TempDir()) / "icef_tfjs_short";
-  const Result<TensorMap> tensors = ReadTfjsWeights(WriteTinyTfjs(dir, 1));
-  ASSERT_FALSE(tensors.ok());
-  EXPECT_NE(tensors.status().message().find("weights[1]"), std::string::npos) << tensors.status().message();
-  const Result<TensorMap> good = ReadTfjsWeights(WriteTinyTfjs(dir));
+TEST(FaceDescriptorTest, MissingTensorsAndMissingFilesAreErrors) {
+  const fs::path dir = fs::path(::testing::TempDir()) / "icef_tfjs_tiny";
+  const Result<infer::TensorMap> good = infer::ReadTfjsWeights(WriteTinyTfjs(dir));
   ASSERT_TRUE(good.ok());
   const Result<FaceDescriptorNet> net = FaceDescriptorNet::FromTensors(*good, "tiny");
   ASSERT_FALSE(net.ok());

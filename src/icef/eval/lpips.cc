@@ -70,7 +70,7 @@ std::string LinName(int i) { return "lin" + std::to_string(i) + ".weight"; }
 std::string LpipsWeights::ToString() const {
   std::ostringstream s;
   s << "LpipsWeights(alex, channels";
-  for (const ConvWeights& c : conv) s << " " << c.cout;
+  for (const infer::ConvWeights& c : conv) s << " " << c.cout;
   s << ")";
   return s.str();
 }
@@ -78,7 +78,7 @@ std::string LpipsWeights::ToString() const {
 Status ValidateLpipsWeights(const LpipsWeights& w, const std::string& source) {
   int cin = 3;
   for (int i = 0; i < kLpipsLayers; ++i) {
-    const ConvWeights& c = w.conv[i];
+    const infer::ConvWeights& c = w.conv[i];
     const std::string name = source + ": conv" + std::to_string(i + 1);
     if (c.kh != kKernel[i] || c.kw != kKernel[i])
       return Status::Error(name + ".weight: kernel " + std::to_string(c.kh) + "x" + std::to_string(c.kw) +
@@ -103,7 +103,7 @@ Status WriteLpipsWeights(const std::filesystem::path& path, const LpipsWeights& 
   PutU32(out, kVersion);
   PutU32(out, 3 * kLpipsLayers);
   for (int i = 0; i < kLpipsLayers; ++i) {
-    const ConvWeights& c = w.conv[i];
+    const infer::ConvWeights& c = w.conv[i];
     std::vector<float> oihw(c.filters.size());  // HWIO -> OIHW (PyTorch)
     for (int y = 0; y < c.kh; ++y)
       for (int x = 0; x < c.kw; ++x)
@@ -168,7 +168,7 @@ Result<LpipsWeights> ReadLpipsWeights(const std::filesystem::path& path) {
     ICEF_ASSIGN_OR_RETURN(const RawTensor* weight, get(ConvName(i, "weight"), 4));
     ICEF_ASSIGN_OR_RETURN(const RawTensor* bias, get(ConvName(i, "bias"), 1));
     ICEF_ASSIGN_OR_RETURN(const RawTensor* lin, get(LinName(i), 4));
-    ConvWeights& c = w.conv[i];
+    infer::ConvWeights& c = w.conv[i];
     c.cout = int(weight->dims[0]);
     c.cin = int(weight->dims[1]);
     c.kh = int(weight->dims[2]);
@@ -205,18 +205,18 @@ Result<LpipsNet> LpipsNet::Load(const std::filesystem::path& path) {
   return FromWeights(std::move(weights), path.string());
 }
 
-std::array<Tensor3, kLpipsLayers> LpipsNet::Features(const Image& image) const {
-  Tensor3 x(image.height, image.width, 3);
+std::array<infer::Tensor3, kLpipsLayers> LpipsNet::Features(const Image& image) const {
+  infer::Tensor3 x(image.height, image.width, 3);
   for (int y = 0; y < image.height; ++y)
     for (int i = 0; i < image.width; ++i) {
       const Vec3f rgb = image.Rgb(i, y);
       for (int c = 0; c < 3; ++c) x.At(y, i, c) = (2.f * rgb[c] - 1.f - kShift[c]) / kScale[c];
     }
-  std::array<Tensor3, kLpipsLayers> taps;
+  std::array<infer::Tensor3, kLpipsLayers> taps;
   for (int l = 0; l < kLpipsLayers; ++l) {
-    if (l == 1 || l == 2) x = MaxPool(x, 3, 2);
-    x = Conv2d(x, weights_.conv[l], kStride[l], Padding::Uniform(kPad[l]));
-    Relu(x);
+    if (l == 1 || l == 2) x = infer::MaxPool(x, 3, 2);
+    x = infer::Conv2d(x, weights_.conv[l], kStride[l], infer::Padding::Uniform(kPad[l]));
+    infer::Relu(x);
     taps[l] = x;
   }
   return taps;
@@ -230,7 +230,7 @@ Result<double> LpipsNet::Distance(const Image& a, const Image& b) const {
   const auto fa = Features(a), fb = Features(b);
   double total = 0.0;
   for (int l = 0; l < kLpipsLayers; ++l) {
-    const Tensor3 &x = fa[l], &y = fb[l];
+    const infer::Tensor3 &x = fa[l], &y = fb[l];
     const size_t pixels = size_t(x.h) * x.w;
     double layer = 0.0;
     for (size_t p = 0; p < pixels; ++p) {

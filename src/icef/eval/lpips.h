@@ -27,7 +27,7 @@
 #include <vector>
 
 #include "icef/core/status.h"
-#include "icef/eval/cnn_layers.h"
+#include "icef/infer/cnn_layers.h"
 #include "icef/io/image.h"
 
 namespace icef::eval {
@@ -38,7 +38,7 @@ constexpr int kLpipsMinSize = 31;
 constexpr const char* kLpipsWeightsFileName = "lpips_alex_v0.1.bin";
 
 struct LpipsWeights {
-  std::array<ConvWeights, kLpipsLayers> conv;       // HWIO filters + bias, AlexNet conv1..conv5
+  std::array<infer::ConvWeights, kLpipsLayers> conv;       // HWIO filters + bias, AlexNet conv1..conv5
   std::array<std::vector<float>, kLpipsLayers> lin;  // [C_i] linear-head weights
   std::string ToString() const;
 };
@@ -57,7 +57,7 @@ class LpipsNet {
   // LPIPS between two images of equal size (RGB; alpha ignored), values in [0, 1].
   Result<double> Distance(const Image& a, const Image& b) const;
   // The five tapped feature maps of one image (after the scaling layer).
-  std::array<Tensor3, kLpipsLayers> Features(const Image& image) const;
+  std::array<infer::Tensor3, kLpipsLayers> Features(const Image& image) const;
 
   const std::string& source() const { return source_; }
   std::string ToString() const;

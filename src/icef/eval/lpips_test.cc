@@ -5,13 +5,13 @@
 #include <cmath>
 #include <filesystem>
 
-#include "icef/eval/cnn_test_util.h"
+#include "icef/infer/cnn_test_util.h"
 #include "icef/io/atomic_file.h"
 
 namespace icef::eval {
 namespace {
 
-using namespace ::icef::eval::testing;
+using namespace ::icef::infer::testing;
 namespace fs = std::filesystem;
 
 // Tiny AlexNet-shaped weights (the real kernel sizes, few channels); non-negative heads as LPIPS's.
@@ -41,14 +41,14 @@ double NaiveLpips(const LpipsWeights& w, const Image& a, const Image& b) {
   const double shift[3] = {-0.030, -0.088, -0.188}, scale[3] = {0.458, 0.448, 0.450};
   const int stride[5] = {4, 1, 1, 1, 1}, pad[5] = {2, 2, 1, 1, 1};
   auto taps = [&](const Image& im) {
-    Tensor3 x(im.height, im.width, 3);
+    infer::Tensor3 x(im.height, im.width, 3);
     for (int y = 0; y < im.height; ++y)
       for (int i = 0; i < im.width; ++i)
         for (int c = 0; c < 3; ++c) x.At(y, i, c) = float((2.0 * im.At(i, y, c) - 1.0 - shift[c]) / scale[c]);
-    std::vector<Tensor3> out;
+    std::vector<infer::Tensor3> out;
     for (int l = 0; l < 5; ++l) {
       if (l == 1 || l == 2) {
-        Tensor3 p((x.h - 3) / 2 + 1, (x.w - 3) / 2 + 1, x.c);
+        infer::Tensor3 p((x.h - 3) / 2 + 1, (x.w - 3) / 2 + 1, x.c);
         for (int y = 0; y < p.h; ++y)
           for (int i = 0; i < p.w; ++i)
             for (int c = 0; c < x.c; ++c) {
@@ -59,7 +59,7 @@ double NaiveLpips(const LpipsWeights& w, const Image& a, const Image& b) {
             }
         x = p;
       }
-      x = NaiveConv(x, w.conv[l], stride[l], Padding::Uniform(pad[l]));
+      x = NaiveConv(x, w.conv[l], stride[l], infer::Padding::Uniform(pad[l]));
       for (float& v : x.data) v = std::max(v, 0.f);
       out.push_back(x);
     }

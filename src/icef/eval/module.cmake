@@ -1,5 +1,5 @@
 find_package(dlib REQUIRED)
-icef_module(eval DEPS icef_train icef_synth icef_landmarks dlib::dlib)
+icef_module(eval DEPS icef_train icef_synth icef_landmarks icef_infer dlib::dlib)
 if(TARGET icef_eval_test)
   target_compile_definitions(icef_eval_test PRIVATE ICEF_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
 endif()

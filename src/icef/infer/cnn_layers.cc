@@ -1,4 +1,4 @@
-#include "icef/eval/cnn_layers.h"
+#include "icef/infer/cnn_layers.h"
 
 // Eigen's AVX-512 GEMM packing trips a GCC 12 false positive (-Wmaybe-uninitialized inside
 // avx512fintrin.h after inlining); the code is correct, so the warning is silenced for this file.
@@ -12,7 +12,7 @@
 
 #include "icef/core/status.h"
 
-namespace icef::eval {
+namespace icef::infer {
 namespace {
 
 using RowMatrix = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
@@ -179,4 +179,4 @@ std::vector<float> FullyConnected(const std::vector<float>& x, const std::vector
   return y;
 }
 
-}  // namespace icef::eval
+}  // namespace icef::infer

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-namespace icef::eval {
+namespace icef::infer {
 
 // [h, w, c] row-major, channels fastest.
 struct Tensor3 {
@@ -72,4 +72,4 @@ std::vector<float> GlobalMean(const Tensor3& input);
 // y[o] = sum_i x[i] * weights[i, o]; weights [in, out] row-major.
 std::vector<float> FullyConnected(const std::vector<float>& x, const std::vector<float>& weights, int out);
 
-}  // namespace icef::eval
+}  // namespace icef::infer

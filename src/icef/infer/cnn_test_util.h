@@ -3,12 +3,15 @@
 
 #include <gtest/gtest.h>
 
+#include <cstring>
+#include <filesystem>
 #include <string>
 
 #include "icef/core/rng.h"
-#include "icef/eval/cnn_layers.h"
+#include "icef/io/atomic_file.h"
+#include "icef/infer/cnn_layers.h"
 
-namespace icef::eval::testing {
+namespace icef::infer::testing {
 
 inline Tensor3 RandomTensor(int h, int w, int c, uint64_t item) {
   Rng rng(7, StreamId("cnn_layers_test"), 0, item);
@@ -61,4 +64,23 @@ inline void ExpectNear(const Tensor3& a, const Tensor3& b, double tol) {
   for (size_t i = 0; i < a.data.size(); ++i) ASSERT_NEAR(a.data[i], b.data[i], tol) << "index " << i;
 }
 
-}  // namespace icef::eval::testing
+// Writes a tiny TF.js manifest + shard: one float32 tensor and one uint8-quantised tensor.
+inline std::filesystem::path WriteTinyTfjs(const std::filesystem::path& dir, size_t truncate_by = 0) {
+  std::filesystem::create_directories(dir);
+  const std::string manifest = R"([{"paths": ["w.bin"], "weights": [
+    {"name": "a", "shape": [2, 2], "dtype": "float32"},
+    {"name": "b", "shape": [3], "dtype": "float32",
+     "quantization": {"dtype": "uint8", "scale": 0.5, "min": -1.0}}]}])";
+  std::string bin(4 * 4 + 3, '\0');
+  const float a[4] = {1.f, -2.f, 3.5f, 0.25f};
+  std::memcpy(bin.data(), a, sizeof(a));
+  bin[16] = char(0);
+  bin[17] = char(4);
+  bin[18] = char(255);
+  bin.resize(bin.size() - truncate_by);
+  EXPECT_TRUE(WriteFileAtomic(dir / "m.json", manifest).ok());
+  EXPECT_TRUE(WriteFileAtomic(dir / "w.bin", bin).ok());
+  return dir / "m.json";
+}
+
+}  // namespace icef::infer::testing

@@ -1,17 +1,17 @@
 // Each layer against a naive double-precision reference on random small tensors.
-#include "icef/eval/cnn_layers.h"
+#include "icef/infer/cnn_layers.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 
-#include "icef/eval/cnn_test_util.h"
+#include "icef/infer/cnn_test_util.h"
 
-namespace icef::eval {
+namespace icef::infer {
 namespace {
 
-using namespace ::icef::eval::testing;
+using namespace ::icef::infer::testing;
 
 struct ConvCase {
   int h, w, cin, cout, k, stride;
@@ -125,4 +125,4 @@ TEST(CnnLayersTest, GlobalMeanAndFullyConnected) {
 }
 
 }  // namespace
-}  // namespace icef::eval
+}  // namespace icef::infer

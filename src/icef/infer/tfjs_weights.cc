@@ -1,4 +1,4 @@
-#include "icef/eval/tfjs_weights.h"
+#include "icef/infer/tfjs_weights.h"
 
 #include <cstring>
 #include <nlohmann/json.hpp>
@@ -6,7 +6,7 @@
 
 #include "icef/io/atomic_file.h"
 
-namespace icef::eval {
+namespace icef::infer {
 
 std::string NamedTensor::ToString() const {
   std::ostringstream s;
@@ -105,4 +105,4 @@ Result<TensorMap> ReadTfjsWeights(const std::filesystem::path& manifest_path) {
   return tensors;
 }
 
-}  // namespace icef::eval
+}  // namespace icef::infer

@@ -10,7 +10,7 @@
 
 #include "icef/core/status.h"
 
-namespace icef::eval {
+namespace icef::infer {
 
 struct NamedTensor {
   std::vector<int> shape;     // as in the manifest (filters: [kh, kw, cin, cout])
@@ -25,4 +25,4 @@ using TensorMap = std::map<std::string, NamedTensor>;
 // name the file and the field, e.g. "m.json: [0].weights[3].quantization.dtype: unsupported 'float16'".
 Result<TensorMap> ReadTfjsWeights(const std::filesystem::path& manifest_path);
 
-}  // namespace icef::eval
+}  // namespace icef::infer
