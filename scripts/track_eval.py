@@ -47,9 +47,11 @@ def evaluate_seed(icef, out, seed, photos, res, extra, synth_extra):
         subprocess.run(["rm", "-rf", d], check=True)
     subprocess.run([icef, "synth", "--photos", str(photos), "--identity-seed", str(seed), "--out", photo_dir] + synth_extra,
                    check=True, stdout=subprocess.DEVNULL)
-    subprocess.run([icef, "track", os.path.join(photo_dir, "photos"), "--out", data_dir, "--res", str(res), "--skip-bad"] + extra,
-                   check=True, stdout=subprocess.DEVNULL)
     truth = json.load(open(os.path.join(photo_dir, "truth", "truth.json")))
+    # The true focal length (all photos of a set share it), unless the caller passes its own.
+    focal = [] if "--focal" in extra else ["--focal", str(truth["photos"][0]["fl_x"])]
+    subprocess.run([icef, "track", os.path.join(photo_dir, "photos"), "--out", data_dir, "--res", str(res), "--skip-bad"] + focal + extra,
+                   check=True, stdout=subprocess.DEVNULL)
     report = json.load(open(os.path.join(data_dir, "track", "report.json")))
     names = truth["expression_names"]
     frames = {}

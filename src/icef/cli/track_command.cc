@@ -41,6 +41,15 @@ CommandFn RegisterTrack(CLI::App& app) {
                  "With --keep-cameras: whose 2D landmarks to fit: detect (dlib, in every frame; default), dlib (the "
                  "dataset's own landmarks_2d, from icef landmarks or icef track), model (the dataset's own, in the face "
                  "model's convention, as icef synth writes them)");
+  app.add_option("--silhouette-points", options->track.silhouette_points,
+                 "Refit each photo's pose, expression and the shape with this many points of its mask's edge "
+                 "beside the landmarks (0 = landmarks only; default 200)");
+  auto region = std::make_shared<std::string>("face");
+  app.add_option("--silhouette-region", *region,
+                 "Which part of the mask's edge the refit uses: face (where it touches the head between the chin and "
+                 "the brows; default: a real head's crown is hair and its neck runs into clothes) or head (the whole "
+                 "outline: heads without hair, such as icef synth --photos)")
+      ->check(CLI::IsMember({"face", "head"}));
   app.add_option("--threads", options->threads, "Worker threads (0 = all cores)");
   app.add_option("--predictor", options->predictor,
                  "dlib 68-point shape predictor (default " + std::string(kDefaultShapePredictorPath) + ")");
@@ -48,7 +57,8 @@ CommandFn RegisterTrack(CLI::App& app) {
   app.add_flag("--calibrate-detector", *calibrate,
                "Developer: measure where dlib puts its landmarks on the face model (renders of validation "
                "identities) and print the table of src/icef/track/detector_landmarks.inc");
-  return [options, focal, calibrate, landmarks, &app]() -> Status {
+  return [options, focal, calibrate, landmarks, region, &app]() -> Status {
+    options->track.fit.silhouette_face_only = *region == "face";
     const auto parsed = track::ParseRetrackLandmarks(*landmarks);
     if (!parsed) return Status::Error("--landmarks: expected detect, dlib or model, got \"" + *landmarks + "\"");
     options->landmarks = *parsed;

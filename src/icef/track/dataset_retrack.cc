@@ -90,7 +90,7 @@ Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions
     std::vector<Frame>* frames = Split(d, split);
     for (size_t i = 0; i < frames->size(); ++i) {
       Frame& f = (*frames)[i];
-      track_frames.push_back(TrackFrame{*f.landmarks_2d, f.camera.intrinsics(), f.camera.world_from_cam()});
+      track_frames.push_back(TrackFrame{*f.landmarks_2d, f.camera.intrinsics(), f.camera.world_from_cam(), {}});
       order.push_back(&f);
       result.frame_names.push_back(FrameName(split, static_cast<int>(i), f));
     }

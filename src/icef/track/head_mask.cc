@@ -94,6 +94,27 @@ Image HeadMask(const Image& image, const Image& silhouette, const Image& outside
   return out;
 }
 
+std::vector<Vec2f> MaskEdgePoints(const Image& mask, const Image& outside, int max_points) {
+  const int w = mask.width, h = mask.height;
+  const auto in = [&](int x, int y) { return mask.At(x, y, 0) > 0.5f; };
+  const auto off_photo = [&](int x, int y) { return !outside.empty() && outside.At(x, y, 0) > 0.5f; };
+  std::vector<Vec2f> all;
+  for (int y = 1; y + 1 < h; ++y)
+    for (int x = 1; x + 1 < w; ++x) {
+      if (!in(x, y) || off_photo(x, y)) continue;
+      constexpr int kDx[4] = {1, -1, 0, 0}, kDy[4] = {0, 0, 1, -1};
+      for (int k = 0; k < 4; ++k) {
+        const int nx = x + kDx[k], ny = y + kDy[k];
+        if (in(nx, ny) || off_photo(nx, ny) || nx == 0 || ny == 0 || nx + 1 == w || ny + 1 == h) continue;
+        all.emplace_back(x + 0.5f + 0.5f * kDx[k], y + 0.5f + 0.5f * kDy[k]);
+      }
+    }
+  if (max_points <= 0 || static_cast<int>(all.size()) <= max_points) return all;
+  std::vector<Vec2f> out;
+  for (int i = 0; i < max_points; ++i) out.push_back(all[size_t(i) * all.size() / max_points]);
+  return out;
+}
+
 double MaskIou(const Image& a, const Image& b) {
   int64_t inter = 0, uni = 0;
   for (int y = 0; y < std::min(a.height, b.height); ++y)

@@ -33,6 +33,12 @@ Image HeadSilhouette(const face::FaceModel& model, const std::vector<float>& exp
 // empty) marks pixels that lie outside the original photo. Deterministic.
 Image HeadMask(const Image& image, const Image& silhouette, const Image& outside, const HeadMaskOptions& options = {});
 
+// Points on the edge of `mask` (1-channel, > 0.5 inside), in pixels (pixel centres at +0.5): the
+// midpoint between each inside pixel and each of its 4-neighbours outside, leaving out edges at the
+// image border and edges touching `outside` (1-channel, may be empty: pixels the photo does not
+// cover). At most max_points, evenly spaced in scan order. Deterministic.
+std::vector<Vec2f> MaskEdgePoints(const Image& mask, const Image& outside, int max_points);
+
 // Intersection over union of two masks (> 0.5).
 double MaskIou(const Image& a, const Image& b);
 

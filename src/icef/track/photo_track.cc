@@ -87,27 +87,50 @@ Intrinsics PhotoIntrinsics(const fs::path& path, const Image& photo, const Track
   return k;
 }
 
+// A tracked photo's crop around the fitted head, its camera and its foreground mask.
+struct HeadCrop {
+  CropBox box;
+  Image rgb;      // the crop (RGB)
+  Image outside;  // 1 where the crop leaves the photo
+  Image mask;     // GrabCut's foreground
+  Camera camera;  // the crop's camera (world = head frame)
+};
+
+HeadCrop CropHead(const face::FaceModel& model, const TrackedFrame& tracked, const TrackedPhoto& photo,
+                  const TrackOptions& options, const Executor& executor) {
+  HeadCrop c;
+  const Camera photo_camera(photo.photo_intrinsics, Inverse(tracked.cam_from_head));
+  c.box = HeadCropBox(photo_camera, options.crop_margin);
+  c.rgb = CropImage(photo.photo, c.box, options.resolution, &c.outside);
+  c.camera = Camera(CropIntrinsics(photo.photo_intrinsics, c.box, options.resolution), Inverse(tracked.cam_from_head));
+  const Image silhouette = HeadSilhouette(model, tracked.expression, c.camera, executor);
+  c.mask = HeadMask(c.rgb, silhouette, c.outside, options.mask);
+  return c;
+}
+
+// The edge points of the photo's mask, in the photo's pixels.
+std::vector<Vec2f> SilhouettePoints(const HeadCrop& c, int resolution, int max_points) {
+  std::vector<Vec2f> points = MaskEdgePoints(c.mask, c.outside, max_points);
+  const float scale = static_cast<float>(c.box.size / resolution);
+  for (Vec2f& p : points) p = Vec2f(static_cast<float>(c.box.x0), static_cast<float>(c.box.y0)) + scale * p;
+  return points;
+}
+
 // The dataset frame and image of one tracked photo.
 void BuildFrame(const face::FaceModel& model, const TrackedFrame& tracked, const TrackOptions& options,
                 const Executor& executor, TrackedPhoto* photo, Frame* frame) {
-  const Camera photo_camera(photo->photo_intrinsics, Inverse(tracked.cam_from_head));
-  photo->crop = HeadCropBox(photo_camera, options.crop_margin);
-  Image outside;
-  const Image rgb = CropImage(photo->photo, photo->crop, options.resolution, &outside);
-  const Intrinsics k = CropIntrinsics(photo->photo_intrinsics, photo->crop, options.resolution);
-  const Camera camera(k, Inverse(tracked.cam_from_head));
-  const Image silhouette = HeadSilhouette(model, tracked.expression, camera, executor);
-  const Image mask = HeadMask(rgb, silhouette, outside, options.mask);
+  const HeadCrop c = CropHead(model, tracked, *photo, options, executor);
+  photo->crop = c.box;
   photo->image = Image(options.resolution, options.resolution, 4);
   for (int y = 0; y < options.resolution; ++y)
     for (int x = 0; x < options.resolution; ++x) {
-      const Vec3f c = rgb.Rgb(x, y);
-      for (int ch = 0; ch < 3; ++ch) photo->image.At(x, y, ch) = std::clamp(c[ch], 0.f, 1.f);
-      photo->image.At(x, y, 3) = mask.At(x, y, 0);
+      const Vec3f rgb = c.rgb.Rgb(x, y);
+      for (int ch = 0; ch < 3; ++ch) photo->image.At(x, y, ch) = std::clamp(rgb[ch], 0.f, 1.f);
+      photo->image.At(x, y, 3) = c.mask.At(x, y, 0);
     }
   const std::string split = photo->test ? "test" : "train";
   frame->file_path = "images/" + split + "_" + Pad3(photo->frame_index) + ".png";
-  frame->camera = camera;
+  frame->camera = c.camera;
   frame->expression = tracked.expression;
   frame->landmarks_2d = CropPoints(photo->detection.landmarks, photo->crop, options.resolution);
   frame->landmarks_3d = std::vector<Vec3f>(tracked.landmarks_head.begin(), tracked.landmarks_head.end());
@@ -129,6 +152,7 @@ Status TrackOptions::Validate() const {
   if (focal && !(*focal > 0 && std::isfinite(*focal))) return Status::Error("focal must be a finite number > 0");
   if (num_test < 0) return Status::Error("the number of test photos must be >= 0");
   if (!(crop_margin >= 1 && crop_margin <= 3)) return Status::Error("crop_margin must be in [1, 3]");
+  if (silhouette_points < 0) return Status::Error("silhouette_points must be >= 0");
   ICEF_RETURN_IF_ERROR(fit.Validate());
   return mask.Validate();
 }
@@ -136,7 +160,8 @@ Status TrackOptions::Validate() const {
 std::string TrackOptions::ToString() const {
   std::ostringstream os;
   os << "TrackOptions(resolution=" << resolution << ", focal=" << (focal ? std::to_string(*focal) : "auto")
-     << ", num_test=" << num_test << ", skip_bad=" << skip_bad << ", crop_margin=" << crop_margin << ", "
+     << ", num_test=" << num_test << ", skip_bad=" << skip_bad << ", crop_margin=" << crop_margin
+     << ", silhouette_points=" << silhouette_points << ", "
      << fit.ToString() << ", " << mask.ToString() << ")";
   return os.str();
 }
@@ -176,9 +201,19 @@ Result<TrackResult> TrackPhotos(const std::vector<fs::path>& photos, const Track
                          std::to_string(options.num_test));
 
   std::vector<TrackFrame> frames;
-  for (const TrackedPhoto& p : result.photos) frames.push_back(TrackFrame{p.detection.landmarks, p.photo_intrinsics, {}});
+  for (const TrackedPhoto& p : result.photos) frames.push_back(TrackFrame{p.detection.landmarks, p.photo_intrinsics, {}, {}});
   ICEF_ASSIGN_OR_RETURN(result.fit, FitTrack(frames, options.fit));
   if (log) log(result.fit.BriefReport());
+  if (options.silhouette_points > 0) {
+    // Refit with the silhouettes of the masks the landmark fit gives.
+    const face::FaceModel first(result.fit.shape);
+    for (int i = 0; i < kept; ++i) {
+      const HeadCrop c = CropHead(first, result.fit.frames[i], result.photos[i], options, executor);
+      frames[i].silhouette = SilhouettePoints(c, options.resolution, options.silhouette_points);
+    }
+    ICEF_ASSIGN_OR_RETURN(result.fit, FitTrack(frames, options.fit));
+    if (log) log(result.fit.BriefReport() + " (with silhouettes)");
+  }
 
   Dataset& d = result.dataset;
   d.expression_dim = face::kNumExpressions;
@@ -225,6 +260,8 @@ Json TrackReportJson(const TrackResult& result) {
                           {"landmark_rms_iod", f.rms_iod},
                           {"landmark_max_iod", f.max_iod},
                           {"landmarks_used", f.landmarks_used},
+                          {"silhouette_rms_iod", f.silhouette_rms_iod},
+                          {"silhouette_points_used", f.silhouette_used},
                           {"yaw_pitch_roll_deg", {ypr.x(), ypr.y(), ypr.z()}},
                           {"head_in_camera", {t.x(), t.y(), t.z()}},
                           {"expression", expression}});

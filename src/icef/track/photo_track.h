@@ -33,6 +33,7 @@ struct TrackOptions {
   int num_test = 0;                 // the last num_test photos become test frames
   bool skip_bad = false;            // skip photos without exactly one face instead of stopping
   double crop_margin = 1.15;        // crop side / the head box's projected extent
+  int silhouette_points = 200;      // refit with this many mask edge points per photo (0: landmarks only)
   TrackFitOptions fit;
   HeadMaskOptions mask;
 

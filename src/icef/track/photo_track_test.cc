@@ -107,6 +107,9 @@ TEST_F(PhotoTrackTest, SyntheticPhotosBecomeADatasetInTheHeadFrame) {
                     photos.truth[i].camera.world_from_cam().block<3, 3>(0, 0);
     EXPECT_LT(Eigen::AngleAxisd(d).angle() * 180 / M_PI, 15.0) << "photo " << i;
     EXPECT_LT(r.fit.frames[i].rms_iod, 0.1) << "photo " << i;
+    // The refit used the mask's edge between the chin and the brows.
+    EXPECT_GT(r.fit.frames[i].silhouette_used, 10) << "photo " << i;
+    EXPECT_LT(r.fit.frames[i].silhouette_rms_iod, 0.1) << "photo " << i;
     // The mask against the true coverage, cropped the same way.
     ASSERT_EQ(p.image.channels, 4);
     Image mask(128, 128, 1);
@@ -179,6 +182,28 @@ TEST_F(PhotoTrackTest, BadPhotosAreClearErrorsAndNothingIsWritten) {
   r = TrackPhotos({photos.files[0]}, all_test, *detector_, Executor(2));
   ASSERT_FALSE(r.ok());
   EXPECT_NE(r.status().message().find("at least one training photo"), std::string::npos);
+}
+
+TEST(HeadMaskTest, EdgePointsLieBetweenInsideAndOutsidePixels) {
+  Image mask(10, 8, 1), outside(10, 8, 1);
+  for (int y = 2; y < 6; ++y)
+    for (int x = 3; x < 7; ++x) mask.At(x, y, 0) = 1.f;  // pixels [3, 7) x [2, 6): edges at x = 3, 7 and y = 2, 6
+  std::vector<Vec2f> points = MaskEdgePoints(mask, Image(), 0);
+  ASSERT_EQ(points.size(), 16u);
+  for (const Vec2f& p : points) {
+    const bool vertical = p.x() == 3.f || p.x() == 7.f, horizontal = p.y() == 2.f || p.y() == 6.f;
+    EXPECT_TRUE(vertical != horizontal) << p.transpose();
+  }
+  // Edges touching pixels outside the photo are left out; max_points keeps an even subset.
+  for (int y = 0; y < 8; ++y) outside.At(7, y, 0) = 1.f;
+  points = MaskEdgePoints(mask, outside, 0);
+  EXPECT_EQ(points.size(), 12u);
+  for (const Vec2f& p : points) EXPECT_NE(p.x(), 7.f);
+  EXPECT_EQ(MaskEdgePoints(mask, outside, 5).size(), 5u);
+  // A mask reaching the image border has no edge there.
+  Image full(6, 6, 1);
+  for (float& v : full.pixels) v = 1.f;
+  EXPECT_TRUE(MaskEdgePoints(full, Image(), 0).empty());
 }
 
 TEST(PhotoCropTest, CropCarriesTheCameraAndThePoints) {

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <limits>
 #include <memory>
 #include <sstream>
 
@@ -73,6 +74,7 @@ struct FrameProblem {
   double iod_px = 1;
   Mat3d base_rotation = Mat3d::Identity();  // photos: the initial head rotation
   std::array<double, kNumLandmarks> weight{};
+  std::vector<double> silhouette_weight;  // [frame->silhouette.size()]: 1, or 0 once an outlier
 };
 
 struct Shared {
@@ -82,6 +84,9 @@ struct Shared {
   bool known_cameras = false;
   bool dlib_convention = true;  // fit the model's landmarks moved by DlibLandmarkOffsets()
   double landmark_sigma = 0.06;  // TrackFitOptions::landmark_sigma_iod
+  double silhouette_sigma = 0.03;  // TrackFitOptions::silhouette_sigma_iod
+  double iod_head = 1;  // the average head's inter-ocular distance (head units)
+  bool use_silhouettes = false;  // add the frames' silhouette residuals (the second stage)
 };
 
 // The camera seeing the head frame (photos) or the dataset world (known cameras) for a pose.
@@ -200,6 +205,128 @@ class LandmarkCost : public ceres::DynamicCostFunction {
   Shared* shared_;
 };
 
+// The head-frame ray through pixel `uv` of a frame for a pose.
+Ray HeadRay(const FrameProblem& fp, const Shared& shared, const double* pose, const Vec2f& uv) {
+  const Camera camera = FrameCamera(fp, shared, pose);
+  const Ray world = camera.RayThrough(uv.x(), uv.y());
+  if (!shared.known_cameras) return world;
+  const face::Similarity sim = SharedSimilarity(shared, pose);
+  return Ray{sim.Apply(world.origin.cast<double>()).cast<float>(), (sim.rotation * world.direction.cast<double>()).cast<float>()};
+}
+
+// The ray parameter of the ray's closest approach to the head's surface: the smallest distance
+// bound over 64 samples around the head, refined by golden-section search. The head lies within
+// 1.2 head units of the frame's origin.
+float ClosestApproach(const face::FaceModel& model, const face::ExpressionState& state, const Ray& ray) {
+  const float t_mid = -ray.origin.dot(ray.direction);
+  constexpr int kSamples = 64;
+  constexpr float kHalf = 1.2f, kStep = 2 * kHalf / (kSamples - 1);
+  float best_t = t_mid, best = std::numeric_limits<float>::infinity();
+  for (int i = 0; i < kSamples; ++i) {
+    const float t = t_mid - kHalf + i * kStep;
+    const float d = model.Distance(ray.At(t), state);
+    if (d < best) best = d, best_t = t;
+  }
+  constexpr float kGolden = 0.618034f;
+  float a = best_t - kStep, b = best_t + kStep;
+  float c = b - kGolden * (b - a), e = a + kGolden * (b - a);
+  float fc = model.Distance(ray.At(c), state), fe = model.Distance(ray.At(e), state);
+  for (int i = 0; i < 20; ++i) {
+    if (fc < fe) {
+      b = e, e = c, fe = fc, c = b - kGolden * (b - a), fc = model.Distance(ray.At(c), state);
+    } else {
+      a = c, c = e, fc = fe, e = a + kGolden * (b - a), fe = model.Distance(ray.At(e), state);
+    }
+  }
+  return 0.5f * (a + b);
+}
+
+// The silhouette residuals of one frame: for each edge point of its mask, the distance bound of the
+// fitted surface at the closest approach of the point's ray (head units over the average head's
+// IOD): 0 where the ray grazes the head, > 0 where it passes outside, < 0 where it cuts through.
+// Jacobian by finite differences at the closest approach found for the current parameters (the
+// minimum's derivative is the distance's there: the envelope theorem), with LandmarkCost's steps.
+class SilhouetteCost : public ceres::DynamicCostFunction {
+ public:
+  SilhouetteCost(const FrameProblem* fp, Shared* shared) : fp_(fp), shared_(shared) {
+    AddParameterBlock(kShape);
+    AddParameterBlock(kExpr);
+    AddParameterBlock(shared->known_cameras ? kSharedPose : kPhotoPose);
+    SetNumResiduals(static_cast<int>(fp->frame->silhouette.size()));
+  }
+
+  bool Evaluate(double const* const* params, double* residuals, double** jacobians) const override {
+    const size_t n = fp_->frame->silhouette.size();
+    std::vector<float> t_star(n);
+    Residuals(params, residuals, &t_star, /*find=*/true);
+    if (!jacobians) return true;
+    const int sizes[3] = {kShape, kExpr, shared_->known_cameras ? kSharedPose : kPhotoPose};
+    std::vector<double> a(n), b(n), at_star(n);
+    Residuals(params, at_star.data(), &t_star, /*find=*/false);
+    for (int block = 0; block < 3; ++block) {
+      if (!jacobians[block]) continue;
+      std::vector<double> x(params[block], params[block] + sizes[block]);
+      double const* p[3] = {params[0], params[1], params[2]};
+      p[block] = x.data();
+      for (int j = 0; j < sizes[block]; ++j) {
+        const double h = block == 0 ? 2e-3 : block == 1 ? 1e-2 : 1e-3;
+        const double x0 = x[j];
+        const bool forward = block == 1 && x0 < h;
+        x[j] = x0 + h;
+        Residuals(p, a.data(), &t_star, false);
+        if (forward) {
+          b = at_star;
+        } else {
+          x[j] = x0 - h;
+          Residuals(p, b.data(), &t_star, false);
+        }
+        x[j] = x0;
+        const double span = forward ? h : 2 * h;
+        for (size_t r = 0; r < n; ++r) jacobians[block][r * sizes[block] + j] = (a[r] - b[r]) / span;
+      }
+    }
+    return true;
+  }
+
+  // The unweighted gaps (IOD) of every point, for the outlier pass and the report.
+  // `contacts`, when given, gets each ray's closest approach (head frame).
+  static std::vector<double> Gaps(const FrameProblem& fp, Shared& shared, const double* shape, const double* expression,
+                                  const double* pose, std::vector<Vec3f>* contacts = nullptr) {
+    const face::FaceModel& model = shared.cache.For(shape);
+    const face::ExpressionState state = model.Prepare(ClampedExpression(expression, shared.max_expression));
+    std::vector<double> gaps;
+    for (const Vec2f& uv : fp.frame->silhouette) {
+      const Ray ray = HeadRay(fp, shared, pose, uv);
+      const Vec3f contact = ray.At(ClosestApproach(model, state, ray));
+      gaps.push_back(model.Distance(contact, state) / shared.iod_head);
+      if (contacts) contacts->push_back(contact);
+    }
+    return gaps;
+  }
+
+ private:
+  void Residuals(double const* const* params, double* residuals, std::vector<float>* t_star, bool find) const {
+    const face::FaceModel& model = shared_->cache.For(params[0]);
+    const face::ExpressionState state = model.Prepare(ClampedExpression(params[1], shared_->max_expression));
+    const std::vector<Vec2f>& points = fp_->frame->silhouette;
+    // A frame's points in use weigh together as much as 68 landmarks.
+    const auto used = std::count_if(fp_->silhouette_weight.begin(), fp_->silhouette_weight.end(), [](double v) { return v > 0; });
+    const double w = std::sqrt(double(kNumLandmarks) / double(std::max<ptrdiff_t>(used, 1))) / shared_->silhouette_sigma;
+    for (size_t i = 0; i < points.size(); ++i) {
+      if (fp_->silhouette_weight[i] == 0) {
+        residuals[i] = 0;
+        continue;
+      }
+      const Ray ray = HeadRay(*fp_, *shared_, params[2], points[i]);
+      if (find) (*t_star)[i] = ClosestApproach(model, state, ray);
+      residuals[i] = w * model.Distance(ray.At((*t_star)[i]), state) / shared_->iod_head;
+    }
+  }
+
+  const FrameProblem* fp_;
+  Shared* shared_;
+};
+
 template <int N>
 struct GaussianPrior {
   double mean;
@@ -222,6 +349,8 @@ Status CheckFrames(std::span<const TrackFrame> frames) {
       if (!p.allFinite()) return Status::Error(where + "landmarks_2d has a non-finite value");
     if (!(Iod2d(f.landmarks_2d) > 1e-6)) return Status::Error(where + "landmarks_2d: the eyes coincide");
     if (Status s = f.intrinsics.Validate(); !s.ok()) return Status::Error(where + "intrinsics: " + s.message());
+    for (const Vec2f& p : f.silhouette)
+      if (!p.allFinite()) return Status::Error(where + "silhouette has a non-finite point");
     if (f.world_from_cam.has_value() != known)
       return Status::Error(where + "camera poses must be known for every frame or for none");
     if (f.world_from_cam) {
@@ -260,6 +389,9 @@ Status Solve(std::vector<FrameProblem>& problems, const std::vector<int>& which,
   for (int k : which) {
     double* pose = shared.known_cameras ? s->pose[0].data() : s->pose[k].data();
     cp.AddResidualBlock(new LandmarkCost(&problems[k], &shared), nullptr, s->shape.data(), s->expression[k].data(), pose);
+    if (shared.use_silhouettes && !problems[k].frame->silhouette.empty())
+      cp.AddResidualBlock(new SilhouetteCost(&problems[k], &shared), nullptr, s->shape.data(), s->expression[k].data(),
+                          pose);
     cp.AddResidualBlock(new ceres::AutoDiffCostFunction<GaussianPrior<kExpr>, kExpr, kExpr>(
                             new GaussianPrior<kExpr>{0.0, 1.0 / options.expression_prior_sigma}),
                         nullptr, s->expression[k].data());
@@ -311,7 +443,48 @@ int DropOutliers(std::vector<FrameProblem>& problems, const std::vector<int>& wh
     for (int i = 0; i < kNumLandmarks; ++i)
       if (errors[j][i] > cut && fp.weight[i] > 0) fp.weight[i] = 0, ++removed;
   }
+  // Silhouette points likewise, on their own median (hair beyond the skull, a collar, a hand).
+  std::vector<std::vector<double>> gaps;
+  std::vector<double> all_gaps;
+  for (int k : which) {
+    if (!shared.use_silhouettes) break;
+    gaps.push_back(SilhouetteCost::Gaps(problems[k], shared, s.shape.data(), s.expression[k].data(), PoseOf(s, shared, k)));
+    for (double& g : gaps.back()) all_gaps.push_back(g = std::abs(g));
+  }
+  if (all_gaps.empty()) return removed;
+  std::nth_element(all_gaps.begin(), all_gaps.begin() + all_gaps.size() / 2, all_gaps.end());
+  const double gap_cut = std::max(options.outlier_iod, 3.0 * all_gaps[all_gaps.size() / 2]);
+  for (size_t j = 0; j < which.size(); ++j) {
+    FrameProblem& fp = problems[which[j]];
+    for (size_t i = 0; i < gaps[j].size(); ++i)
+      if (gaps[j][i] > gap_cut && fp.silhouette_weight[i] > 0) fp.silhouette_weight[i] = 0, ++removed;
+  }
   return removed;
+}
+
+// Keeps the silhouette points that the landmark fit's head explains: within silhouette_max_gap_iod
+// of its surface (farther: hair, a hat, a collar, a hand) and, with silhouette_face_only, touching
+// it between the chin and the brows (the face's own outline: a real head's crown is hair and its
+// neck runs into clothes, neither of which the face model has).
+void SelectSilhouettePoints(std::vector<FrameProblem>& problems, Shared& shared, const TrackFitOptions& options,
+                            const Solution& s) {
+  for (size_t k = 0; k < problems.size(); ++k) {
+    FrameProblem& fp = problems[k];
+    if (fp.frame->silhouette.empty()) continue;
+    const double* pose = PoseOf(s, shared, static_cast<int>(k));
+    std::vector<Vec3f> contacts;
+    const std::vector<double> gaps = SilhouetteCost::Gaps(fp, shared, s.shape.data(), s.expression[k].data(), pose, &contacts);
+    const face::FaceModel& model = shared.cache.For(s.shape.data());
+    const std::array<Vec3f, 68> lm = model.Landmarks(model.Prepare(ClampedExpression(s.expression[k].data(), shared.max_expression)));
+    float brow_y = 0;
+    for (int i = 17; i <= 26; ++i) brow_y += lm[i].y() / 10.f;
+    const float chin_y = lm[8].y();
+    for (size_t i = 0; i < gaps.size(); ++i) {
+      const bool near = std::abs(gaps[i]) <= options.silhouette_max_gap_iod;
+      const bool face_band = contacts[i].y() >= chin_y && contacts[i].y() <= brow_y;
+      fp.silhouette_weight[i] = near && (face_band || !options.silhouette_face_only) ? 1.0 : 0.0;
+    }
+  }
 }
 
 // Pose-only warm start, then the joint solve with one outlier pass.
@@ -356,6 +529,9 @@ Status TrackFitOptions::Validate() const {
   if (!(outlier_iod > 0)) return Status::Error("outlier_iod must be > 0");
   if (!(landmark_sigma_iod > 0) || !std::isfinite(landmark_sigma_iod))
     return Status::Error("landmark_sigma_iod must be a finite number > 0");
+  if (!(silhouette_sigma_iod > 0) || !std::isfinite(silhouette_sigma_iod))
+    return Status::Error("silhouette_sigma_iod must be a finite number > 0");
+  if (!(silhouette_max_gap_iod > 0)) return Status::Error("silhouette_max_gap_iod must be > 0");
   return Status::Ok();
 }
 
@@ -364,7 +540,9 @@ std::string TrackFitOptions::ToString() const {
   os << "TrackFitOptions(shape_prior_sigma=" << shape_prior_sigma << ", expression_prior_sigma="
      << expression_prior_sigma << ", max_expression=" << max_expression << ", jaw_line_weight=" << jaw_line_weight
      << ", max_iterations=" << max_iterations << ", outlier_iod=" << outlier_iod
-     << ", dlib_convention=" << dlib_convention << ", landmark_sigma_iod=" << landmark_sigma_iod << ")";
+     << ", dlib_convention=" << dlib_convention << ", landmark_sigma_iod=" << landmark_sigma_iod
+     << ", silhouette_sigma_iod=" << silhouette_sigma_iod << ", silhouette_max_gap_iod=" << silhouette_max_gap_iod
+     << ", silhouette_face_only=" << silhouette_face_only << ")";
   return os.str();
 }
 
@@ -388,6 +566,8 @@ Result<TrackFit> FitTrack(std::span<const TrackFrame> frames, const TrackFitOpti
   shared.known_cameras = frames[0].world_from_cam.has_value();
   shared.dlib_convention = options.dlib_convention;
   shared.landmark_sigma = options.landmark_sigma_iod;
+  shared.silhouette_sigma = options.silhouette_sigma_iod;
+  shared.iod_head = iod_head;
   std::vector<FrameProblem> problems(n);
   Solution s;
   s.shape.fill(1.0);
@@ -397,6 +577,7 @@ Result<TrackFit> FitTrack(std::span<const TrackFrame> frames, const TrackFitOpti
     problems[k].frame = &frames[k];
     problems[k].iod_px = Iod2d(frames[k].landmarks_2d);
     problems[k].weight.fill(1.0);
+    problems[k].silhouette_weight.assign(frames[k].silhouette.size(), 1.0);
     for (int i = 0; i <= 16; ++i) problems[k].weight[i] = options.jaw_line_weight;
   }
   if (shared.known_cameras) {
@@ -421,13 +602,26 @@ Result<TrackFit> FitTrack(std::span<const TrackFrame> frames, const TrackFitOpti
   std::vector<int> joint, rest;
   const int stride = (n + kMaxJointFrames - 1) / kMaxJointFrames;
   for (int k = 0; k < n; ++k) (k % stride == 0 ? joint : rest).push_back(k);
-  ICEF_RETURN_IF_ERROR(SolveFrames(problems, joint, shared, options, /*fit_shape=*/true, &s));
-  for (int k : rest) {
-    if (shared.known_cameras) {  // the shared pose stays: expression only
-      ICEF_RETURN_IF_ERROR(Solve(problems, {k}, shared, options, false, false, &s));
-    } else {
-      ICEF_RETURN_IF_ERROR(SolveFrames(problems, {k}, shared, options, /*fit_shape=*/false, &s));
+  const auto solve_all = [&]() -> Status {
+    ICEF_RETURN_IF_ERROR(SolveFrames(problems, joint, shared, options, /*fit_shape=*/true, &s));
+    for (int k : rest) {
+      if (shared.known_cameras) {  // the shared pose stays: expression only
+        ICEF_RETURN_IF_ERROR(Solve(problems, {k}, shared, options, false, false, &s));
+      } else {
+        ICEF_RETURN_IF_ERROR(SolveFrames(problems, {k}, shared, options, /*fit_shape=*/false, &s));
+      }
     }
+    return Status::Ok();
+  };
+  // The landmarks alone first: the silhouette residuals have local minima far from the pose.
+  ICEF_RETURN_IF_ERROR(solve_all());
+  if (std::any_of(frames.begin(), frames.end(), [](const TrackFrame& f) { return !f.silhouette.empty(); })) {
+    shared.use_silhouettes = true;
+    SelectSilhouettePoints(problems, shared, options, s);
+    const bool any = std::any_of(problems.begin(), problems.end(), [](const FrameProblem& fp) {
+      return std::any_of(fp.silhouette_weight.begin(), fp.silhouette_weight.end(), [](double w) { return w > 0; });
+    });
+    if (any) ICEF_RETURN_IF_ERROR(solve_all());
   }
 
   TrackFit fit;
@@ -462,6 +656,11 @@ Result<TrackFit> FitTrack(std::span<const TrackFrame> frames, const TrackFitOpti
       if (problems[k].weight[i] > 0) frame_sum2 += e[i] * e[i], ++tf.landmarks_used;
     }
     tf.rms_iod = std::sqrt(frame_sum2 / std::max(tf.landmarks_used, 1));
+    const std::vector<double> gaps = SilhouetteCost::Gaps(problems[k], shared, s.shape.data(), s.expression[k].data(), pose);
+    double gap_sum2 = 0;
+    for (size_t i = 0; i < gaps.size(); ++i)
+      if (problems[k].silhouette_weight[i] > 0) gap_sum2 += gaps[i] * gaps[i], ++tf.silhouette_used;
+    tf.silhouette_rms_iod = std::sqrt(gap_sum2 / std::max(tf.silhouette_used, 1));
     sum2 += frame_sum2;
     used_all += tf.landmarks_used;
     fit.max_iod = std::max(fit.max_iod, tf.max_iod);

@@ -30,6 +30,10 @@ struct TrackFrame {
   std::vector<Vec2f> landmarks_2d;      // [68] pixels
   Intrinsics intrinsics;
   std::optional<Mat4d> world_from_cam;  // known camera pose (all frames or none)
+  // Optional: points on the edge of the head's foreground mask (pixels, e.g. MaskEdgePoints of a
+  // GrabCut mask). Each adds a silhouette residual: the fitted surface's closest approach to the
+  // point's ray, which is 0 where the ray grazes the head.
+  std::vector<Vec2f> silhouette;
 };
 
 // The defaults were chosen on synthetic photos of validation identities 101-106 (scripts/track_eval.py).
@@ -42,6 +46,13 @@ struct TrackFitOptions {
   int max_iterations = 80;              // Levenberg-Marquardt iterations per pass
   double outlier_iod = 0.1;             // second pass: drop landmarks farther than this (IOD) and 3x the median
   bool dlib_convention = true;          // the landmarks are dlib's: fit the model's landmarks moved by DlibLandmarkOffsets()
+  // Silhouette points (TrackFrame::silhouette): their noise (IOD). A frame's points weigh together
+  // as much as 68 landmarks at this noise would, however many there are.
+  double silhouette_sigma_iod = 0.03;
+  // Silhouette points the landmark fit's head does not explain are left out: farther than this from
+  // its surface (IOD), or, with silhouette_face_only, touching it above the brows or below the chin.
+  double silhouette_max_gap_iod = 0.15;
+  bool silhouette_face_only = true;
 
   Status Validate() const;
   std::string ToString() const;
@@ -57,6 +68,8 @@ struct TrackedFrame {
   double rms_iod = 0;                       // landmark residual of this frame (inliers)
   double max_iod = 0;                       // its largest landmark residual (all landmarks)
   int landmarks_used = 0;                   // inliers
+  double silhouette_rms_iod = 0;            // silhouette gap of the inlier silhouette points (0: none given)
+  int silhouette_used = 0;                  // inlier silhouette points
   std::string ToString() const;
   // The head's rotation relative to the camera, degrees: yaw (positive turns the face toward the
   // subject's left, the image's right), pitch (positive lifts the chin), roll (positive turns the
