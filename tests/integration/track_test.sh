@@ -17,9 +17,10 @@ trap 'rm -rf "$TMP"' EXIT
 fail() { echo "FAIL: $*" >&2; exit 1; }
 
 # Synthetic photos with known truth: pose, expression and mask within loose bounds (the measured
-# figures are in docs/results/track_eval; these bounds catch a tracker gone wrong).
+# figures are in docs/results/track_eval; these bounds catch a tracker gone wrong: without the
+# silhouette refit this subject's pose is off by 5.4 degrees and 0.17 head heights).
 /usr/bin/python3 "$HERE/../../scripts/track_eval.py" --icef "$ICEF" --out "$TMP/eval" --seeds 2 --photos 3 \
-  --res 128 --track-args="--focal 896" --check 15,0.3,0.3,0.9 || fail "track_eval bounds"
+  --res 128 --check 4,0.08,0.3,0.9 || fail "track_eval bounds"
 "$ICEF" info "$TMP/eval/track_2" >/dev/null || fail "the tracked dataset does not validate"
 ls "$TMP/eval/track_2/track/overlay_000.png" >/dev/null || fail "no overlay"
 
