@@ -142,55 +142,69 @@ std::vector<double> Errors(const FrameProblem& fp, Shared& shared, const double*
   return e;
 }
 
-// The landmark residuals of one frame with a Jacobian by finite differences whose steps suit each
-// block (Ceres' relative steps vanish for weights at 0 and drown in the SDF's float noise): central
-// differences, forward ones for an expression weight at its lower bound.
-class LandmarkCost : public ceres::DynamicCostFunction {
+// The residuals of one frame over its (shape, expression, pose) blocks, with a Jacobian by finite
+// differences whose steps suit each block (Ceres' relative steps vanish for weights at 0 and drown
+// in the SDF's float noise): central differences, forward ones for an expression weight at its
+// lower bound. Linearise() fixes, at the current parameters, what the differences hold constant.
+// Not thread-safe (Linearise may keep state; the solver runs on one thread).
+class FrameCost : public ceres::DynamicCostFunction {
  public:
-  LandmarkCost(const FrameProblem* fp, Shared* shared) : fp_(fp), shared_(shared) {
+  FrameCost(const FrameProblem* fp, Shared* shared, int num_residuals) : fp_(fp), shared_(shared) {
     AddParameterBlock(kShape);
     AddParameterBlock(kExpr);
     AddParameterBlock(shared->known_cameras ? kSharedPose : kPhotoPose);
-    SetNumResiduals(2 * kNumLandmarks);
+    SetNumResiduals(num_residuals);
   }
 
   bool Evaluate(double const* const* params, double* residuals, double** jacobians) const override {
+    Linearise(params);
     Residuals(params, residuals);
     if (!jacobians) return true;
     const int sizes[3] = {kShape, kExpr, shared_->known_cameras ? kSharedPose : kPhotoPose};
-    std::vector<double> a(2 * kNumLandmarks), b(2 * kNumLandmarks);
+    const size_t n = static_cast<size_t>(num_residuals());
+    std::vector<double> a(n), b(n);
     for (int block = 0; block < 3; ++block) {
       if (!jacobians[block]) continue;
       std::vector<double> x(params[block], params[block] + sizes[block]);
       double const* p[3] = {params[0], params[1], params[2]};
       p[block] = x.data();
       for (int j = 0; j < sizes[block]; ++j) {
-        const double h = Step(block, j);
+        // Shape scales (~1), expression weights ([0, ~1]), angle-axis (radians), translation
+        // (head or world units) and log scale.
+        const double h = block == 0 ? 2e-3 : block == 1 ? 1e-2 : 1e-3;
         const double x0 = x[j];
         const bool forward = block == 1 && x0 < h;
         x[j] = x0 + h;
         Residuals(p, a.data());
         if (forward) {
-          std::copy(residuals, residuals + a.size(), b.begin());
+          std::copy(residuals, residuals + n, b.begin());
         } else {
           x[j] = x0 - h;
           Residuals(p, b.data());
         }
         x[j] = x0;
         const double span = forward ? h : 2 * h;
-        for (size_t r = 0; r < a.size(); ++r) jacobians[block][r * sizes[block] + j] = (a[r] - b[r]) / span;
+        for (size_t r = 0; r < n; ++r) jacobians[block][r * sizes[block] + j] = (a[r] - b[r]) / span;
       }
     }
     return true;
   }
 
+ protected:
+  virtual void Linearise(double const* const* /*params*/) const {}
+  virtual void Residuals(double const* const* params, double* residuals) const = 0;
+
+  const FrameProblem* fp_;
+  Shared* shared_;
+};
+
+// The 68 landmark residuals of one frame (IOD over the landmark noise).
+class LandmarkCost : public FrameCost {
+ public:
+  LandmarkCost(const FrameProblem* fp, Shared* shared) : FrameCost(fp, shared, 2 * kNumLandmarks) {}
+
  private:
-  static double Step(int block, int j) {
-    if (block == 0) return 2e-3;   // shape scales (~1)
-    if (block == 1) return 1e-2;   // expression weights ([0, ~1])
-    return j < 3 ? 1e-3 : 1e-3;    // angle-axis (radians), translation (head or world units), log scale
-  }
-  void Residuals(double const* const* params, double* residuals) const {
+  void Residuals(double const* const* params, double* residuals) const override {
     const auto proj = Project(*fp_, *shared_, params[0], params[1], params[2]);
     for (int i = 0; i < kNumLandmarks; ++i) {
       const double w = fp_->weight[i] / shared_->landmark_sigma;
@@ -200,9 +214,6 @@ class LandmarkCost : public ceres::DynamicCostFunction {
       residuals[2 * i + 1] = w * d.y();
     }
   }
-
-  const FrameProblem* fp_;
-  Shared* shared_;
 };
 
 // The head-frame ray through pixel `uv` of a frame for a pose.
@@ -244,49 +255,12 @@ float ClosestApproach(const face::FaceModel& model, const face::ExpressionState&
 // The silhouette residuals of one frame: for each edge point of its mask, the distance bound of the
 // fitted surface at the closest approach of the point's ray (head units over the average head's
 // IOD): 0 where the ray grazes the head, > 0 where it passes outside, < 0 where it cuts through.
-// Jacobian by finite differences at the closest approach found for the current parameters (the
-// minimum's derivative is the distance's there: the envelope theorem), with LandmarkCost's steps.
-class SilhouetteCost : public ceres::DynamicCostFunction {
+// The finite differences hold the closest approach found for the current parameters fixed (the
+// minimum's derivative is the distance's there: the envelope theorem).
+class SilhouetteCost : public FrameCost {
  public:
-  SilhouetteCost(const FrameProblem* fp, Shared* shared) : fp_(fp), shared_(shared) {
-    AddParameterBlock(kShape);
-    AddParameterBlock(kExpr);
-    AddParameterBlock(shared->known_cameras ? kSharedPose : kPhotoPose);
-    SetNumResiduals(static_cast<int>(fp->frame->silhouette.size()));
-  }
-
-  bool Evaluate(double const* const* params, double* residuals, double** jacobians) const override {
-    const size_t n = fp_->frame->silhouette.size();
-    std::vector<float> t_star(n);
-    Residuals(params, residuals, &t_star, /*find=*/true);
-    if (!jacobians) return true;
-    const int sizes[3] = {kShape, kExpr, shared_->known_cameras ? kSharedPose : kPhotoPose};
-    std::vector<double> a(n), b(n), at_star(n);
-    Residuals(params, at_star.data(), &t_star, /*find=*/false);
-    for (int block = 0; block < 3; ++block) {
-      if (!jacobians[block]) continue;
-      std::vector<double> x(params[block], params[block] + sizes[block]);
-      double const* p[3] = {params[0], params[1], params[2]};
-      p[block] = x.data();
-      for (int j = 0; j < sizes[block]; ++j) {
-        const double h = block == 0 ? 2e-3 : block == 1 ? 1e-2 : 1e-3;
-        const double x0 = x[j];
-        const bool forward = block == 1 && x0 < h;
-        x[j] = x0 + h;
-        Residuals(p, a.data(), &t_star, false);
-        if (forward) {
-          b = at_star;
-        } else {
-          x[j] = x0 - h;
-          Residuals(p, b.data(), &t_star, false);
-        }
-        x[j] = x0;
-        const double span = forward ? h : 2 * h;
-        for (size_t r = 0; r < n; ++r) jacobians[block][r * sizes[block] + j] = (a[r] - b[r]) / span;
-      }
-    }
-    return true;
-  }
+  SilhouetteCost(const FrameProblem* fp, Shared* shared)
+      : FrameCost(fp, shared, static_cast<int>(fp->frame->silhouette.size())) {}
 
   // The unweighted gaps (IOD) of every point, for the outlier pass and the report.
   // `contacts`, when given, gets each ray's closest approach (head frame).
@@ -305,7 +279,16 @@ class SilhouetteCost : public ceres::DynamicCostFunction {
   }
 
  private:
-  void Residuals(double const* const* params, double* residuals, std::vector<float>* t_star, bool find) const {
+  void Linearise(double const* const* params) const override {
+    const face::FaceModel& model = shared_->cache.For(params[0]);
+    const face::ExpressionState state = model.Prepare(ClampedExpression(params[1], shared_->max_expression));
+    const std::vector<Vec2f>& points = fp_->frame->silhouette;
+    t_star_.assign(points.size(), 0.f);
+    for (size_t i = 0; i < points.size(); ++i)
+      if (fp_->silhouette_weight[i] > 0) t_star_[i] = ClosestApproach(model, state, HeadRay(*fp_, *shared_, params[2], points[i]));
+  }
+
+  void Residuals(double const* const* params, double* residuals) const override {
     const face::FaceModel& model = shared_->cache.For(params[0]);
     const face::ExpressionState state = model.Prepare(ClampedExpression(params[1], shared_->max_expression));
     const std::vector<Vec2f>& points = fp_->frame->silhouette;
@@ -318,13 +301,11 @@ class SilhouetteCost : public ceres::DynamicCostFunction {
         continue;
       }
       const Ray ray = HeadRay(*fp_, *shared_, params[2], points[i]);
-      if (find) (*t_star)[i] = ClosestApproach(model, state, ray);
-      residuals[i] = w * model.Distance(ray.At((*t_star)[i]), state) / shared_->iod_head;
+      residuals[i] = w * model.Distance(ray.At(t_star_[i]), state) / shared_->iod_head;
     }
   }
 
-  const FrameProblem* fp_;
-  Shared* shared_;
+  mutable std::vector<float> t_star_;  // Linearise's closest approaches
 };
 
 template <int N>
