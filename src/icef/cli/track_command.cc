@@ -20,8 +20,8 @@ CommandFn RegisterTrack(CLI::App& app) {
   app.description(
       "Turn photos of one person into a dataset: detects the face and its 68 landmarks in each photo (exactly one "
       "face per photo), fits the face model to all photos at once (shared identity; per photo a head pose and "
-      "expression weights), crops a square around the head, masks the person (GrabCut seeded by the fitted head) "
-      "and writes the dataset in the fitted head's frame, with track/overlay_NNN.png to check the fit and "
+      "expression weights), crops a square around the head, masks the person (GrabCut seeded by the fitted head), "
+      "refits the face model to the landmarks and each mask's outline, crops and masks again, and writes the dataset in the fitted head's frame, with track/overlay_NNN.png to check the fit and "
       "track/report.json. Then: icef train DATASET, icef render --sweep.\n"
       "With --keep-cameras, re-express an existing dataset (NerFace, instant-ngp, any expression space) in the face "
       "model's expressions: same cameras and images, the face model fitted to every frame's landmarks.");
