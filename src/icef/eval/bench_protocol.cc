@@ -372,7 +372,10 @@ Status MergeBench(const std::vector<fs::path>& inputs, const fs::path& out_dir, 
     if (!fs::is_directory(in / "runs", ec)) return Status::Error(in.string() + ": not a bench directory (no runs/)");
     if (fs::exists(in / "bench.json", ec)) {
       ICEF_ASSIGN_OR_RETURN(Json s, ReadJsonFile(in / "bench.json"));
-      if (s.is_object()) s.erase("shard");
+      // Which shard or which identities a directory ran does not make it another bench: benches of
+      // the same protocol over other identity seeds merge like shards.
+      if (s.is_object())
+        for (const char* key : {"shard", "identities", "first_identity_seed"}) s.erase(key);
       if (!settings) {
         settings = s;
       } else if (*settings != s) {

@@ -174,6 +174,9 @@ TEST(BenchProtocolTest, MergesShardDirectories) {
   ASSERT_TRUE(WriteFileAtomic(dir / "a" / "bench.json", R"({"steps": 10, "shard": "0/2"})").ok());
   ASSERT_TRUE(WriteFileAtomic(dir / "b" / "bench.json", R"({"steps": 10, "shard": "1/2"})").ok());
   EXPECT_TRUE(MergeBench({dir / "a", dir / "b"}, dir / "merged4", log).ok());
+  // Other identity seeds of the same protocol merge too.
+  ASSERT_TRUE(WriteFileAtomic(dir / "b" / "bench.json", R"({"steps": 10, "identities": 3, "first_identity_seed": 104})").ok());
+  EXPECT_TRUE(MergeBench({dir / "a", dir / "b"}, dir / "merged6", log).ok());
   ASSERT_TRUE(WriteFileAtomic(dir / "b" / "bench.json", R"({"steps": 20, "shard": "1/2"})").ok());
   const Status differ = MergeBench({dir / "a", dir / "b"}, dir / "merged5", log);
   ASSERT_FALSE(differ.ok());

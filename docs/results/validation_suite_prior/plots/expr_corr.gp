@@ -1,7 +1,7 @@
 # gnuplot expr_corr.gp (run in this directory) draws expr_corr.png and expr_corr.svg
 set terminal pngcairo noenhanced size 460,420 font "sans,9"
 set output "expr_corr.png"
-set multiplot layout 1,1 title "expr_corr against delta (mean +- std over 3 identities)"
+set multiplot layout 1,1 title "expr_corr against delta (mean +- std over 6 identities)"
 set xlabel "delta (distance to the nearest training expression)"
 set ylabel "cosine of the render's change with the true change (higher = better)"
 set grid
@@ -12,7 +12,7 @@ plot 'expr_corr.dat' index 0 using 1:2:3 with yerrorlines lw 2 pt 7 title "icef-
 unset multiplot
 set terminal svg noenhanced size 460,420 font "sans,9"
 set output "expr_corr.svg"
-set multiplot layout 1,1 title "expr_corr against delta (mean +- std over 3 identities)"
+set multiplot layout 1,1 title "expr_corr against delta (mean +- std over 6 identities)"
 set xlabel "delta (distance to the nearest training expression)"
 set ylabel "cosine of the render's change with the true change (higher = better)"
 set grid

@@ -1,7 +1,7 @@
 # gnuplot expr_gain.gp (run in this directory) draws expr_gain.png and expr_gain.svg
 set terminal pngcairo noenhanced size 460,420 font "sans,9"
 set output "expr_gain.png"
-set multiplot layout 1,1 title "expr_gain against delta (mean +- std over 3 identities)"
+set multiplot layout 1,1 title "expr_gain against delta (mean +- std over 6 identities)"
 set xlabel "delta (distance to the nearest training expression)"
 set ylabel "share of the true expression change reproduced (1 = all, 0 = none)"
 set grid
@@ -12,7 +12,7 @@ plot 'expr_gain.dat' index 0 using 1:2:3 with yerrorlines lw 2 pt 7 title "icef-
 unset multiplot
 set terminal svg noenhanced size 460,420 font "sans,9"
 set output "expr_gain.svg"
-set multiplot layout 1,1 title "expr_gain against delta (mean +- std over 3 identities)"
+set multiplot layout 1,1 title "expr_gain against delta (mean +- std over 6 identities)"
 set xlabel "delta (distance to the nearest training expression)"
 set ylabel "share of the true expression change reproduced (1 = all, 0 = none)"
 set grid

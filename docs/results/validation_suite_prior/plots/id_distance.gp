@@ -1,7 +1,7 @@
 # gnuplot id_distance.gp (run in this directory) draws id_distance.png and id_distance.svg
 set terminal pngcairo noenhanced size 460,420 font "sans,9"
 set output "id_distance.png"
-set multiplot layout 1,1 title "id_distance against delta (mean +- std over 3 identities)"
+set multiplot layout 1,1 title "id_distance against delta (mean +- std over 6 identities)"
 set xlabel "delta (distance to the nearest training expression)"
 set ylabel "identity distance to own neutral render"
 set grid
@@ -12,7 +12,7 @@ plot 'id_distance.dat' index 0 using 1:2:3 with yerrorlines lw 2 pt 7 title "ice
 unset multiplot
 set terminal svg noenhanced size 460,420 font "sans,9"
 set output "id_distance.svg"
-set multiplot layout 1,1 title "id_distance against delta (mean +- std over 3 identities)"
+set multiplot layout 1,1 title "id_distance against delta (mean +- std over 6 identities)"
 set xlabel "delta (distance to the nearest training expression)"
 set ylabel "identity distance to own neutral render"
 set grid

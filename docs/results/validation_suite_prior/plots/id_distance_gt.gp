@@ -1,7 +1,7 @@
 # gnuplot id_distance_gt.gp (run in this directory) draws id_distance_gt.png and id_distance_gt.svg
 set terminal pngcairo noenhanced size 460,420 font "sans,9"
 set output "id_distance_gt.png"
-set multiplot layout 1,1 title "id_distance_gt against delta (mean +- std over 3 identities)"
+set multiplot layout 1,1 title "id_distance_gt against delta (mean +- std over 6 identities)"
 set xlabel "delta (distance to the nearest training expression)"
 set ylabel "identity distance to ground truth (lower = better)"
 set grid
@@ -12,7 +12,7 @@ plot 'id_distance_gt.dat' index 0 using 1:2:3 with yerrorlines lw 2 pt 7 title "
 unset multiplot
 set terminal svg noenhanced size 460,420 font "sans,9"
 set output "id_distance_gt.svg"
-set multiplot layout 1,1 title "id_distance_gt against delta (mean +- std over 3 identities)"
+set multiplot layout 1,1 title "id_distance_gt against delta (mean +- std over 6 identities)"
 set xlabel "delta (distance to the nearest training expression)"
 set ylabel "identity distance to ground truth (lower = better)"
 set grid

@@ -1,7 +1,7 @@
 # gnuplot id_distance_reference.gp (run in this directory) draws id_distance_reference.png and id_distance_reference.svg
 set terminal pngcairo noenhanced size 460,420 font "sans,9"
 set output "id_distance_reference.png"
-set multiplot layout 1,1 title "id_distance_reference against delta (mean +- std over 3 identities)"
+set multiplot layout 1,1 title "id_distance_reference against delta (mean +- std over 6 identities)"
 set xlabel "delta (distance to the nearest training expression)"
 set ylabel "ground truth's own distance to its neutral (reference)"
 set grid
@@ -12,7 +12,7 @@ plot 'id_distance_reference.dat' index 0 using 1:2:3 with yerrorlines lw 2 pt 7 
 unset multiplot
 set terminal svg noenhanced size 460,420 font "sans,9"
 set output "id_distance_reference.svg"
-set multiplot layout 1,1 title "id_distance_reference against delta (mean +- std over 3 identities)"
+set multiplot layout 1,1 title "id_distance_reference against delta (mean +- std over 6 identities)"
 set xlabel "delta (distance to the nearest training expression)"
 set ylabel "ground truth's own distance to its neutral (reference)"
 set grid

@@ -1,7 +1,7 @@
 # gnuplot psnr_neutral_floor.gp (run in this directory) draws psnr_neutral_floor.png and psnr_neutral_floor.svg
 set terminal pngcairo noenhanced size 460,420 font "sans,9"
 set output "psnr_neutral_floor.png"
-set multiplot layout 1,1 title "psnr_neutral_floor against delta (mean +- std over 3 identities)"
+set multiplot layout 1,1 title "psnr_neutral_floor against delta (mean +- std over 6 identities)"
 set xlabel "delta (distance to the nearest training expression)"
 set ylabel "PSNR of the ground-truth neutral, dB (a face that does not move)"
 set grid
@@ -12,7 +12,7 @@ plot 'psnr_neutral_floor.dat' index 0 using 1:2:3 with yerrorlines lw 2 pt 7 tit
 unset multiplot
 set terminal svg noenhanced size 460,420 font "sans,9"
 set output "psnr_neutral_floor.svg"
-set multiplot layout 1,1 title "psnr_neutral_floor against delta (mean +- std over 3 identities)"
+set multiplot layout 1,1 title "psnr_neutral_floor against delta (mean +- std over 6 identities)"
 set xlabel "delta (distance to the nearest training expression)"
 set ylabel "PSNR of the ground-truth neutral, dB (a face that does not move)"
 set grid
