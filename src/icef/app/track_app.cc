@@ -50,7 +50,7 @@ std::string ExpressionText(const std::vector<float>& beta) {
 Image TrackOverlay(const track::TrackResult& result, int photo_index) {
   const track::TrackedPhoto& p = result.photos[photo_index];
   const track::TrackedFrame& f = result.fit.frames[photo_index];
-  const Vec3f green(0.1f, 0.95f, 0.2f), red(1.f, 0.15f, 0.1f);
+  const Vec3f green(0.1f, 0.95f, 0.2f), red(1.f, 0.15f, 0.1f), cyan(0.1f, 0.85f, 1.f);
   // The fitted landmarks as the fit saw them (dlib's convention), scaled to an image.
   auto fitted = [&](const std::vector<Vec2f>& points, double scale) {
     std::vector<std::optional<Vec2d>> uv;
@@ -63,6 +63,7 @@ Image TrackOverlay(const track::TrackResult& result, int photo_index) {
   Image left = track::ResizeImage(p.photo, w, kOverlayHeight);
   const double s = double(kOverlayHeight) / p.photo.height;
   DrawFaceOutline2d(&left, fitted(f.projected, s), red);
+  for (const Vec2f& q : f.silhouette_points) Dot(&left, (q.cast<double>() * s).cast<float>(), cyan);
   for (const Vec2f& l : p.detection.landmarks) Dot(&left, (l.cast<double>() * s).cast<float>(), green);
 
   Image right = track::ResizeImage(OverChecker(p.image), kOverlayHeight, kOverlayHeight);

@@ -110,6 +110,7 @@ TEST_F(PhotoTrackTest, SyntheticPhotosBecomeADatasetInTheHeadFrame) {
     // The refit used the mask's edge between the chin and the brows.
     EXPECT_GT(r.fit.frames[i].silhouette_used, 10) << "photo " << i;
     EXPECT_LT(r.fit.frames[i].silhouette_rms_iod, 0.1) << "photo " << i;
+    EXPECT_EQ(static_cast<int>(r.fit.frames[i].silhouette_points.size()), r.fit.frames[i].silhouette_used);
     // The mask against the true coverage, cropped the same way.
     ASSERT_EQ(p.image.channels, 4);
     Image mask(128, 128, 1);

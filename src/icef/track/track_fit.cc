@@ -640,7 +640,10 @@ Result<TrackFit> FitTrack(std::span<const TrackFrame> frames, const TrackFitOpti
     const std::vector<double> gaps = SilhouetteCost::Gaps(problems[k], shared, s.shape.data(), s.expression[k].data(), pose);
     double gap_sum2 = 0;
     for (size_t i = 0; i < gaps.size(); ++i)
-      if (problems[k].silhouette_weight[i] > 0) gap_sum2 += gaps[i] * gaps[i], ++tf.silhouette_used;
+      if (problems[k].silhouette_weight[i] > 0) {
+        gap_sum2 += gaps[i] * gaps[i], ++tf.silhouette_used;
+        tf.silhouette_points.push_back(frames[k].silhouette[i]);
+      }
     tf.silhouette_rms_iod = std::sqrt(gap_sum2 / std::max(tf.silhouette_used, 1));
     sum2 += frame_sum2;
     used_all += tf.landmarks_used;

@@ -70,6 +70,7 @@ struct TrackedFrame {
   int landmarks_used = 0;                   // inliers
   double silhouette_rms_iod = 0;            // silhouette gap of the inlier silhouette points (0: none given)
   int silhouette_used = 0;                  // inlier silhouette points
+  std::vector<Vec2f> silhouette_points;     // those points (pixels), for overlays
   std::string ToString() const;
   // The head's rotation relative to the camera, degrees: yaw (positive turns the face toward the
   // subject's left, the image's right), pitch (positive lifts the chin), roll (positive turns the
