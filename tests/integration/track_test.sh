@@ -52,6 +52,16 @@ awk -v r="$rms" 'BEGIN { exit !(r <= 0.08) }' || fail "landmark RMS $rms IOD on 
   || fail "render of the tracked model"
 ls "$TMP/woman_render"/*.png >/dev/null || fail "no render"
 
+# A poor fit warns and names the overlay to look at, which exists (Grace Hopper: her hat and collar
+# leave the face model little to fit; python-matplotlib-data).
+GRACE=/usr/share/matplotlib/mpl-data/sample_data/grace_hopper.jpg
+if [ -f "$GRACE" ]; then
+  "$ICEF" track "$GRACE" --out "$TMP/grace" --res 128 > "$TMP/grace.log" || fail "track of Grace Hopper"
+  overlay=$(grep -o 'check track/[^ ]*\.png' "$TMP/grace.log" | head -1 | cut -d' ' -f2)
+  [ -n "$overlay" ] || fail "no warning naming an overlay: $(cat "$TMP/grace.log")"
+  [ -f "$TMP/grace/$overlay" ] || fail "the warning names $overlay, which was not written"
+fi
+
 # --keep-cameras on a synthetic dataset: same cameras, the face model's expressions.
 "$ICEF" synth --identity-seed 3 --k 3 --res 160 --test-views 1 --novel-per-tier 1 --out "$TMP/syn" >/dev/null
 "$ICEF" track "$TMP/syn" --keep-cameras --out "$TMP/syn_tracked" > "$TMP/keep.log" || fail "--keep-cameras"

@@ -127,11 +127,11 @@ Status RunTrack(const TrackAppOptions& options, std::ostream& out) {
         << p.photo_intrinsics.fl_x << " px (" << track::FocalSourceName(p.focal_source) << "), "
         << ExpressionText(f.expression) << "\n";
     out << std::setprecision(3);
-    if (f.rms_iod > 0.05)
-      out << "  warning: " << p.source.string() << ": the face model fits its landmarks poorly (RMS " << f.rms_iod
-          << " IOD > 0.05); check track/overlay_" << i << ".png\n";
     char name[64];
     std::snprintf(name, sizeof(name), "track/overlay_%03zu.png", i);
+    if (f.rms_iod > 0.05)
+      out << "  warning: " << p.source.string() << ": the face model fits its landmarks poorly (RMS " << f.rms_iod
+          << " IOD > 0.05); check " << name << "\n";
     overlays.emplace_back(name, TrackOverlay(result, static_cast<int>(i)));
   }
   out.unsetf(std::ios::fixed);
