@@ -10,12 +10,14 @@ Gaussian (sigma in pixels; 0 = the pixel measure icef eval reports), per tier:
 - `blurred truth S`: the ground truth and its neutral blurred by a Gaussian of S pixels, as a
   render that has every bit of the expression but is that soft would score;
 - `--reference DIR`: the test images of another dataset of the same views and expressions (e.g.
-  `icef synth --generic-style`: the face model's generic expressions, which is what the prior knows).
+  `icef synth --generic-style`: the face model's generic expressions, which is what the prior knows;
+  `icef synth --canonical-shading`: the same expressions with the shading moving with the skin, what
+  a warp of a static field can reproduce at best), with `--reference-blur S,...` also blurred.
 
 A render whose score rises to near 1 when measured at a coarser scale has the expression but lacks
 its pixel-scale sharpness; one that stays low does not move the face as the truth does.
 
-Usage: scripts/expr_gain_probe.py DATASET EVAL_DIR [--reference DATASET2] [--json OUT]
+Usage: scripts/expr_gain_probe.py DATASET EVAL_DIR [--reference DATASET2 [--reference-blur S,...]] [--json OUT]
 """
 import argparse
 import json
@@ -88,6 +90,7 @@ def main():
     ap.add_argument("dataset")
     ap.add_argument("eval_dir")
     ap.add_argument("--reference", help="dataset with the same test views and expressions (e.g. --generic-style)")
+    ap.add_argument("--reference-blur", default="", help="also the reference blurred by these Gaussian sigmas (pixels)")
     ap.add_argument("--truth-blur", default="0.5,0.7,1.0", help="Gaussian sigmas (pixels) of the blurred-truth rows")
     ap.add_argument("--json", help="also write the table here")
     args = ap.parse_args()
@@ -95,6 +98,7 @@ def main():
     bg = np.array(meta.get("background", [1, 1, 1])[:3], dtype=np.float64)
     rows = {"render": {}}
     blurs = [float(s) for s in args.truth_blur.split(",") if s]
+    reference_blurs = [float(s) for s in args.reference_blur.split(",") if s]
     for f in meta["frames"]:
         tier = f.get("tier", "observed")
         if "neutral_file_path" not in f or "landmarks_2d" not in f:
@@ -115,8 +119,11 @@ def main():
             candidates["reference"] = (os.path.join(args.reference, f["file_path"]),
                                        os.path.join(args.reference, f["neutral_file_path"]))
         for name, (a, b) in candidates.items():
-            m = load(a, bg) - load(b, bg)
-            rows.setdefault(name, {}).setdefault(tier, []).append([gain(m, t, region, s) for s in SCALES])
+            changed, still = load(a, bg), load(b, bg)
+            for s in [0.0] + (reference_blurs if name == "reference" else []):
+                m = blur(changed, s) - blur(still, s)
+                row = name if s == 0 else f"{name} blurred {s:g}"
+                rows.setdefault(row, {}).setdefault(tier, []).append([gain(m, t, region, sc) for sc in SCALES])
         for s in blurs:
             m = blur(truth, s) - blur(neutral, s)
             rows.setdefault(f"blurred truth {s:g}", {}).setdefault(tier, []).append(

@@ -38,6 +38,10 @@ CommandFn RegisterSynth(CLI::App& app) {
       ->capture_default_str();
   app.add_flag("--generic-style", o.generic_style,
                "Render the face model's generic expressions instead of the identity's own style");
+  app.add_flag("--canonical-shading", o.render.canonical_shading,
+               "Shade every point as its neutral canonical point is shaded, so the lighting moves with the skin "
+               "and no expression changes it: what a warp of a static field can reproduce (a reference for "
+               "scripts/expr_gain_probe.py, not a realistic render)");
   app.add_option("--k", o.num_train, "Number of training frames K")->capture_default_str();
   app.add_option("--res", o.resolution, "Image width = height in pixels")->capture_default_str();
   app.add_option("--test-views", o.test_views, "Held-out test views V")->capture_default_str();

@@ -23,6 +23,7 @@ std::string RenderOptions::ToString() const {
      << ", diffuse=" << diffuse;
   if (fill > 0.f) os << ", fill=" << fill << "@[" << fill_direction.transpose() << "]";
   if (specular > 0.f) os << ", specular=" << specular << "^" << shininess;
+  if (canonical_shading) os << ", canonical_shading";
   os << ", max_steps=" << max_steps << ")";
   return os.str();
 }
@@ -33,6 +34,7 @@ Image RenderGroundTruth(const HeadModel& head, const Camera& camera, const std::
   ICEF_CHECK(valid.ok(), valid.message());
   const face::FaceModel& face_model = head.face();
   const face::ExpressionState state = face_model.Prepare(expression);
+  const face::ExpressionState neutral = face_model.Prepare(std::vector<float>(expression.size(), 0.f));
   const Aabb bounds = face_model.Bounds();
   const Vec3f light = options.light_direction.normalized();
   const Vec3f fill_light = options.fill > 0.f ? Vec3f(options.fill_direction.normalized()) : Vec3f::Zero();
@@ -53,7 +55,8 @@ Image RenderGroundTruth(const HeadModel& head, const Camera& camera, const std::
             const Vec3f p = ray.At(t);
             const face::FaceModel::Sample sample = face_model.Evaluate(p, state);
             const Vec3f albedo = head.Albedo(sample, p, state);
-            const Vec3f normal = face_model.Normal(p, state);
+            const Vec3f normal = options.canonical_shading ? face_model.Normal(sample.canonical, neutral)
+                                                           : face_model.Normal(p, state);
             const float lambert = std::max(0.f, normal.dot(light));
             float shade = options.ambient + options.diffuse * lambert;
             if (options.fill > 0.f) shade += options.fill * std::max(0.f, normal.dot(fill_light));

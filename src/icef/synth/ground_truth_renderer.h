@@ -36,6 +36,11 @@ struct RenderOptions {
   Vec3f background = Vec3f::Ones();
   // Maximum sphere-tracing steps per ray.
   int max_steps = 192;
+  // Shade each surface point with the neutral surface's normal at its canonical point instead of
+  // its own: the shading moves with the skin, unchanged by the expression, as a model whose
+  // canonical colours are fixed (a warp of a static field) renders it. A reference for what a
+  // deformation alone can reproduce (scripts/expr_gain_probe.py), not a realistic render.
+  bool canonical_shading = false;
 
   Status Validate() const;
   std::string ToString() const;

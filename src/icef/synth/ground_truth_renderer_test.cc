@@ -40,6 +40,28 @@ TEST(GroundTruthRendererTest, DeterministicAndIndependentOfThreads) {
   EXPECT_EQ(EncodePng(a), EncodePng(c));
 }
 
+TEST(GroundTruthRendererTest, CanonicalShadingChangesOnlyTheShadingOfExpressions) {
+  const HeadModel head(IdentityParams::FromSeed(12));
+  RenderOptions canonical;
+  canonical.canonical_shading = true;
+  // Neutral: every point is its own canonical point, so the two renders are the same.
+  EXPECT_EQ(RenderGroundTruth(head, TestCamera(15, 5), Zeros(), Executor(2)).pixels,
+            RenderGroundTruth(head, TestCamera(15, 5), Zeros(), Executor(2), canonical).pixels);
+  std::vector<float> beta = Zeros();
+  beta[kJawOpen] = 0.9f, beta[face::kCheekPuff] = 1.f;
+  const Image observed = RenderGroundTruth(head, TestCamera(15, 5), beta, Executor(2));
+  const Image moved = RenderGroundTruth(head, TestCamera(15, 5), beta, Executor(2), canonical);
+  double changed = 0, coverage_diff = 0;
+  for (int y = 0; y < kRes; ++y)
+    for (int x = 0; x < kRes; ++x) {
+      coverage_diff += std::abs(observed.At(x, y, 3) - moved.At(x, y, 3));  // same geometry
+      // The same albedo under other light: the colour's chromaticity stays, its brightness moves.
+      if (observed.At(x, y, 3) == 1.f && std::abs(observed.At(x, y, 1) - moved.At(x, y, 1)) > 0.02f) ++changed;
+    }
+  EXPECT_EQ(coverage_diff, 0.0);
+  EXPECT_GT(changed, 20) << "the opened jaw and the puffed cheeks should be shaded as at neutral";
+}
+
 TEST(GroundTruthRendererTest, WhiteBackgroundAlphaMaskAndAFaceInTheMiddle) {
   const HeadModel head(IdentityParams::Average());
   const Image img = RenderGroundTruth(head, TestCamera(), Zeros(), Executor(2));

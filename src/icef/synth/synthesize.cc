@@ -175,7 +175,8 @@ Json SceneInfoJson(const SynthOptions& o, const IdentityParams& id) {
   doc["drawn_axes"] = o.vary.ToString();
   doc["lighting"] = Json{{"key_direction", vec(o.render.light_direction)}, {"key", o.render.diffuse},
                          {"ambient", o.render.ambient}, {"fill_direction", vec(o.render.fill_direction)},
-                         {"fill", o.render.fill}, {"specular", o.render.specular}, {"shininess", o.render.shininess}};
+                         {"fill", o.render.fill}, {"specular", o.render.specular}, {"shininess", o.render.shininess},
+                         {"canonical_shading", o.render.canonical_shading}};
   doc["placement"] = Json{{"head_scale", o.head_scale}, {"head_offset", vec(o.head_offset)}};
   doc["camera"] = Json{{"distance", o.camera_distance}, {"focal_scale", o.focal_scale}};
   doc["views"] = Json{{"max_yaw_deg", o.max_yaw_deg}, {"max_pitch_deg", o.max_pitch_deg}};
