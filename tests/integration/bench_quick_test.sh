@@ -79,6 +79,18 @@ mkdir -p "$WORK/c" && cp -r "$WORK/m/runs" "$WORK/c/"
 grep -q "bench: 7 runs in shard 0/1 (7 already done)" "$WORK/c.txt" || fail "unsharded plan: $(head -1 "$WORK/c.txt")"
 diff <(grep -A4 "^## Verdict" "$WORK/c/report.md") <(grep -A4 "^## Verdict" "$R") || fail "verdicts differ"
 
+# Training replicates: every run trained twice with its own seed, averaged per identity in the
+# tables, their spread in a table of its own.
+"$ICEF" bench --quick --methods icef --replicates 2 --out "$WORK/rep" --threads 2 > "$WORK/rep.txt" || fail "replicates exited $?"
+ls "$WORK/rep/runs" | grep -qx "id1_k3_icef_r1" || fail "no second replicate: $(ls "$WORK/rep/runs")"
+grep -q '"replicate": 1' "$WORK/rep/runs/id1_k3_icef_r1/metrics.json" || fail "replicate not recorded"
+# Another training seed trains another model: the replicates differ.
+if grep -q "| 3 | \`icef\` | observed | 1 | 2 | 0.00 |" "$WORK/rep/report.md"; then fail "replicates trained the same model"; fi
+grep -q "^## Training-seed spread" "$WORK/rep/report.md" || fail "no training-seed spread in the report"
+grep -q "| 3 | \`icef\` | far | 1 | 2 |" "$WORK/rep/report.md" || fail "spread row: $(grep -A6 'Training-seed' "$WORK/rep/report.md")"
+if "$ICEF" bench --out "$WORK/x" --replicates 0 2> "$WORK/err.txt"; then fail "--replicates 0 accepted"; fi
+grep -q "replicates" "$WORK/err.txt" || fail "unclear replicates error"
+
 # Bad options exit 1 with a message.
 if "$ICEF" bench --out "$WORK/x" --shard 2/2 2> "$WORK/err.txt"; then fail "bad shard accepted"; fi
 grep -q "shard" "$WORK/err.txt" || fail "unclear shard error"

@@ -36,6 +36,10 @@ CommandFn RegisterBench(CLI::App& app) {
   app.add_option("--first-seed", o.first_identity_seed, "Seed of the first identity")->capture_default_str();
   app.add_option("--k", args->app.ks, "Training-frame counts K, comma-separated (default 3,5,10)");
   app.add_option("--methods", args->app.methods, "Methods (default: all seven: icef-prior, warp-prior, icef, icef-no-conf, icef-uniform, warp, nerface)")->delimiter(',');
+  app.add_option("--replicates", o.replicates,
+                 "Train every (identity, K, method) this many times with different training seeds (identity seed, "
+                 "then + 1000 per replicate); the report averages them per identity and gives their spread")
+      ->capture_default_str();
   app.add_option("--res", o.resolution, "Image width = height")->capture_default_str();
   app.add_option("--test-views", o.test_views, "Held-out test views per dataset")->capture_default_str();
   app.add_option("--novel-per-tier", o.novel_per_tier, "Novel test expressions per tier")->capture_default_str();

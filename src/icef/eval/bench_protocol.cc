@@ -71,6 +71,7 @@ Status BenchOptions::Validate() const {
                          " and up are validation identities; a test bench uses seeds below it (got seeds " +
                          std::to_string(first_identity_seed) + ".." + std::to_string(last_seed) +
                          "; add --validation for a validation bench)");
+  if (replicates < 1) return Status::Error("bench: --replicates must be >= 1");
   if (ks.empty()) return Status::Error("bench: --k needs at least one value");
   for (int k : ks)
     if (k < 1) return Status::Error("bench: --k values must be >= 1, got " + std::to_string(k));
@@ -92,6 +93,7 @@ Json BenchOptions::ToJson() const {
   j["first_identity_seed"] = first_identity_seed;
   j["validation"] = validation;
   j["ks"] = ks;
+  j["replicates"] = replicates;
   j["methods"] = methods;
   j["resolution"] = draw_resolution ? Json("drawn per identity, 128-" + std::to_string(kMaxValidationResolution))
                                     : Json(resolution);
@@ -148,7 +150,8 @@ std::vector<RunId> PlanRuns(const BenchOptions& o) {
   std::vector<RunId> runs;
   for (int i = 0; i < o.identities; ++i)
     for (int k : o.ks)
-      for (const std::string& m : o.methods) runs.push_back(RunId{o.first_identity_seed + uint64_t(i), k, m});
+      for (const std::string& m : o.methods)
+        for (int r = 0; r < o.replicates; ++r) runs.push_back(RunId{o.first_identity_seed + uint64_t(i), k, m, r});
   return runs;
 }
 
@@ -206,7 +209,7 @@ Result<RunConfig> MakeRunConfig(const BenchOptions& o, const RunId& id) {
   config.model.method = id.method;
   config.train.steps = o.steps;
   config.train.time_budget_seconds = o.time_budget_seconds;
-  config.train.seed = static_cast<int64_t>(id.identity_seed);
+  config.train.seed = id.TrainSeed();
   config.train.threads = o.threads;
   ICEF_RETURN_IF_ERROR(config.Validate());
   return config;
@@ -372,10 +375,10 @@ Status MergeBench(const std::vector<fs::path>& inputs, const fs::path& out_dir, 
     if (!fs::is_directory(in / "runs", ec)) return Status::Error(in.string() + ": not a bench directory (no runs/)");
     if (fs::exists(in / "bench.json", ec)) {
       ICEF_ASSIGN_OR_RETURN(Json s, ReadJsonFile(in / "bench.json"));
-      // Which shard or which identities a directory ran does not make it another bench: benches of
-      // the same protocol over other identity seeds merge like shards.
+      // Which shard, which identities or how many training replicates a directory ran does not make
+      // it another bench: benches of the same protocol over other identity seeds merge like shards.
       if (s.is_object())
-        for (const char* key : {"shard", "identities", "first_identity_seed"}) s.erase(key);
+        for (const char* key : {"shard", "identities", "first_identity_seed", "replicates"}) s.erase(key);
       if (!settings) {
         settings = s;
       } else if (*settings != s) {

@@ -52,6 +52,10 @@ struct BenchOptions {
   int test_views = 3;
   // Novel test expressions per tier (near, moderate, far).
   int novel_per_tier = 2;
+  // Trainings per (identity, K, method), each with its own training seed (RunId::TrainSeed): the
+  // report averages them per identity and gives their spread (two trainings of one identity can
+  // differ by more than a prior changes, docs/results/priors_validation.md).
+  int replicates = 1;
   // Training steps per run (the same budget for every run).
   int64_t steps = kDefaultBenchSteps;
   // Wall-clock budget per run in seconds (0 = none; with it, steps is only an upper bound).

@@ -34,6 +34,21 @@ TEST(BenchProtocolTest, PlansRunsInStableOrder) {
   std::set<std::string> names;
   for (const RunId& r : runs) names.insert(r.Name());
   EXPECT_EQ(names.size(), runs.size());
+  // Training replicates: each run r times in a row, the first as before, each with its own seed.
+  o.replicates = 2;
+  o.ks = {5};
+  o.methods = {"icef"};
+  EXPECT_TRUE(o.Validate().ok());
+  const std::vector<RunId> twice = PlanRuns(o);
+  ASSERT_EQ(twice.size(), 3u * 2u);
+  EXPECT_EQ(twice[0].Name(), "id1_k5_icef");
+  EXPECT_EQ(twice[1].Name(), "id1_k5_icef_r1");
+  EXPECT_EQ(twice[2].Name(), "id2_k5_icef");
+  EXPECT_EQ(twice[0].TrainSeed(), 1);
+  EXPECT_EQ(twice[1].TrainSeed(), 1001);
+  EXPECT_EQ(o.ToJson()["replicates"], 2);
+  o.replicates = 0;
+  EXPECT_FALSE(o.Validate().ok());
 }
 
 TEST(BenchProtocolTest, ShardsPartitionTheRuns) {

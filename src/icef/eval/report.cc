@@ -6,6 +6,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <tuple>
 #include <cstdlib>
 
 #include "icef/core/progress.h"
@@ -17,7 +18,10 @@ namespace fs = std::filesystem;
 
 namespace icef::eval {
 
-std::string RunId::Name() const { return "id" + std::to_string(identity_seed) + "_k" + std::to_string(k) + "_" + method; }
+std::string RunId::Name() const {
+  return "id" + std::to_string(identity_seed) + "_k" + std::to_string(k) + "_" + method +
+         (replicate > 0 ? "_r" + std::to_string(replicate) : std::string());
+}
 
 const std::array<Metric, kNumMetrics>& AllMetrics() {
   static const std::array<Metric, kNumMetrics> kAll = {
@@ -229,10 +233,111 @@ const std::vector<std::string>& PrimaryMethods() {
   return kPrimary;
 }
 
+// The mean of JSON objects of the same shape: floating-point numbers averaged over the objects
+// that have one (null when none has), every other value (integer counts, strings) from the first.
+Json MeanJson(const std::vector<Json>& objects) {
+  Json out = objects.front();
+  for (auto& [key, value] : out.items()) {
+    bool floating = value.is_number_float();
+    double sum = 0;
+    int n = 0;
+    for (const Json& o : objects) {
+      const auto it = o.find(key);
+      if (it == o.end() || !it->is_number()) continue;
+      floating = floating || it->is_number_float();
+      sum += it->get<double>();
+      ++n;
+    }
+    if (floating || (value.is_null() && n > 0)) value = n > 0 ? Json(sum / n) : Json(nullptr);
+  }
+  return out;
+}
+
+std::vector<ReplicateSpreadCell> ReplicateSpread(const std::vector<RunRecord>& runs) {
+  // (k, method) -> identity -> replicates
+  std::map<std::pair<int, std::string>, std::map<uint64_t, std::vector<const RunRecord*>>> groups;
+  for (const RunRecord& r : runs) groups[{r.id.k, r.id.method}][r.id.identity_seed].push_back(&r);
+  std::vector<ReplicateSpreadCell> out;
+  for (const auto& [key, identities] : groups)
+    for (Tier tier : AllTiers()) {
+      ReplicateSpreadCell cell;
+      cell.k = key.first;
+      cell.method = key.second;
+      cell.tier = tier;
+      std::vector<double> psnr_ranges, gain_ranges;
+      for (const auto& [seed, reps] : identities) {
+        if (reps.size() < 2) continue;
+        ++cell.identities;
+        cell.replicates = std::max(cell.replicates, static_cast<int>(reps.size()));
+        for (auto [metric, ranges] : {std::pair{Metric::kPsnr, &psnr_ranges}, std::pair{Metric::kExprGain, &gain_ranges}}) {
+          std::vector<double> v;
+          for (const RunRecord* r : reps)
+            if (const auto x = TierValue(r->metrics.tiers[TierIndex(tier)], metric)) v.push_back(*x);
+          if (v.size() >= 2) ranges->push_back(*std::max_element(v.begin(), v.end()) - *std::min_element(v.begin(), v.end()));
+        }
+      }
+      if (cell.identities == 0) continue;
+      if (const auto s = Spread::Of(psnr_ranges)) cell.psnr_range = s->mean;
+      if (const auto s = Spread::Of(gain_ranges)) cell.expr_gain_range = s->mean;
+      out.push_back(std::move(cell));
+    }
+  std::sort(out.begin(), out.end(), [](const ReplicateSpreadCell& x, const ReplicateSpreadCell& y) {
+    if (x.k != y.k) return x.k < y.k;
+    if (x.method != y.method) return MethodLess(x.method, y.method);
+    return TierIndex(x.tier) < TierIndex(y.tier);
+  });
+  return out;
+}
+
 }  // namespace
 
-Aggregate AggregateRuns(const std::vector<RunRecord>& runs) {
+Json ReplicateSpreadCell::ToJson() const {
+  return Json{{"k", k},
+              {"method", method},
+              {"tier", TierName(tier)},
+              {"identities", identities},
+              {"replicates", replicates},
+              {"psnr_range", psnr_range ? Json(*psnr_range) : Json(nullptr)},
+              {"expr_gain_range", expr_gain_range ? Json(*expr_gain_range) : Json(nullptr)}};
+}
+
+std::vector<RunRecord> PoolReplicates(const std::vector<RunRecord>& runs) {
+  std::vector<RunRecord> out;
+  std::map<std::tuple<uint64_t, int, std::string>, std::vector<const RunRecord*>> groups;
+  std::vector<std::tuple<uint64_t, int, std::string>> order;
+  for (const RunRecord& r : runs) {
+    const auto key = std::make_tuple(r.id.identity_seed, r.id.k, r.id.method);
+    auto& g = groups[key];
+    if (g.empty()) order.push_back(key);
+    g.push_back(&r);
+  }
+  for (const auto& key : order) {
+    const std::vector<const RunRecord*>& g = groups[key];
+    RunRecord pooled = *g.front();
+    pooled.id.replicate = 0;
+    if (g.size() > 1) {
+      for (int t = 0; t < kNumTiers; ++t) {
+        std::vector<Json> tiers;
+        for (const RunRecord* r : g) tiers.push_back(r->metrics.tiers[t].ToJson());
+        pooled.metrics.tiers[t] = TierMetrics::FromJson(MeanJson(tiers), "pooled tier").value();
+      }
+      std::vector<Json> fits;
+      for (const RunRecord* r : g) fits.push_back(r->metrics.train_fit.ToJson());
+      pooled.metrics.train_fit = TrainingFit::FromJson(MeanJson(fits), "pooled training-view fit").value();
+      double train = 0, eval = 0;
+      for (const RunRecord* r : g) train += r->train_seconds, eval += r->eval_seconds;
+      pooled.train_seconds = train / g.size();
+      pooled.eval_seconds = eval / g.size();
+    }
+    out.push_back(std::move(pooled));
+  }
+  return out;
+}
+
+Aggregate AggregateRuns(const std::vector<RunRecord>& all_runs) {
+  const std::vector<RunRecord> runs = PoolReplicates(all_runs);
   Aggregate a;
+  a.replicate_spread = ReplicateSpread(all_runs);
   std::set<int> ks;
   std::set<uint64_t> ids;
   std::vector<std::string> methods;
@@ -648,8 +753,20 @@ std::string ReportMarkdown(const Aggregate& a, const std::vector<RunRecord>& run
       s << "\n### K = " << k << ", training-view fit\n\n| method | runs | face_psnr | face_psnr_min | psnr |\n"
         << "|---|---|---|---|---|\n" << fit_rows;
   }
+  if (!a.replicate_spread.empty()) {
+    s << "\n## Training-seed spread\n\nIdentities trained more than once (`--replicates`), each time with its own "
+      << "training seed: the tables above count each identity once, as the mean of its replicates; here, the mean "
+      << "over those identities of each one's range (max - min over its replicates). A difference between methods "
+      << "or settings smaller than this is within what retraining alone changes.\n\n"
+      << "| K | method | tier | identities | replicates | psnr range (dB) | expr_gain range |\n"
+      << "|---|---|---|---|---|---|---|\n";
+    for (const ReplicateSpreadCell& c : a.replicate_spread)
+      s << "| " << c.k << " | `" << c.method << "` | " << TierName(c.tier) << " | " << c.identities << " | "
+        << c.replicates << " | " << Opt(c.psnr_range, "%.2f") << " | " << Opt(c.expr_gain_range, "%.3f") << " |\n";
+  }
   if (ctx.PerIdentity() && !runs.empty()) {
-    const std::vector<IdentityRow> rows = IdentityRows(runs);
+    const std::vector<RunRecord> pooled = PoolReplicates(runs);
+    const std::vector<IdentityRow> rows = IdentityRows(pooled);
     s << "\n## Per identity\n\nEvery run: the training-view fit (mean face-region PSNR over its training views, "
       << "its worst view, and the face's fine detail relative to the truth's: 1 = as sharp, below 1 = blurred) "
       << "beside its observed- and far-tier numbers, to find the identity that fails and see whether it already "
@@ -711,8 +828,12 @@ Json ReportJson(const Aggregate& a, const std::vector<RunRecord>& runs, const Re
   Json fits = Json::array();
   for (const TrainFitCell& c : a.train_fit) fits.push_back(c.ToJson());
   j["train_fit"] = std::move(fits);
+  Json spread = Json::array();
+  for (const ReplicateSpreadCell& c : a.replicate_spread) spread.push_back(c.ToJson());
+  j["replicate_spread"] = std::move(spread);
   if (ctx.PerIdentity()) {
-    const std::vector<IdentityRow> rows = IdentityRows(runs);
+    const std::vector<RunRecord> pooled = PoolReplicates(runs);
+    const std::vector<IdentityRow> rows = IdentityRows(pooled);
     const auto worst_fit = FindWorstIdentity(rows, &IdentityRow::train_face_psnr);
     const auto worst_psnr = FindWorstIdentity(rows, &IdentityRow::observed_psnr);
     j["worst_identity"] = Json{{"train_fit_face_psnr", worst_fit ? worst_fit->ToJson() : Json(nullptr)},
@@ -725,6 +846,7 @@ Json ReportJson(const Aggregate& a, const std::vector<RunRecord>& runs, const Re
   for (const RunRecord& r : runs)
     rj.push_back(Json{{"name", r.id.Name()},
                       {"identity_seed", r.id.identity_seed},
+                      {"replicate", r.id.replicate},
                       {"k", r.id.k},
                       {"method", r.id.method},
                       {"train_steps", r.train_steps},
@@ -740,7 +862,8 @@ Json ReportJson(const Aggregate& a, const std::vector<RunRecord>& runs, const Re
 Json RunRecordJson(const RunRecord& r) {
   Json j = r.metrics.ToJson();
   j["run"] = Json{{"identity_seed", r.id.identity_seed}, {"k", r.id.k},
-                  {"method", r.id.method},               {"train_steps", r.train_steps},
+                  {"method", r.id.method},               {"replicate", r.id.replicate},
+                  {"train_steps", r.train_steps},
                   {"train_seconds", r.train_seconds},    {"eval_seconds", r.eval_seconds}};
   return j;
 }
@@ -757,6 +880,10 @@ Result<RunRecord> ReadRunRecord(const fs::path& path) {
   r.id.identity_seed = static_cast<uint64_t>(seed);
   ICEF_ASSIGN_OR_RETURN(r.id.k, v.Int("k"));
   ICEF_ASSIGN_OR_RETURN(r.id.method, v.String("method"));
+  if (run->contains("replicate")) {  // absent in runs from before replicates: 0
+    ICEF_ASSIGN_OR_RETURN(r.id.replicate, v.Int("replicate"));
+    if (r.id.replicate < 0) return v.Error("replicate", "expected a non-negative integer");
+  }
   ICEF_ASSIGN_OR_RETURN(const double steps, v.Number("train_steps"));
   r.train_steps = static_cast<int64_t>(steps);
   ICEF_ASSIGN_OR_RETURN(r.train_seconds, v.Number("train_seconds"));
@@ -783,7 +910,8 @@ Result<std::vector<RunRecord>> ReadRunRecords(const fs::path& dir) {
   std::sort(out.begin(), out.end(), [](const RunRecord& x, const RunRecord& y) {
     if (x.id.identity_seed != y.id.identity_seed) return x.id.identity_seed < y.id.identity_seed;
     if (x.id.k != y.id.k) return x.id.k < y.id.k;
-    return MethodLess(x.id.method, y.id.method);
+    if (x.id.method != y.id.method) return MethodLess(x.id.method, y.id.method);
+    return x.id.replicate < y.id.replicate;
   });
   return out;
 }

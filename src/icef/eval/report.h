@@ -24,8 +24,12 @@ struct RunId {
   uint64_t identity_seed = 1;
   int k = 3;
   std::string method;
-  // Directory name under runs/: "id<seed>_k<K>_<method>", e.g. "id1_k3_icef".
+  // Training replicate: 0 trains with the identity seed, r > 0 with identity_seed + 1000 r.
+  int replicate = 0;
+  // Directory name under runs/: "id<seed>_k<K>_<method>", e.g. "id1_k3_icef"; replicates r > 0
+  // add "_r<r>".
   std::string Name() const;
+  int64_t TrainSeed() const { return static_cast<int64_t>(identity_seed) + 1000 * int64_t(replicate); }
   bool operator==(const RunId& o) const = default;
 };
 
@@ -128,6 +132,24 @@ struct TrainFitCell {
   Json ToJson() const;
 };
 
+// Training-seed spread of one (K, method, tier): over the identities trained more than once
+// (BenchOptions::replicates), the mean of each identity's range (max - min over its replicates).
+struct ReplicateSpreadCell {
+  int k = 0;
+  std::string method;
+  Tier tier = Tier::kObserved;
+  int identities = 0;                     // identities with two or more replicates
+  int replicates = 0;                     // the most replicates of any of them
+  std::optional<double> psnr_range;       // dB
+  std::optional<double> expr_gain_range;
+  Json ToJson() const;
+};
+
+// One record per (identity, K, method): each tier's and the training-view fit's numbers averaged
+// over the run's training replicates (counts from the first replicate), replicate 0, the per-frame
+// metrics of the first. Runs without replicates come back unchanged.
+std::vector<RunRecord> PoolReplicates(const std::vector<RunRecord>& runs);
+
 struct Aggregate {
   std::vector<int> ks;                     // ascending
   std::vector<std::string> methods;        // in AllMethods() order, then others by name
@@ -136,10 +158,13 @@ struct Aggregate {
   std::vector<Comparison> far_comparisons;  // icef vs every other method, far tier, per K, per metric
   std::vector<PairVerdict> verdicts;        // icef and icef-prior vs every other method, per K, near/moderate/far
   std::vector<TrainFitCell> train_fit;      // k-major, then method (every (K, method) with runs)
+  std::vector<ReplicateSpreadCell> replicate_spread;  // k-major, then method, then tier; empty without replicates
   const AggregateCell* Find(int k, const std::string& method, Tier tier) const;
   const TrainFitCell* FindTrainFit(int k, const std::string& method) const;
 };
 
+// Spreads over identities of every metric; an identity's training replicates count once, as
+// their mean (PoolReplicates), and their spread goes to replicate_spread.
 Aggregate AggregateRuns(const std::vector<RunRecord>& runs);
 
 // What the report says about the setup (copied into report.md / report.json).

@@ -230,6 +230,65 @@ TEST(ReportTest, WritesMarkdownJsonAndPlots) {
   fs::remove_all(dir);
 }
 
+TEST(ReportTest, TrainingReplicatesCountOncePerIdentityWithTheirSpread) {
+  // icef on three identities, the first two trained twice (far PSNR 20 / 22 and 22 / 26).
+  std::vector<RunRecord> runs = ThreeIdentities();
+  RunRecord again1 = MakeRun(1, 3, "icef", 22, 0.34, 0.6);
+  again1.id.replicate = 1;
+  RunRecord again2 = MakeRun(2, 3, "icef", 26, 0.40);
+  again2.id.replicate = 1;
+  runs.push_back(again1);
+  runs.push_back(again2);
+  EXPECT_EQ(again1.id.Name(), "id1_k3_icef_r1");
+  EXPECT_EQ(again1.id.TrainSeed(), 1001);
+  EXPECT_EQ(runs[0].id.TrainSeed(), 1);
+
+  const std::vector<RunRecord> pooled = PoolReplicates(runs);
+  ASSERT_EQ(pooled.size(), 6u);  // one per (identity, K, method)
+  const TierMetrics& far1 = pooled[0].metrics.tiers[TierIndex(Tier::kFar)];
+  EXPECT_EQ(pooled[0].id.Name(), "id1_k3_icef");
+  EXPECT_DOUBLE_EQ(*far1.psnr, 21.0);
+  EXPECT_DOUBLE_EQ(*far1.id_distance, 0.32);
+  EXPECT_DOUBLE_EQ(*far1.expr_gain, 0.7);
+  EXPECT_EQ(far1.count, 1);  // counts from the first replicate
+  EXPECT_DOUBLE_EQ(*pooled[1].metrics.tiers[TierIndex(Tier::kFar)].psnr, 24.0);
+  EXPECT_DOUBLE_EQ(*pooled[2].metrics.tiers[TierIndex(Tier::kFar)].psnr, 24.0);  // identity 3: one run
+
+  const Aggregate a = AggregateRuns(runs);
+  const AggregateCell* icef = a.Find(3, "icef", Tier::kFar);
+  ASSERT_NE(icef, nullptr);
+  EXPECT_EQ(icef->runs, 3);  // identities, not trainings
+  EXPECT_DOUBLE_EQ(icef->Get(Metric::kPsnr)->mean, 23.0);  // (21 + 24 + 24) / 3
+  // The spread: identities 1 and 2 ranges 2 and 4 dB (mean 3); expr_gain 0.2 and 0.
+  const ReplicateSpreadCell* spread = nullptr;
+  for (const ReplicateSpreadCell& c : a.replicate_spread)
+    if (c.method == "icef" && c.tier == Tier::kFar) spread = &c;
+  ASSERT_NE(spread, nullptr);
+  EXPECT_EQ(spread->identities, 2);
+  EXPECT_EQ(spread->replicates, 2);
+  EXPECT_DOUBLE_EQ(*spread->psnr_range, 3.0);
+  EXPECT_NEAR(*spread->expr_gain_range, 0.1, 1e-12);
+  for (const ReplicateSpreadCell& c : a.replicate_spread) EXPECT_NE(c.method, "warp");  // trained once
+  EXPECT_TRUE(AggregateRuns(ThreeIdentities()).replicate_spread.empty());
+
+  // Written and read back: the replicate survives, the report has the spread table.
+  const fs::path dir = TempDir("replicates");
+  for (const RunRecord& r : runs) {
+    fs::create_directories(dir / "runs" / r.id.Name());
+    ASSERT_TRUE(WriteFileAtomic(dir / "runs" / r.id.Name() / "metrics.json", FormatJson(RunRecordJson(r))).ok());
+  }
+  const Result<std::vector<RunRecord>> read = ReadRunRecords(dir);
+  ASSERT_TRUE(read.ok()) << read.status().message();
+  ASSERT_EQ(read->size(), 8u);
+  EXPECT_EQ((*read)[1].id.Name(), "id1_k3_icef_r1");
+  ASSERT_TRUE(WriteReport(dir, *read, ReportContext()).ok());
+  const Result<std::string> md = ReadFile(dir / "report.md");
+  ASSERT_TRUE(md.ok());
+  EXPECT_NE(md->find("## Training-seed spread"), std::string::npos) << *md;
+  EXPECT_NE(md->find("| 3 | `icef` | far | 2 | 2 | 3.00 | 0.100 |"), std::string::npos) << *md;
+  fs::remove_all(dir);
+}
+
 // `run` with a training-view fit of two views: face PSNR face_psnr -+ 1, full image face_psnr - 5.
 RunRecord WithTrainFit(RunRecord run, double face_psnr) {
   run.metrics.train_fit =
