@@ -767,7 +767,8 @@ std::string ReportMarkdown(const Aggregate& a, const std::vector<RunRecord>& run
   if (ctx.PerIdentity() && !runs.empty()) {
     const std::vector<RunRecord> pooled = PoolReplicates(runs);
     const std::vector<IdentityRow> rows = IdentityRows(pooled);
-    s << "\n## Per identity\n\nEvery run: the training-view fit (mean face-region PSNR over its training views, "
+    s << "\n## Per identity\n\nEvery run (with training replicates, the mean of an identity's replicates): "
+      << "the training-view fit (mean face-region PSNR over its training views, "
       << "its worst view, and the face's fine detail relative to the truth's: 1 = as sharp, below 1 = blurred) "
       << "beside its observed- and far-tier numbers, to find the identity that fails and see whether it already "
       << "fails on its own training views.\n\n"
