@@ -73,6 +73,7 @@ Json FrameMetrics::ToJson() const {
   j["id_excess"] = OptionalJson(id_excess);
   j["expr_gain"] = OptionalJson(expr_gain);
   j["expr_corr"] = OptionalJson(expr_corr);
+  j["expr_gain_coarse"] = OptionalJson(expr_gain_coarse);
   j["expr_true_rms"] = OptionalJson(expr_true_rms);
   j["region_psnr"] = OptionalJson(region_psnr);
   j["psnr_neutral_floor"] = OptionalJson(psnr_neutral_floor);
@@ -111,6 +112,7 @@ Result<FrameMetrics> FrameMetrics::FromJson(const Json& j, const std::string& wh
   }
   for (auto [key, field] : {std::pair{"id_excess", &f.id_excess}, std::pair{"expr_gain", &f.expr_gain},
                             std::pair{"expr_corr", &f.expr_corr}, std::pair{"expr_true_rms", &f.expr_true_rms},
+                            std::pair{"expr_gain_coarse", &f.expr_gain_coarse},
                             std::pair{"region_psnr", &f.region_psnr},
                             std::pair{"psnr_neutral_floor", &f.psnr_neutral_floor}}) {
     if (j.contains(key)) {
@@ -140,6 +142,7 @@ Json TierMetrics::ToJson() const {
   j["id_excess"] = OptionalJson(id_excess);
   j["expr_gain"] = OptionalJson(expr_gain);
   j["expr_corr"] = OptionalJson(expr_corr);
+  j["expr_gain_coarse"] = OptionalJson(expr_gain_coarse);
   j["region_psnr"] = OptionalJson(region_psnr);
   j["psnr_neutral_floor"] = OptionalJson(psnr_neutral_floor);
   j["expr_count"] = expr_count;
@@ -167,6 +170,7 @@ Result<TierMetrics> TierMetrics::FromJson(const Json& j, const std::string& wher
   }
   for (auto [key, field] : {std::pair{"id_excess", &t.id_excess}, std::pair{"expr_gain", &t.expr_gain},
                             std::pair{"expr_corr", &t.expr_corr}, std::pair{"region_psnr", &t.region_psnr},
+                            std::pair{"expr_gain_coarse", &t.expr_gain_coarse},
                             std::pair{"psnr_neutral_floor", &t.psnr_neutral_floor}}) {
     if (j.contains(key)) {
       ICEF_ASSIGN_OR_RETURN(*field, OptionalNumber(j, where, key));
@@ -191,7 +195,7 @@ std::array<TierMetrics, kNumTiers> AggregateTiers(const std::vector<FrameMetrics
   };
   struct TierAcc {
     Acc psnr, ssim, lpips, id_cosine, id_distance, id_distance_gt, under, delta, reference, excess, gain, corr,
-        region_psnr, floor;
+        gain_coarse, region_psnr, floor;
     int negligible = 0;
   };
   std::array<TierAcc, kNumTiers> acc;
@@ -211,6 +215,7 @@ std::array<TierMetrics, kNumTiers> AggregateTiers(const std::vector<FrameMetrics
     a.excess.Add(f.id_excess);
     a.gain.Add(f.expr_gain);
     a.corr.Add(f.expr_corr);
+    a.gain_coarse.Add(f.expr_gain_coarse);
     a.region_psnr.Add(f.region_psnr);
     a.floor.Add(f.psnr_neutral_floor);
     if (f.expr_true_rms && !f.expr_gain) ++a.negligible;
@@ -230,6 +235,7 @@ std::array<TierMetrics, kNumTiers> AggregateTiers(const std::vector<FrameMetrics
     m.id_excess = a.excess.Mean();
     m.expr_gain = a.gain.Mean();
     m.expr_corr = a.corr.Mean();
+    m.expr_gain_coarse = a.gain_coarse.Mean();
     m.region_psnr = a.region_psnr.Mean();
     m.psnr_neutral_floor = a.floor.Mean();
     m.expr_count = a.gain.n;
@@ -395,16 +401,16 @@ std::string EvalResult::Table() const {
   std::ostringstream s;
   char line[256];
   if (expression_scale != 1) s << "every frame rendered at " << expression_scale << " x its expression\n";
-  std::snprintf(line, sizeof line, "%-9s %5s %7s %7s %6s %6s %9s %9s %10s %9s\n", "tier", "count", "psnr", "floor",
-                "ssim", "lpips", "expr_gain", "expr_corr", "region_psnr", "expr_n");
+  std::snprintf(line, sizeof line, "%-9s %5s %7s %7s %6s %6s %9s %9s %11s %10s %9s\n", "tier", "count", "psnr",
+                "floor", "ssim", "lpips", "expr_gain", "expr_corr", "expr_coarse", "region_psnr", "expr_n");
   s << line;
   for (Tier t : AllTiers()) {
     const TierMetrics& m = tiers[TierIndex(t)];
     const std::string expr_n = std::to_string(m.expr_count) + (m.expr_negligible ? "+" + std::to_string(m.expr_negligible) : "");
-    std::snprintf(line, sizeof line, "%-9s %5d %7s %7s %6s %6s %9s %9s %10s %9s\n", TierName(t), m.count,
+    std::snprintf(line, sizeof line, "%-9s %5d %7s %7s %6s %6s %9s %9s %11s %10s %9s\n", TierName(t), m.count,
                   Fmt(m.psnr, "%.2f").c_str(), Fmt(m.psnr_neutral_floor, "%.2f").c_str(), Fmt(m.ssim, "%.3f").c_str(),
                   Fmt(m.lpips, "%.3f").c_str(), Fmt(m.expr_gain, "%.3f").c_str(), Fmt(m.expr_corr, "%.3f").c_str(),
-                  Fmt(m.region_psnr, "%.2f").c_str(), expr_n.c_str());
+                  Fmt(m.expr_gain_coarse, "%.3f").c_str(), Fmt(m.region_psnr, "%.2f").c_str(), expr_n.c_str());
     s << line;
   }
   std::snprintf(line, sizeof line, "%-9s %9s %7s %10s %7s %9s %7s\n", "tier", "id_cosine", "id_dist", "id_dist_gt",
@@ -420,7 +426,9 @@ std::string EvalResult::Table() const {
   }
   s << "floor: PSNR of the ground-truth neutral against the ground truth (a model that renders no expression); "
        "expr_gain: share of the true change (ground truth - its neutral) that the render's change (render - the "
-       "model's neutral) reproduces in the brow/eye/mouth region (1 = all, 0 = none), expr_corr their cosine; "
+       "model's neutral) reproduces in the brow/eye/mouth region (1 = all, 0 = none), expr_corr their cosine, "
+       "expr_coarse the same share with both changes low-passed (2 px at 128): a soft render that has the "
+       "expression scores high here and lower on pixels; "
        "expr_n: frames in those means (+ frames left out: negligible true change)\n";
   s << "id_*: face-descriptor distance/cosine of each render to the model's own neutral render (same view); "
        "id_dist_gt: to the ground truth; gt_ref: the ground truth's own distance to its neutral; "
@@ -561,10 +569,12 @@ Status MeasureExpressionMetrics(const Frame& frame, const Image& render, const I
   if (!region_psnr.ok()) return Status::Ok();  // the region lies outside the image: no values
   m->region_psnr = Finite(*region_psnr);
   if (!view.truth) return Status::Ok();
-  ICEF_ASSIGN_OR_RETURN(const ExpressionFidelity f, MeasureExpression(render, view.render, truth, *view.truth, region));
+  ICEF_ASSIGN_OR_RETURN(const ExpressionFidelity f, MeasureExpression(render, view.render, truth, *view.truth, region,
+                                                                      DefaultCoarseSigma(truth.width)));
   m->expr_true_rms = f.true_rms;
   m->expr_gain = f.gain;
   m->expr_corr = f.corr;
+  m->expr_gain_coarse = f.gain_coarse;
   return Status::Ok();
 }
 

@@ -60,6 +60,7 @@ struct FrameMetrics {
   // change is negligible (expr_true_rms below kNegligibleExpressionRms).
   std::optional<double> expr_gain;
   std::optional<double> expr_corr;
+  std::optional<double> expr_gain_coarse;  // expr_gain at the features' scale (eval/expression_fidelity.h)
   std::optional<double> expr_true_rms;  // RMS of ground truth - ground-truth neutral in the region
   std::optional<double> region_psnr;    // PSNR inside the expression region, dB
   // PSNR of the ground-truth neutral of the view against the ground truth: what a model that
@@ -92,6 +93,7 @@ struct TierMetrics {
   std::optional<double> id_excess;           // mean over frames with both distances
   std::optional<double> expr_gain;           // means over the frames with a non-negligible true change
   std::optional<double> expr_corr;
+  std::optional<double> expr_gain_coarse;
   std::optional<double> region_psnr;
   std::optional<double> psnr_neutral_floor;
   int expr_count = 0;                        // frames in the expr_gain mean

@@ -9,6 +9,10 @@
 //     expr_gain = <m, t> / <t, t>   (1 = the expression at full strength, 0 = none, < 0 = the
 //                                    opposite way, > 1 = exaggerated)
 //     expr_corr = <m, t> / (|m| |t|) (cosine; null when the model's change is exactly zero)
+//     expr_gain_coarse = expr_gain with m and t each first filtered by a Gaussian of `coarse_sigma`
+//                        pixels (DefaultCoarseSigma: 2 px at 128): the expression at the scale of the
+//                        features, where a render that is merely softer than the truth still scores
+//                        nearly 1 (the truth blurred by 1 px: 0.3-0.5 on pixels, about 0.9 here)
 // - A frame whose true change is negligible (RMS of t over the region below
 //   kNegligibleExpressionRms) gets no gain or cosine: they would divide by nearly nothing.
 // - Face region (FaceRegion): the filled hull of all 68 landmarks, for the training-view fit
@@ -33,6 +37,9 @@ const std::vector<int>& ExpressionLandmarkIndices();
 // Default dilation of the region in pixels for an image `width` wide: 3 px at 128, scaled.
 int DefaultRegionDilation(int width);
 
+// Default Gaussian sigma (pixels) of expr_gain_coarse for an image `width` wide: 2 px at 128, scaled.
+double DefaultCoarseSigma(int width);
+
 // 1-channel mask (1 inside, 0 outside) of the expression region. `neutral` may be empty (the
 // frame's hull alone). Landmarks are in pixel coordinates (pixel centres at +0.5).
 Image ExpressionRegion(int width, int height, const std::vector<Vec2f>& frame_landmarks,
@@ -51,10 +58,11 @@ struct ExpressionFidelity {
   bool negligible = true;     // true_rms < kNegligibleExpressionRms: gain and corr are null
   std::optional<double> gain;
   std::optional<double> corr;
+  std::optional<double> gain_coarse;  // with m and t low-passed (null with the gain, or coarse_sigma <= 0)
 };
 
 // All four images RGB (or RGBA, alpha ignored) of the region's size. Errors: size mismatches.
 Result<ExpressionFidelity> MeasureExpression(const Image& render, const Image& render_neutral, const Image& truth,
-                                             const Image& truth_neutral, const Image& region);
+                                             const Image& truth_neutral, const Image& region, double coarse_sigma = 0);
 
 }  // namespace icef::eval

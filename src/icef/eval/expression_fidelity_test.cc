@@ -3,6 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
+
+#include "icef/eval/metrics.h"
 
 namespace icef::eval {
 namespace {
@@ -79,8 +82,10 @@ TEST(ExpressionFidelityTest, KnownGains) {
   const Image render_neutral = Pattern(0.5f, 0.f);  // the model's neutral may differ from the truth's
   for (const double amount : {0.0, 0.5, 1.0}) {
     const Image render = Pattern(0.5f, static_cast<float>(amount));
-    const Result<ExpressionFidelity> f = MeasureExpression(render, render_neutral, truth, truth_neutral, region);
+    const Result<ExpressionFidelity> f = MeasureExpression(render, render_neutral, truth, truth_neutral, region, 1.5);
     ASSERT_TRUE(f.ok()) << f.status().message();
+    ASSERT_TRUE(f->gain_coarse.has_value());
+    EXPECT_NEAR(*f->gain_coarse, amount, 1e-5) << amount;  // both changes are the same pattern: any scale agrees
     EXPECT_FALSE(f->negligible);
     EXPECT_EQ(f->pixels, 16 * 16);
     ASSERT_TRUE(f->gain.has_value());
@@ -99,6 +104,41 @@ TEST(ExpressionFidelityTest, KnownGains) {
   const auto f = MeasureExpression(opposite, render_neutral, truth, truth_neutral, region);
   EXPECT_NEAR(*f->gain, -1.0, 1e-5);
   EXPECT_NEAR(*f->corr, -1.0, 1e-6);
+}
+
+// A 64x64 grey image with a dark horizontal bar whose top edge lies at row `top`, optionally
+// blurred by a Gaussian of `blur` pixels (a render that has the expression but is soft).
+Image Bar(double top, double blur) {
+  std::vector<double> plane(64 * 64);
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) plane[size_t(y) * 64 + x] = (y + 0.5 >= top && y < 40) ? 0.1 : 0.7;
+  plane = GaussianFilter(plane, 64, 64, blur);
+  Image image(64, 64, 3, 0.f);
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x)
+      for (int c = 0; c < 3; ++c) image.At(x, y, c) = static_cast<float>(plane[size_t(y) * 64 + x]);
+  return image;
+}
+
+TEST(ExpressionFidelityTest, CoarseGainForgivesSoftnessNotAbsence) {
+  EXPECT_DOUBLE_EQ(DefaultCoarseSigma(128), 2.0);
+  EXPECT_DOUBLE_EQ(DefaultCoarseSigma(256), 4.0);
+  // The "expression" raises the bar's top edge by two pixels (a brow lifting).
+  const Image region = ExpressionRegion(64, 64, BoxLandmarks(8, 20, 56, 44), {}, 0);
+  const Image truth_neutral = Bar(32, 0), truth = Bar(30, 0);
+  // A render with all of the expression, one pixel softer than the truth.
+  const auto soft = MeasureExpression(Bar(30, 1.0), Bar(32, 1.0), truth, truth_neutral, region, 2.0);
+  ASSERT_TRUE(soft.ok()) << soft.status().message();
+  EXPECT_LT(*soft->gain, 0.8);
+  EXPECT_GT(*soft->gain_coarse, 0.9);
+  // Half of the expression (the edge raised by one pixel), as soft: about half at the coarse scale.
+  const auto half = MeasureExpression(Bar(31, 1.0), Bar(32, 1.0), truth, truth_neutral, region, 2.0);
+  EXPECT_NEAR(*half->gain_coarse, 0.5, 0.1);
+  // None of it: zero at every scale.
+  const auto none = MeasureExpression(Bar(32, 1.0), Bar(32, 1.0), truth, truth_neutral, region, 2.0);
+  EXPECT_NEAR(*none->gain_coarse, 0.0, 1e-12);
+  // Without a coarse scale there is no coarse gain.
+  EXPECT_FALSE(MeasureExpression(Bar(30, 1.0), Bar(32, 1.0), truth, truth_neutral, region)->gain_coarse.has_value());
 }
 
 TEST(ExpressionFidelityTest, NegligibleTruthAndErrors) {

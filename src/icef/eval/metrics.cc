@@ -43,7 +43,20 @@ std::vector<double> Blur(const std::vector<double>& plane, int w, int h, const s
   return out;
 }
 
+std::vector<double> GaussianKernel(double sigma, int radius) {
+  std::vector<double> kernel(2 * radius + 1);
+  double sum = 0.0;
+  for (int k = -radius; k <= radius; ++k) sum += kernel[k + radius] = std::exp(-0.5 * k * k / (sigma * sigma));
+  for (double& k : kernel) k /= sum;
+  return kernel;
+}
+
 }  // namespace
+
+std::vector<double> GaussianFilter(const std::vector<double>& plane, int width, int height, double sigma) {
+  if (!(sigma > 0)) return plane;
+  return Blur(plane, width, height, GaussianKernel(sigma, static_cast<int>(std::ceil(3.0 * sigma))));
+}
 
 Result<double> Psnr(const Image& a, const Image& b, const Image* mask, double data_range) {
   ICEF_ASSIGN_OR_RETURN(const int channels, CheckPair(a, b, mask, "PSNR"));
@@ -109,10 +122,7 @@ Result<double> Ssim(const Image& a, const Image& b, const SsimOptions& options, 
   if (w < 2 * r + 1 || h < 2 * r + 1)
     return Status::Error("SSIM: image " + a.ToString() + " smaller than the " + std::to_string(2 * r + 1) +
                          "-pixel window");
-  std::vector<double> kernel(2 * r + 1);
-  double ksum = 0.0;
-  for (int k = -r; k <= r; ++k) ksum += kernel[k + r] = std::exp(-0.5 * k * k / (options.sigma * options.sigma));
-  for (double& k : kernel) k /= ksum;
+  const std::vector<double> kernel = GaussianKernel(options.sigma, r);
   const double c1 = std::pow(options.k1 * options.data_range, 2), c2 = std::pow(options.k2 * options.data_range, 2);
 
   double total = 0.0;

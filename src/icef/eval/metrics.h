@@ -8,6 +8,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "icef/core/status.h"
 #include "icef/io/image.h"
@@ -34,6 +35,10 @@ struct SsimOptions {
 // pixels at least `radius` from the border, then over channels. Images must be at least
 // 2 * radius + 1 pixels in each dimension; a mask with no pixel in that interior is an error.
 Result<double> Ssim(const Image& a, const Image& b, const SsimOptions& options = {}, const Image* mask = nullptr);
+
+// One image plane [h, w] (row-major) filtered by a normalised Gaussian of `sigma` pixels (taps to
+// ceil(3 sigma)), separably, with scipy's 'reflect' boundary. sigma <= 0: the plane unchanged.
+std::vector<double> GaussianFilter(const std::vector<double>& plane, int width, int height, double sigma);
 
 // Fine detail of `render` relative to `truth`: sqrt(E(render) / E(truth)), E the mean squared
 // Laplacian (4-neighbour, of the mean over compared channels) over the masked pixels at least one

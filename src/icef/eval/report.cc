@@ -26,7 +26,8 @@ std::string RunId::Name() const {
 const std::array<Metric, kNumMetrics>& AllMetrics() {
   static const std::array<Metric, kNumMetrics> kAll = {
       Metric::kPsnr,          Metric::kPsnrNeutralFloor, Metric::kSsim,          Metric::kLpips,
-      Metric::kExprGain,      Metric::kExprCorr,         Metric::kRegionPsnr,    Metric::kIdCosine,
+      Metric::kExprGain,      Metric::kExprCorr,         Metric::kExprGainCoarse, Metric::kRegionPsnr,
+      Metric::kIdCosine,
       Metric::kIdDistance,    Metric::kIdDistanceGt,     Metric::kIdShareUnder06, Metric::kIdDistanceReference,
       Metric::kIdExcess};
   return kAll;
@@ -40,6 +41,7 @@ const char* MetricName(Metric m) {
     case Metric::kLpips: return "lpips";
     case Metric::kExprGain: return "expr_gain";
     case Metric::kExprCorr: return "expr_corr";
+    case Metric::kExprGainCoarse: return "expr_gain_coarse";
     case Metric::kRegionPsnr: return "region_psnr";
     case Metric::kIdCosine: return "id_cosine";
     case Metric::kIdDistance: return "id_distance";
@@ -59,6 +61,7 @@ const char* MetricLabel(Metric m) {
     case Metric::kLpips: return "LPIPS (lower = better)";
     case Metric::kExprGain: return "share of the true expression change reproduced (1 = all, 0 = none)";
     case Metric::kExprCorr: return "cosine of the render's change with the true change (higher = better)";
+    case Metric::kExprGainCoarse: return "share of the expression change reproduced, low-passed 2 px at 128 (1 = all)";
     case Metric::kRegionPsnr: return "PSNR in the brow/eye/mouth region, dB (higher = better)";
     case Metric::kIdCosine: return "identity cosine to own neutral render (higher = better)";
     case Metric::kIdDistance: return "identity distance to own neutral render";
@@ -72,7 +75,7 @@ const char* MetricLabel(Metric m) {
 
 bool HigherIsBetter(Metric m) {
   return m == Metric::kPsnr || m == Metric::kSsim || m == Metric::kIdCosine || m == Metric::kIdShareUnder06 ||
-         m == Metric::kExprGain || m == Metric::kExprCorr || m == Metric::kRegionPsnr;
+         m == Metric::kExprGain || m == Metric::kExprCorr || m == Metric::kExprGainCoarse || m == Metric::kRegionPsnr;
 }
 
 std::optional<double> TierValue(const TierMetrics& t, Metric m) {
@@ -83,6 +86,7 @@ std::optional<double> TierValue(const TierMetrics& t, Metric m) {
     case Metric::kLpips: return t.lpips;
     case Metric::kExprGain: return t.expr_gain;
     case Metric::kExprCorr: return t.expr_corr;
+    case Metric::kExprGainCoarse: return t.expr_gain_coarse;
     case Metric::kRegionPsnr: return t.region_psnr;
     case Metric::kIdCosine: return t.id_cosine;
     case Metric::kIdDistance: return t.id_distance;
@@ -720,7 +724,7 @@ std::string ReportMarkdown(const Aggregate& a, const std::vector<RunRecord>& run
     << "`runs` = identities contributing, `delta` = mean expression distance of the tier's frames.\n";
   const std::vector<Metric> image_metrics = {Metric::kPsnr,     Metric::kPsnrNeutralFloor, Metric::kSsim,
                                              Metric::kLpips,    Metric::kExprGain,         Metric::kExprCorr,
-                                             Metric::kRegionPsnr};
+                                             Metric::kExprGainCoarse, Metric::kRegionPsnr};
   const std::vector<Metric> identity_metrics = {Metric::kIdDistanceGt, Metric::kIdDistance, Metric::kIdDistanceReference,
                                                 Metric::kIdExcess,     Metric::kIdCosine,   Metric::kIdShareUnder06};
   for (int k : a.ks) {

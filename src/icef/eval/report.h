@@ -44,12 +44,12 @@ struct RunRecord {
 
 // The metrics a report aggregates, in table order.
 // kIdDistanceReference: the ground truth's own drift (GT vs GT neutral), the floor a perfect model shows.
-// The expression metrics (kExprGain, kExprCorr, kRegionPsnr) and kPsnrNeutralFloor, kIdExcess: eval/evaluate.h.
+// The expression metrics (kExprGain, kExprCorr, kExprGainCoarse, kRegionPsnr) and kPsnrNeutralFloor, kIdExcess: eval/evaluate.h.
 enum class Metric {
-  kPsnr, kPsnrNeutralFloor, kSsim, kLpips, kExprGain, kExprCorr, kRegionPsnr,
+  kPsnr, kPsnrNeutralFloor, kSsim, kLpips, kExprGain, kExprCorr, kExprGainCoarse, kRegionPsnr,
   kIdCosine, kIdDistance, kIdDistanceGt, kIdShareUnder06, kIdDistanceReference, kIdExcess
 };
-constexpr int kNumMetrics = 13;
+constexpr int kNumMetrics = 14;
 const std::array<Metric, kNumMetrics>& AllMetrics();
 const char* MetricName(Metric metric);   // the metrics.json key, e.g. "id_distance"
 const char* MetricLabel(Metric metric);  // axis label, e.g. "identity distance to own neutral (lower = better)"
