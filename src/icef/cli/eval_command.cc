@@ -19,7 +19,7 @@ CommandFn RegisterEval(CLI::App& app) {
       "neutral: "
       "what a face that does not move scores); expression fidelity in the brow/eye/mouth region (expr_gain: "
       "how much of the true change the render's change reproduces, 1 = all, 0 = none; expr_corr; "
-      "region_psnr); "
+      "expr_gain_coarse, the same at the features' scale, which softness costs little; region_psnr); "
       "identity (face-descriptor distance between each render and the model's own neutral render of the same "
       "view, the ground truth's own such distance, their difference id_excess, and the distance to the "
       "ground "
