@@ -47,8 +47,8 @@ CommandFn RegisterTrack(CLI::App& app) {
   auto region = std::make_shared<std::string>("face");
   app.add_option("--silhouette-region", *region,
                  "Which part of the mask's edge the refit uses: face (where it touches the head between the chin and "
-                 "the brows; default: a real head's crown is hair and its neck runs into clothes) or head (the whole "
-                 "outline: heads without hair, such as icef synth --photos)")
+                 "the brows with skin just inside it; default: a real head's crown and often its cheeks are hair, its "
+                 "neck runs into clothes) or head (the whole outline: heads without hair, such as icef synth --photos)")
       ->check(CLI::IsMember({"face", "head"}));
   app.add_option("--threads", options->threads, "Worker threads (0 = all cores)");
   app.add_option("--predictor", options->predictor,

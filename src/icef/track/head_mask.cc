@@ -115,6 +115,77 @@ std::vector<Vec2f> MaskEdgePoints(const Image& mask, const Image& outside, int m
   return out;
 }
 
+namespace {
+
+Vec3d SkinFeature(const Vec3f& rgb) {
+  const Vec3d c = rgb.cast<double>().cwiseMax(0.0) + Vec3d::Constant(1e-3);
+  const double sum = c.sum();
+  return Vec3d(c.x() / sum, c.y() / sum, std::log(sum));
+}
+
+}  // namespace
+
+double SkinModel::Distance(const Vec3f& rgb) const {
+  const Vec3d d = SkinFeature(rgb) - mean;
+  return std::sqrt(std::max(0.0, d.dot(inverse_covariance * d)));
+}
+
+SkinModel FitSkinModel(const Image& image, const std::vector<Vec2f>& lm) {
+  SkinModel skin;
+  if (lm.size() < 68 || image.channels < 3) return skin;
+  const float iod = ((lm[36] + lm[39]) * 0.5f - (lm[42] + lm[45]) * 0.5f).norm();
+  const Vec2f centres[] = {0.5f * (lm[2] + lm[30]), 0.5f * (lm[14] + lm[30]), 0.5f * (lm[4] + lm[48]),
+                           0.5f * (lm[12] + lm[54]), lm[29]};
+  const int r = std::max(1, static_cast<int>(0.12f * iod));
+  std::vector<Vec3d> samples;
+  for (const Vec2f& c : centres) {
+    if (!c.allFinite()) continue;
+    for (int dy = -r; dy <= r; ++dy)
+      for (int dx = -r; dx <= r; ++dx) {
+        const int x = static_cast<int>(c.x()) + dx, y = static_cast<int>(c.y()) + dy;
+        if (dx * dx + dy * dy > r * r || x < 0 || y < 0 || x >= image.width || y >= image.height) continue;
+        samples.push_back(SkinFeature(image.Rgb(x, y)));
+      }
+  }
+  if (samples.size() < 8) return skin;
+  for (const Vec3d& s : samples) skin.mean += s;
+  skin.mean /= static_cast<double>(samples.size());
+  Mat3d cov = Mat3d::Zero();
+  for (const Vec3d& s : samples) cov += (s - skin.mean) * (s - skin.mean).transpose();
+  cov /= static_cast<double>(samples.size() - 1);
+  // A floor under the spread: lighting and shading vary more across a face than across five patches.
+  cov += Vec3d(1e-4, 1e-4, 1e-2).asDiagonal();
+  skin.inverse_covariance = cov.inverse();
+  skin.valid = true;
+  return skin;
+}
+
+std::vector<bool> SkinEdges(const Image& image, const Image& mask, const std::vector<Vec2f>& points,
+                            const SkinModel& skin, double depth, double max_distance) {
+  std::vector<bool> keep(points.size(), true);
+  if (!skin.valid) return keep;
+  const int w = mask.width, h = mask.height;
+  for (size_t i = 0; i < points.size(); ++i) {
+    // The inward normal: the mean offset of the mask's inside pixels around the point.
+    const int px = static_cast<int>(points[i].x()), py = static_cast<int>(points[i].y());
+    Vec2d g = Vec2d::Zero();
+    for (int dy = -3; dy <= 3; ++dy)
+      for (int dx = -3; dx <= 3; ++dx) {
+        const int x = px + dx, y = py + dy;
+        if (x >= 0 && y >= 0 && x < w && y < h && mask.At(x, y, 0) > 0.5f) g += Vec2d(dx, dy);
+      }
+    if (g.norm() == 0) continue;
+    const Vec2d q = points[i].cast<double>() + depth * g.normalized();
+    const int qx = static_cast<int>(q.x()), qy = static_cast<int>(q.y());
+    if (qx < 1 || qy < 1 || qx + 1 >= image.width || qy + 1 >= image.height) continue;
+    Vec3f mean = Vec3f::Zero();
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) mean += image.Rgb(qx + dx, qy + dy);
+    keep[i] = skin.Distance(mean / 9.f) <= max_distance;
+  }
+  return keep;
+}
+
 double MaskIou(const Image& a, const Image& b) {
   int64_t inter = 0, uni = 0;
   for (int y = 0; y < std::min(a.height, b.height); ++y)

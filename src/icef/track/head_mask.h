@@ -39,6 +39,26 @@ Image HeadMask(const Image& image, const Image& silhouette, const Image& outside
 // cover). At most max_points, evenly spaced in scan order. Deterministic.
 std::vector<Vec2f> MaskEdgePoints(const Image& mask, const Image& outside, int max_points);
 
+// The colour of a face's skin: the mean and inverse covariance of (r, g) chromaticity and log
+// brightness of the pixels in disks (radius 0.12 IOD) at the cheeks, beside the mouth and on the
+// nose bridge, placed from its 68 landmarks (pixels). Invalid (nothing sampled) when the disks miss
+// the image.
+struct SkinModel {
+  Vec3d mean = Vec3d::Zero();
+  Mat3d inverse_covariance = Mat3d::Identity();
+  bool valid = false;
+  // Mahalanobis distance of a colour (RGB in [0, 1]) from the skin's.
+  double Distance(const Vec3f& rgb) const;
+};
+SkinModel FitSkinModel(const Image& image, const std::vector<Vec2f>& landmarks);
+
+// Per edge point of `mask` (MaskEdgePoints): whether the mask's inside just behind it (depth pixels
+// along the inward normal, a 3x3 mean) is skin, within max_distance of `skin`. The face's own
+// outline is skin against the background; hair over the cheeks, a hat, a collar are not. An
+// invalid skin model keeps every point.
+std::vector<bool> SkinEdges(const Image& image, const Image& mask, const std::vector<Vec2f>& points,
+                            const SkinModel& skin, double depth, double max_distance = 3.0);
+
 // Intersection over union of two masks (> 0.5).
 double MaskIou(const Image& a, const Image& b);
 

@@ -108,9 +108,21 @@ HeadCrop CropHead(const face::FaceModel& model, const TrackedFrame& tracked, con
   return c;
 }
 
-// The edge points of the photo's mask, in the photo's pixels.
-std::vector<Vec2f> SilhouettePoints(const HeadCrop& c, int resolution, int max_points) {
+// max_points edge points of the photo's mask (evenly spaced along it), in the photo's pixels; with
+// skin_only, those of them where skin lies just inside the edge (SkinEdges: the face's own outline,
+// not hair over the cheeks, a hat or a collar).
+std::vector<Vec2f> SilhouettePoints(const HeadCrop& c, const TrackedPhoto& photo, int resolution, int max_points,
+                                    bool skin_only) {
   std::vector<Vec2f> points = MaskEdgePoints(c.mask, c.outside, max_points);
+  if (skin_only) {
+    const std::vector<Vec2f> lm = CropPoints(photo.detection.landmarks, c.box, resolution);
+    const float iod = ((lm[36] + lm[39]) * 0.5f - (lm[42] + lm[45]) * 0.5f).norm();
+    const std::vector<bool> keep = SkinEdges(c.rgb, c.mask, points, FitSkinModel(c.rgb, lm), 0.08 * iod);
+    std::vector<Vec2f> skin;
+    for (size_t i = 0; i < points.size(); ++i)
+      if (keep[i]) skin.push_back(points[i]);
+    points = std::move(skin);
+  }
   const float scale = static_cast<float>(c.box.size / resolution);
   for (Vec2f& p : points) p = Vec2f(static_cast<float>(c.box.x0), static_cast<float>(c.box.y0)) + scale * p;
   return points;
@@ -209,7 +221,8 @@ Result<TrackResult> TrackPhotos(const std::vector<fs::path>& photos, const Track
     const face::FaceModel first(result.fit.shape);
     for (int i = 0; i < kept; ++i) {
       const HeadCrop c = CropHead(first, result.fit.frames[i], result.photos[i], options, executor);
-      frames[i].silhouette = SilhouettePoints(c, options.resolution, options.silhouette_points);
+      frames[i].silhouette = SilhouettePoints(c, result.photos[i], options.resolution, options.silhouette_points,
+                                              options.fit.silhouette_face_only);
     }
     ICEF_ASSIGN_OR_RETURN(result.fit, FitTrack(frames, options.fit));
     if (log) log(result.fit.BriefReport() + " (with silhouettes)");

@@ -207,6 +207,49 @@ TEST(HeadMaskTest, EdgePointsLieBetweenInsideAndOutsidePixels) {
   EXPECT_TRUE(MaskEdgePoints(full, Image(), 0).empty());
 }
 
+TEST(HeadMaskTest, SkinEdgesKeepTheFaceOutlineNotHair) {
+  // A shaded skin disk (the face, radius 24 about (48, 48)) over a blue-grey background, with brown
+  // "hair" covering its left side out to radius 32; the mask is face and hair.
+  Image image(96, 96, 3), mask(96, 96, 1);
+  for (int y = 0; y < 96; ++y)
+    for (int x = 0; x < 96; ++x) {
+      const float dx = x + 0.5f - 48.f, dy = y + 0.5f - 48.f, r = std::sqrt(dx * dx + dy * dy);
+      Vec3f c(0.45f, 0.5f, 0.6f);
+      if (r < 24.f) c = Vec3f(0.82f, 0.62f, 0.5f) * (1.f - 0.25f * r / 24.f);  // darker towards the outline
+      if (dx < -12.f && r < 32.f && r >= 20.f) c = Vec3f(0.35f, 0.24f, 0.14f);
+      for (int ch = 0; ch < 3; ++ch) image.At(x, y, ch) = c[ch];
+      mask.At(x, y, 0) = (r < 24.f || (dx < -12.f && r < 32.f)) ? 1.f : 0.f;
+    }
+  // Landmarks: the eyes 20 px apart, everything else at the centre.
+  std::vector<Vec2f> lm(68, Vec2f(48.f, 50.f));
+  for (int i : {36, 39}) lm[i] = Vec2f(38.f, 44.f);
+  for (int i : {42, 45}) lm[i] = Vec2f(58.f, 44.f);
+  const SkinModel skin = FitSkinModel(image, lm);
+  ASSERT_TRUE(skin.valid);
+  EXPECT_LT(skin.Distance(Vec3f(0.82f, 0.62f, 0.5f) * 0.9f), 3.0);
+  EXPECT_GT(skin.Distance(Vec3f(0.35f, 0.24f, 0.14f)), 3.0);
+  const std::vector<Vec2f> points = MaskEdgePoints(mask, Image(), 0);
+  const std::vector<bool> keep = SkinEdges(image, mask, points, skin, 0.08 * 20);
+  ASSERT_EQ(keep.size(), points.size());
+  int face = 0, hair = 0;
+  for (size_t i = 0; i < points.size(); ++i) {
+    const float dx = points[i].x() - 48.f;
+    if (dx > 4.f) {  // the face's own outline against the background
+      EXPECT_TRUE(keep[i]) << points[i].transpose();
+      ++face;
+    } else if (dx < -16.f) {  // the hair's outline
+      EXPECT_FALSE(keep[i]) << points[i].transpose();
+      ++hair;
+    }
+  }
+  EXPECT_GT(face, 20);
+  EXPECT_GT(hair, 20);
+  // Landmarks off the image: no skin model, every point kept.
+  const SkinModel none = FitSkinModel(image, std::vector<Vec2f>(68, Vec2f(-500.f, -500.f)));
+  EXPECT_FALSE(none.valid);
+  for (bool k : SkinEdges(image, mask, points, none, 2.0)) EXPECT_TRUE(k);
+}
+
 TEST(PhotoCropTest, CropCarriesTheCameraAndThePoints) {
   Intrinsics k;
   k.width = 640;
