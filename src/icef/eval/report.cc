@@ -273,11 +273,14 @@ std::vector<ReplicateSpreadCell> ReplicateSpread(const std::vector<RunRecord>& r
         if (reps.size() < 2) continue;
         ++cell.identities;
         cell.replicates = std::max(cell.replicates, static_cast<int>(reps.size()));
-        for (auto [metric, ranges] : {std::pair{Metric::kPsnr, &psnr_ranges}, std::pair{Metric::kExprGain, &gain_ranges}}) {
+        for (auto [metric, ranges] :
+             {std::pair{Metric::kPsnr, &psnr_ranges}, std::pair{Metric::kExprGain, &gain_ranges}}) {
           std::vector<double> v;
           for (const RunRecord* r : reps)
             if (const auto x = TierValue(r->metrics.tiers[TierIndex(tier)], metric)) v.push_back(*x);
-          if (v.size() >= 2) ranges->push_back(*std::max_element(v.begin(), v.end()) - *std::min_element(v.begin(), v.end()));
+          if (v.size() < 2) continue;
+          const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
+          ranges->push_back(*hi - *lo);
         }
       }
       if (cell.identities == 0) continue;

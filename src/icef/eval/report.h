@@ -44,7 +44,8 @@ struct RunRecord {
 
 // The metrics a report aggregates, in table order.
 // kIdDistanceReference: the ground truth's own drift (GT vs GT neutral), the floor a perfect model shows.
-// The expression metrics (kExprGain, kExprCorr, kExprGainCoarse, kRegionPsnr) and kPsnrNeutralFloor, kIdExcess: eval/evaluate.h.
+// The expression metrics (kExprGain, kExprCorr, kExprGainCoarse, kRegionPsnr) and kPsnrNeutralFloor,
+// kIdExcess: eval/evaluate.h.
 enum class Metric {
   kPsnr, kPsnrNeutralFloor, kSsim, kLpips, kExprGain, kExprCorr, kExprGainCoarse, kRegionPsnr,
   kIdCosine, kIdDistance, kIdDistanceGt, kIdShareUnder06, kIdDistanceReference, kIdExcess
