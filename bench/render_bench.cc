@@ -25,7 +25,7 @@ namespace {
 struct Subject {
   icef::Dataset dataset;
   std::unique_ptr<icef::Trainer> trainer;
-  // The same model loaded as `icef render --set model.render_transmittance_eps=1e-4` would: renders
+  // The same model loaded as `icef render --set model.render.transmittance_eps=1e-4` would: renders
   // composite rays as deep as training does (the render threshold's before/after).
   std::unique_ptr<icef::AvatarModel> deep;
   std::string error;
@@ -52,8 +52,9 @@ icef::Status Train(Subject* s) {
   config.train.checkpoint_every = 0;
   ICEF_ASSIGN_OR_RETURN(s->trainer, icef::Trainer::Create(s->dataset, dir / "model", config));
   ICEF_RETURN_IF_ERROR(s->trainer->Run(nullptr, nullptr).status());
-  ICEF_ASSIGN_OR_RETURN(icef::TrainedModel deep, icef::LoadTrainedModel(dir / "model", icef::Executor(2),
-                                                                        {"model.render_transmittance_eps=1e-4"}));
+  ICEF_ASSIGN_OR_RETURN(
+      icef::TrainedModel deep,
+      icef::LoadTrainedModel(dir / "model", icef::Executor(2), {"model.render.transmittance_eps=1e-4"}));
   s->deep = std::move(deep.model);
   return icef::Status::Ok();
 }
@@ -76,7 +77,7 @@ const icef::Frame& FarFrame(const Subject& s) {
 }
 
 // Arg: 0 = the grid of the rendered expression (default), 1 = the training grid, 2 = the default
-// grid with rays composited to the training threshold 1e-4 instead of model.render_transmittance_eps.
+// grid with rays composited to the training threshold 1e-4 instead of model.render.transmittance_eps.
 void BM_RenderImage128(benchmark::State& state) {
   const Subject& s = TrainedSubject();
   if (!s.error.empty()) return state.SkipWithError(s.error.c_str());

@@ -49,9 +49,9 @@ variants=(
   "no-distortion|distortion loss off|train.lambda_distortion=0"
   "lambda-id-0.1|L_id weight 0.1 instead of the default|train.lambda_id=0.1"
   "no-jitter|training rays through pixel centres|train.pixel_jitter=false"
-  "no-supersample|renders with one ray per pixel|model.render_supersample=1"
-  "sh-degree-4|view-dependent colour, SH degree 4|model.sh_degree=4"
-  "no-hull|no visual-hull prior|model.visual_hull=false"
+  "no-supersample|renders with one ray per pixel|model.render.supersample=1"
+  "sh-degree-4|view-dependent colour, SH degree 4|model.static_field.sh_degree=4"
+  "no-hull|no visual-hull prior|model.visual_hull.enabled=false"
   "no-random-bg|white background only|train.random_background=false"
 )
 

@@ -6,8 +6,8 @@
 #     --out BASE/<variant> [--set KEY=VALUE]
 import json, os, sys
 base=sys.argv[1] if len(sys.argv) > 1 else 'docs/results/priors_diverse'
-variants=[('default','all defaults'),('no-supersample','`model.render_supersample=1` (one ray per pixel in renders)'),
-          ('no-hull','`model.visual_hull=false`'),('no-distortion','`train.lambda_distortion=0`'),
+variants=[('default','all defaults'),('no-supersample','`model.render.supersample=1` (one ray per pixel in renders)'),
+          ('no-hull','`model.visual_hull.enabled=false`'),('no-distortion','`train.lambda_distortion=0`'),
           ('no-symmetry','`train.lambda_symmetry=0`'),('no-occlusion','`train.lambda_occlusion=0`')]
 def load(v):
     out={}

@@ -10,9 +10,9 @@ fail() { echo "FAIL: $*" >&2; exit 1; }
 
 "$ICEF" synth --out "$WORK/data" --identity-seed 2 --k 3 --res 32 --test-views 1 --novel-per-tier 1 \
   --supersample 1 --threads 2 > /dev/null
-TINY=(--set model.grid_levels=4 --set model.grid_log2_table_size=10 --set model.grid_finest_resolution=32
-      --set model.density_hidden=16 --set "model.color_hidden=[16]" --set "model.deform_hidden=[16,16]"
-      --set model.samples_per_ray=16 --set model.occupancy_resolution=16 --set train.batch_rays=256)
+TINY=(--set model.static_field.grid.num_levels=4 --set model.static_field.grid.log2_table_size=10 --set model.static_field.grid.finest_resolution=32
+      --set model.static_field.density_hidden=16 --set "model.static_field.color_hidden=[16]" --set "model.deformation.hidden=[16,16]"
+      --set model.sampler.num_samples=16 --set model.occupancy.resolution=16 --set train.batch_rays=256)
 "$ICEF" train "$WORK/data" --out "$WORK/model" --steps 10 --threads 2 --quiet "${TINY[@]}" > "$WORK/train.txt" \
   || fail "icef train exited $?"
 # The symmetry prior (on by default) reports how well the synthetic face's landmarks mirror.

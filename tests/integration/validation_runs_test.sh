@@ -12,11 +12,11 @@ fail() { echo "FAIL: $*" >&2; exit 1; }
 
 runs() { "$ROOT/scripts/validation_runs.sh" --icef "$ICEF" --out "$WORK/v" --seeds 101 --res 32 --steps 20 --threads 2 "$@"; }
 runs --variant default --train-seeds "0 1" 2> "$WORK/log" || fail "default runs exited $?: $(cat "$WORK/log")"
-runs --variant no-hull --set model.visual_hull=false --train-seeds 0 2>> "$WORK/log" || fail "variant exited $?"
+runs --variant no-hull --set model.visual_hull.enabled=false --train-seeds 0 2>> "$WORK/log" || fail "variant exited $?"
 for r in default_101_t0 default_101_t1 no-hull_101_t0; do
   test -s "$WORK/v/runs/$r/eval/metrics.json" || fail "no metrics for $r"
 done
-grep -q '"visual_hull": false' "$WORK/v/runs/no-hull_101_t0/config.json" || fail "the variant's --set did not reach its run"
+grep -q '"enabled": false' "$WORK/v/runs/no-hull_101_t0/config.json" || fail "the variant's --set did not reach its run"
 test -s "$WORK/v/data/seed101_32/scene.json" || fail "the dataset is not the diverse scene"
 # A finished run is kept, not trained again.
 before=$(stat -c %Y "$WORK/v/runs/default_101_t0/eval/metrics.json")

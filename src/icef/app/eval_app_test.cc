@@ -49,11 +49,12 @@ TEST(EvalApp, InvalidExpressionScaleNamesTheOption) {
 TEST(EvalApp, RefusedOverrideNamesTheKey) {
   EvalAppOptions o = TinyEval("eval_app_override");
   testing_app::WriteTinyModelDir(o.model);
-  o.overrides = {"model.deform_hidden=[8,8]"};
+  o.overrides = {"model.deformation.hidden=[8,8]"};
   std::ostringstream out, err;
   const Status s = RunEval(o, Executor(1), out, err).status();
   ASSERT_FALSE(s.ok());
-  EXPECT_NE(s.message().find("model.deform_hidden cannot be changed on a trained model"), std::string::npos)
+  EXPECT_NE(s.message().find("model.deformation.hidden cannot be changed on a trained model"),
+            std::string::npos)
       << s.message();
   EXPECT_FALSE(fs::exists(o.out / "metrics.json"));
 }

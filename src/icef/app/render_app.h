@@ -7,7 +7,7 @@
 // number of output frames is the larger of the camera and expression counts (a single camera or
 // expression is repeated). Per frame it writes color, depth, mask and deformation PNGs; sequences
 // also get animated GIFs; frames.json lists delta, kappa and beta_n of every frame. Inference-only
-// model keys (render_supersample, ...) may be overridden with "model.KEY=VALUE".
+// model keys (render.supersample, ...) may be overridden with "model.KEY=VALUE".
 #pragma once
 
 #include <filesystem>

@@ -20,7 +20,7 @@ TEST(RenderApp, InferenceOverrideApplies) {
   o.model = testing_app::WriteTinyModelDir(dir / "model");
   o.out = dir / "out";
   o.threads = 1;
-  o.overrides = {"model.render_supersample=1", "model.bf16_inference=false"};
+  o.overrides = {"model.render.supersample=1", "model.bf16_inference=false"};
   std::ostringstream out;
   const Result<std::vector<RenderedFrameInfo>> frames = RunRender(o, out);
   ASSERT_TRUE(frames.ok()) << frames.status().message();
@@ -37,11 +37,12 @@ TEST(RenderApp, ArchitectureOverrideIsRefused) {
   o.model = testing_app::WriteTinyModelDir(dir / "model");
   o.out = dir / "out";
   o.threads = 1;
-  o.overrides = {"model.grid_log2_table_size=12"};
+  o.overrides = {"model.static_field.grid.log2_table_size=12"};
   std::ostringstream out;
   const Status s = RunRender(o, out).status();
   ASSERT_FALSE(s.ok());
-  EXPECT_NE(s.message().find("model.grid_log2_table_size cannot be changed on a trained model"), std::string::npos)
+  EXPECT_NE(s.message().find("model.static_field.grid.log2_table_size cannot be changed on a trained model"),
+            std::string::npos)
       << s.message();
   EXPECT_FALSE(fs::exists(o.out / "color_000.png"));
 }

@@ -45,8 +45,9 @@ CommandFn RegisterEval(CLI::App& app) {
       "expressions costs");
   app.add_option(
       "--set", o->overrides,
-      "Override an inference-only model key, model.KEY=VALUE with KEY render_supersample, samples_per_ray, "
-      "render_transmittance_eps or bf16_inference (repeatable; keys fixed by training are refused)");
+      "Override an inference-only model key, model.KEY=VALUE with KEY render.supersample, "
+      "sampler.num_samples, "
+      "render.transmittance_eps or bf16_inference (repeatable; keys fixed by training are refused)");
   app.add_option("--threads", *threads, "Worker threads (0 = all cores)")->capture_default_str();
   return [o, threads]() -> Status {
     EvalAppOptions options = *o;

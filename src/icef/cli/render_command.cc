@@ -34,9 +34,11 @@ CommandFn RegisterRender(CLI::App& app) {
   app.add_option("--sweep-frames", o->sweep_frames, "Frames of a sweep")->capture_default_str()->check(CLI::Range(2, 1000));
   app.add_option("--sweep-beyond", o->sweep_beyond, "The sweep ends at this multiple of the target")->capture_default_str();
   app.add_option("--threads", o->threads, "Worker threads (0 = all cores)")->check(CLI::NonNegativeNumber);
-  app.add_option("--set", o->overrides,
-                 "Override an inference-only model key, model.KEY=VALUE with KEY render_supersample, samples_per_ray, "
-                 "render_transmittance_eps or bf16_inference (repeatable; keys fixed by training are refused)");
+  app.add_option(
+      "--set", o->overrides,
+      "Override an inference-only model key, model.KEY=VALUE with KEY render.supersample, "
+      "sampler.num_samples, "
+      "render.transmittance_eps or bf16_inference (repeatable; keys fixed by training are refused)");
   return [=]() -> Status {
     RenderAppOptions opts = *o;
     if (!frame->empty()) opts.frame = *frame;

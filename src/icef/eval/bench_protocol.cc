@@ -30,12 +30,19 @@ void BenchOptions::ApplyQuick() {
   steps = 20;
   time_budget_seconds = 0;
   // A tiny model (the user's --set overrides still come after these).
-  const std::vector<std::string> tiny = {
-      "model.grid_levels=6",         "model.grid_log2_table_size=12", "model.grid_finest_resolution=64",
-      "model.density_hidden=32",     "model.color_hidden=[32]",       "model.deform_hidden=[32, 32]",
-      "model.samples_per_ray=24",    "model.occupancy_resolution=32", "train.batch_rays=512", 
-      "train.anneal_steps=10",       "train.occupancy_warmup=16",     "train.occupancy_every=8",
-      "train.log_every=10"};
+  const std::vector<std::string> tiny = {"model.static_field.grid.num_levels=6",
+                                         "model.static_field.grid.log2_table_size=12",
+                                         "model.static_field.grid.finest_resolution=64",
+                                         "model.static_field.density_hidden=32",
+                                         "model.static_field.color_hidden=[32]",
+                                         "model.deformation.hidden=[32, 32]",
+                                         "model.sampler.num_samples=24",
+                                         "model.occupancy.resolution=32",
+                                         "train.batch_rays=512",
+                                         "train.anneal_steps=10",
+                                         "train.occupancy_warmup=16",
+                                         "train.occupancy_every=8",
+                                         "train.log_every=10"};
   overrides.insert(overrides.begin(), tiny.begin(), tiny.end());
 }
 

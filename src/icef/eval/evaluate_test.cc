@@ -216,14 +216,14 @@ Dataset TinySyntheticDataset(const fs::path& dir, const Executor& executor) {
 std::unique_ptr<Trainer> TinyTrainer(const Dataset& dataset, const fs::path& dir, int steps) {
   RunConfig config;
   config.model.method = "icef";
-  config.model.grid_levels = 4;
-  config.model.grid_log2_table_size = 10;
-  config.model.grid_finest_resolution = 32;
-  config.model.density_hidden = 16;
-  config.model.color_hidden = {16};
-  config.model.deform_hidden = {16, 16};
-  config.model.samples_per_ray = 16;
-  config.model.occupancy_resolution = 16;
+  config.model.static_field.grid.num_levels = 4;
+  config.model.static_field.grid.log2_table_size = 10;
+  config.model.static_field.grid.finest_resolution = 32;
+  config.model.static_field.density_hidden = 16;
+  config.model.static_field.color_hidden = {16};
+  config.model.deformation.hidden = {16, 16};
+  config.model.sampler.num_samples = 16;
+  config.model.occupancy.resolution = 16;
   config.train.steps = std::max(steps, 1);  // 0: created, not trained
   config.train.batch_rays = 256;
   config.train.checkpoint_every = 0;

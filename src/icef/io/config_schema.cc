@@ -82,16 +82,72 @@ void ConfigSchema::IntArray(const std::string& key, std::vector<int>* value, con
        [=]() { return Json(*value); }});
 }
 
-Status ConfigSchema::Read(const JsonObjectView& object) const {
-  const std::vector<std::string> keys = Keys();
-  const std::vector<std::string> unknown = object.UnknownKeys(keys);
+void ConfigSchema::Block(const std::string& key, const std::function<void(ConfigSchema&)>& bind) {
+  auto block = std::make_shared<ConfigSchema>();
+  bind(*block);
+  Add({key, "",
+       [=](const JsonObjectView& o) -> Status {
+         ICEF_ASSIGN_OR_RETURN(const JsonObjectView inner, o.Object(key));
+         return block->Read(inner);
+       },
+       [=]() { return block->Write(); }, block});
+}
+
+void ConfigSchema::Renamed(const std::string& old_key, const std::string& current) {
+  renamed_.emplace_back(old_key, current);
+}
+
+namespace {
+std::vector<std::string> SplitPath(const std::string& dotted) {
+  std::vector<std::string> parts;
+  size_t start = 0;
+  for (size_t dot; (dot = dotted.find('.', start)) != std::string::npos; start = dot + 1)
+    parts.push_back(dotted.substr(start, dot - start));
+  parts.push_back(dotted.substr(start));
+  return parts;
+}
+}  // namespace
+
+Result<Json> ConfigSchema::Upgrade(const JsonObjectView& object) const {
+  Json out = object.json();
+  for (const auto& [old_key, current] : renamed_) {
+    if (!out.contains(old_key) || out[old_key].is_object()) continue;  // a block of that name is current
+    Json value = std::move(out[old_key]);
+    out.erase(old_key);  // first: a block may take the old key's name ("visual_hull")
+    Json* at = &out;
+    for (const std::string& part : SplitPath(current)) {
+      if (!at->is_object() && !at->is_null())
+        return object.Error(old_key, "renamed to " + current + ", which is not an object here");
+      at = &(*at)[part];
+    }
+    if (!at->is_null()) return object.Error(old_key, "given twice: under this old name and as " + current);
+    *at = std::move(value);
+  }
+  return out;
+}
+
+Status ConfigSchema::Read(const JsonObjectView& object, OldKeys old_keys) const {
+  for (const auto& [old_key, current] : renamed_) {
+    if (old_keys == OldKeys::kReject && object.Has(old_key) && !object.json()[old_key].is_object())
+      return object.Error(old_key, "renamed to " + (object.path().empty() ? "" : object.path() + ".") +
+                                       current + " (docs/config.md lists every key)");
+  }
+  Json upgraded;
+  JsonObjectView view = object;
+  if (!renamed_.empty()) {
+    ICEF_ASSIGN_OR_RETURN(upgraded, Upgrade(object));
+    ICEF_ASSIGN_OR_RETURN(view, JsonObjectView::Make(upgraded, object.file(), object.path()));
+  }
+  std::vector<std::string> top;
+  for (const auto& e : entries_) top.push_back(e.key);
+  const std::vector<std::string> unknown = view.UnknownKeys(top);
   if (!unknown.empty()) {
     std::string valid;
-    for (const auto& k : keys) valid += (valid.empty() ? "" : ", ") + k;
-    return object.Error(unknown.front(), "unknown key (valid keys: " + valid + ")");
+    for (const auto& k : top) valid += (valid.empty() ? "" : ", ") + k;
+    return view.Error(unknown.front(), "unknown key (valid keys: " + valid + ")");
   }
   for (const auto& e : entries_) {
-    if (object.Has(e.key)) ICEF_RETURN_IF_ERROR(e.read(object));
+    if (view.Has(e.key)) ICEF_RETURN_IF_ERROR(e.read(view));
   }
   return Status::Ok();
 }
@@ -104,13 +160,31 @@ Json ConfigSchema::Write() const {
 
 std::vector<std::string> ConfigSchema::Keys() const {
   std::vector<std::string> keys;
-  for (const auto& e : entries_) keys.push_back(e.key);
+  for (const auto& e : entries_) {
+    if (!e.block) {
+      keys.push_back(e.key);
+      continue;
+    }
+    for (const std::string& inner : e.block->Keys()) keys.push_back(e.key + "." + inner);
+  }
   return keys;
 }
 
 std::string ConfigSchema::MarkdownRows() const {
   std::string out;
-  for (const auto& e : entries_) out += "| `" + e.key + "` | `" + e.write().dump() + "` | " + e.meaning + " |\n";
+  for (const auto& e : entries_) {
+    if (!e.block) {
+      out += "| `" + e.key + "` | `" + e.write().dump() + "` | " + e.meaning + " |\n";
+      continue;
+    }
+    // A block's rows, each key prefixed with the block's name.
+    const std::string rows = e.block->MarkdownRows();
+    for (size_t start = 0; start < rows.size();) {
+      const size_t end = rows.find('\n', start);
+      out += "| `" + e.key + "." + rows.substr(start + 3, end - start - 3) + "\n";
+      start = end + 1;
+    }
+  }
   return out;
 }
 

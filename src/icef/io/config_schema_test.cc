@@ -74,5 +74,71 @@ TEST(ConfigSchemaTest, WriteRoundTripsAndDocuments) {
   EXPECT_NE(s.MarkdownRows().find("| `lr` | `0.5` | learning rate |"), std::string::npos);
 }
 
+struct Inner {
+  int width = 4;
+  double rate = 0.25;
+};
+struct Outer {
+  int steps = 1;
+  Inner inner;
+  void Bind(ConfigSchema& s) {
+    s.Int("steps", &steps, "steps");
+    s.Block("inner", [this](ConfigSchema& b) {
+      b.Int("width", &inner.width, "inner width");
+      b.Number("rate", &inner.rate, "inner rate");
+    });
+    s.Renamed("inner_width", "inner.width");
+  }
+};
+
+Result<Outer> ParseOuter(const std::string& text,
+                         ConfigSchema::OldKeys old_keys = ConfigSchema::OldKeys::kReject) {
+  ICEF_ASSIGN_OR_RETURN(Json j, ParseJson(text, "cfg.json"));
+  ICEF_ASSIGN_OR_RETURN(JsonObjectView v, JsonObjectView::Make(j, "cfg.json", ""));
+  Outer o;
+  ICEF_RETURN_IF_ERROR(ReadConfig(v, &o, old_keys));
+  return o;
+}
+
+TEST(ConfigSchemaTest, BlocksReadWriteAndDocumentTheirKeysAsPaths) {
+  auto o = ParseOuter(R"({"inner": {"width": 9}})");
+  ASSERT_TRUE(o.ok()) << o.status().message();
+  EXPECT_EQ(o->inner.width, 9);
+  EXPECT_EQ(o->inner.rate, 0.25);  // absent inside the block: kept
+  const Json j = WriteConfig(*o);
+  EXPECT_EQ(j["inner"]["width"], 9);
+  EXPECT_EQ(j["inner"]["rate"], 0.25);
+  ConfigSchema s;
+  Outer d;
+  d.Bind(s);
+  EXPECT_EQ(s.Keys(), (std::vector<std::string>{"steps", "inner.width", "inner.rate"}));
+  EXPECT_NE(s.MarkdownRows().find("| `inner.width` | `4` | inner width |\n"), std::string::npos)
+      << s.MarkdownRows();
+  // Errors inside a block name the block's path.
+  auto bad = ParseOuter(R"({"inner": {"widht": 9}})");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.status().message().find("cfg.json: inner.widht: unknown key (valid keys: width, rate)"),
+            std::string::npos)
+      << bad.status().message();
+  EXPECT_FALSE(ParseOuter(R"({"inner": 3})").ok());
+  EXPECT_FALSE(ParseOuter(R"({"inner": {"width": "x"}})").ok());
+}
+
+TEST(ConfigSchemaTest, RenamedKeysAreReadOnlyWhenAskedAndNeverTwice) {
+  auto rejected = ParseOuter(R"({"inner_width": 7})");
+  ASSERT_FALSE(rejected.ok());
+  EXPECT_NE(rejected.status().message().find("inner_width: renamed to inner.width"), std::string::npos)
+      << rejected.status().message();
+  auto read = ParseOuter(R"({"inner_width": 7, "inner": {"rate": 0.5}})", ConfigSchema::OldKeys::kRead);
+  ASSERT_TRUE(read.ok()) << read.status().message();
+  EXPECT_EQ(read->inner.width, 7);
+  EXPECT_EQ(read->inner.rate, 0.5);
+  auto twice = ParseOuter(R"({"inner_width": 7, "inner": {"width": 8}})", ConfigSchema::OldKeys::kRead);
+  ASSERT_FALSE(twice.ok());
+  EXPECT_NE(twice.status().message().find("given twice"), std::string::npos) << twice.status().message();
+  // Old names are not written.
+  EXPECT_FALSE(WriteConfig(*read).contains("inner_width"));
+}
+
 }  // namespace
 }  // namespace icef

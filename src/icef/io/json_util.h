@@ -41,6 +41,7 @@ class JsonObjectView {
 
   const std::string& file() const { return file_; }
   const std::string& path() const { return path_; }
+  const Json& json() const { return *value_; }
   // Present under this key (whatever its type, null included).
   bool Has(std::string_view key) const;
   // Keys present here that are not in `known`, in document order.

@@ -37,14 +37,14 @@ void DropCavityGradients(int64_t n, const uint8_t* inside, float* d_sigma, float
 }  // namespace
 
 AvatarModel::AvatarModel(const ModelConfig& config, const ModelSetup& setup, RegionMask mask,
-                     ExpressionConfidence confidence)
+                         ExpressionConfidence confidence)
     : config_(config),
       setup_(setup),
       method_(config.ParsedMethod()),
       traits_(TraitsOf(method_)),
       mask_(std::move(mask)),
       confidence_(std::move(confidence)),
-      occupancy_(setup.aabb, config.OccupancyOptions()),
+      occupancy_(setup.aabb, config.occupancy),
       train_ws_(std::make_unique<ModelWorkspace>()),
       render_ws_(std::make_unique<ModelWorkspace>()),
       losses_(MakeLosses()) {}
@@ -57,9 +57,10 @@ Result<std::unique_ptr<AvatarModel>> AvatarModel::Create(const ModelConfig& conf
   ICEF_RETURN_IF_ERROR(config.Validate().WithContext("model config"));
   if (!setup.aabb.IsValid()) return Status::Error("model setup: invalid aabb " + setup.aabb.ToString());
   if (setup.expression_dim < 1) return Status::Error("model setup: expression_dim must be >= 1");
-  ICEF_ASSIGN_OR_RETURN(RegionMask mask, RegionMask::FromLandmarks(setup.mask_landmarks, config.MaskOptions(), executor));
+  ICEF_ASSIGN_OR_RETURN(RegionMask mask,
+                        RegionMask::FromLandmarks(setup.mask_landmarks, config.region_mask, executor));
   ICEF_ASSIGN_OR_RETURN(ExpressionConfidence confidence,
-                        ExpressionConfidence::Create(setup.training_expressions, config.ConfidenceOpts()));
+                        ExpressionConfidence::Create(setup.training_expressions, config.confidence));
   if (confidence.expression_dim() != setup.expression_dim)
     return Status::Error("model setup: training expressions do not have expression_dim values");
   std::unique_ptr<AvatarModel> model(new AvatarModel(config, setup, std::move(mask), std::move(confidence)));
@@ -188,7 +189,7 @@ LossTerms AvatarModel::TrainForwardBackward(const TrainRays& batch, const LossWe
   CompositeInputs<float> in{ws.sigma, ws.rgb, ws.samples.t, ws.samples.dt, ws.samples.ray_offset,
                             ws.samples.ray_count,
                             batch.background.empty() ? std::span<const float>(bg, 3) : std::span<const float>(batch.background)};
-  CompositeForward(in, config_.CompositeOpts(), executor, &ws.composite);
+  CompositeForward(in, config_.compositing, executor, &ws.composite);
 
   // The loss terms stage by stage along the backward pass: rays, back through compositing to the
   // samples, through the static field to the canonical positions, through the warp.
@@ -316,7 +317,7 @@ void AvatarModel::Render(std::span<const Ray> rays, std::span<const float> beta,
         }
       });
       march.Composite(ws.samples, ws.sigma.data(), ws.rgb.data(), ws.extras.data(),
-                      static_cast<float>(config_.render_transmittance_eps), executor);
+                      static_cast<float>(config_.render.transmittance_eps), executor);
       out->samples_evaluated += n;
     }
     for (int64_t r = 0; r < nr; ++r) {

@@ -21,7 +21,7 @@ using testing_model::TinySetup;
 // bf16 = false: inference in FP32 (finite-difference checks need more than BF16's 8 bits).
 std::unique_ptr<AvatarModel> MakeModel(const std::string& method, float deform_scale = 0.5f, bool bf16 = true) {
   ModelConfig config = TinyModelConfig(method);
-  config.deform_init_scale = deform_scale;  // a clearly non-zero warp from the start
+  config.deformation.output_init_scale = deform_scale;  // a clearly non-zero warp from the start
   config.bf16_inference = bf16;
   auto model = AvatarModel::Create(config, TinySetup(), Executor(2));
   ICEF_CHECK(model.ok(), model.status().message());
@@ -188,8 +188,8 @@ TEST(IdentityLossTest, GradientsMatchFiniteDifferences) {
 // component (nn/, render/, identity_losses).
 TEST(RenderImageTest, SupersamplingAveragesSubpixelRays) {
   ModelConfig config = TinyModelConfig("icef");
-  config.render_supersample = 2;
-  config.density_bias = 2.f;  // visible structure, so the sub-pixel rays differ
+  config.render.supersample = 2;
+  config.static_field.density_bias = 2.f;  // visible structure, so the sub-pixel rays differ
   auto created = AvatarModel::Create(config, TinySetup(), Executor(2));
   ASSERT_TRUE(created.ok()) << created.status().message();
   AvatarModel& model = **created;
@@ -224,8 +224,8 @@ TEST(RenderImageTest, SupersamplingAveragesSubpixelRays) {
 // Large images render in bands of rows; every pixel must match a render of its own rays.
 TEST(RenderImageTest, BandedRenderMatchesPerPixelRays) {
   ModelConfig config = TinyModelConfig("icef");
-  config.render_supersample = 1;
-  config.density_bias = 2.f;
+  config.render.supersample = 1;
+  config.static_field.density_bias = 2.f;
   auto created = AvatarModel::Create(config, TinySetup(), Executor(2));
   ASSERT_TRUE(created.ok()) << created.status().message();
   AvatarModel& model = **created;
@@ -256,9 +256,9 @@ TEST(AvatarModelTest, RenderEqualsCompositingEverySampleWhileSkippingOccludedOne
   for (const char* method : {"icef", "nerface"}) {
     SCOPED_TRACE(method);
     ModelConfig config = TinyModelConfig(method);
-    config.density_bias = 4.5f;  // opaque within a few samples along most rays
-    config.deform_init_scale = 0.5f;
-    config.render_transmittance_eps = 3e-3;  // renders stop at their own threshold, not training's
+    config.static_field.density_bias = 4.5f;  // opaque within a few samples along most rays
+    config.deformation.output_init_scale = 0.5f;
+    config.render.transmittance_eps = 3e-3;  // renders stop at their own threshold, not training's
     auto created = AvatarModel::Create(config, TinySetup(), Executor(2));
     ASSERT_TRUE(created.ok()) << created.status().message();
     AvatarModel& model = **created;
@@ -295,7 +295,7 @@ TEST(AvatarModelTest, RenderEqualsCompositingEverySampleWhileSkippingOccludedOne
                               std::span<const float>(bg, 3)};
     CompositeOutputs<float> ref;
     CompositeOptions render_eps;
-    render_eps.transmittance_eps = config.render_transmittance_eps;
+    render_eps.transmittance_eps = config.render.transmittance_eps;
     CompositeForward(in, render_eps, ex, &ref);
     int64_t used = 0;
     for (int64_t r = 0; r < samples.num_rays(); ++r) {
@@ -321,8 +321,8 @@ TEST(AvatarModelTest, Bf16InferenceRendersCloseToFp32) {
   RenderOutput out[2];
   for (int b = 0; b < 2; ++b) {
     ModelConfig config = TinyModelConfig("icef");
-    config.density_bias = 2.f;
-    config.deform_init_scale = 0.5f;
+    config.static_field.density_bias = 2.f;
+    config.deformation.output_init_scale = 0.5f;
     config.bf16_inference = b == 1;
     auto created = AvatarModel::Create(config, TinySetup(), Executor(2));
     ASSERT_TRUE(created.ok()) << created.status().message();
@@ -384,7 +384,7 @@ namespace {
 // silhouette" above the chin line y = 0).
 TEST(AvatarModelTest, RenderOccupancyFollowsTheWarpBeyondTheTrainingHull) {
   ModelConfig config = TinyModelConfig("warp");
-  config.density_bias = 3.f;  // dense everywhere: opacity ~1 over any 0.25 of path
+  config.static_field.density_bias = 3.f;  // dense everywhere: opacity ~1 over any 0.25 of path
   ModelSetup setup = TinySetup();
   for (auto& e : setup.training_expressions) std::fill(e.begin(), e.end(), 0.f);
   auto created = AvatarModel::Create(config, setup, Executor(2));
@@ -398,8 +398,9 @@ TEST(AvatarModelTest, RenderOccupancyFollowsTheWarpBeyondTheTrainingHull) {
   ASSERT_GE(block, 0);
   float* w = store.params() + store.block(block).offset;
   std::fill(w, w + store.block(block).size, 0.f);
-  const int input = 3 * (1 + 2 * config.deform_frequencies) + setup.expression_dim;  // [freq(x), beta]
-  const int h0 = config.deform_hidden[0], h1 = config.deform_hidden[1];
+  const int input =
+      3 * (1 + 2 * config.deformation.num_frequencies) + setup.expression_dim;  // [freq(x), beta]
+  const int h0 = config.deformation.hidden[0], h1 = config.deformation.hidden[1];
   w[(input - setup.expression_dim) * h0 + 0] = 1.f;  // beta_0 -> hidden unit 0
   w[input * h0 + 0 * h1 + 0] = 1.f;                  // unit 0 -> unit 0
   w[input * h0 + h0 * h1 + 0 * 3 + 1] = 0.4f;        // unit 0 -> y offset

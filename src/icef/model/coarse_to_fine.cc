@@ -6,12 +6,12 @@
 namespace icef {
 
 double DeformationAnnealing(const ModelConfig& model, int anneal_steps, int64_t step) {
-  const double n = model.deform_frequencies;
+  const double n = model.deformation.num_frequencies;
   return anneal_steps > 0 ? std::min(n, n * double(step) / anneal_steps) : n;
 }
 
 std::vector<float> GridLevelWeights(const ModelConfig& model, int grid_anneal_steps, int64_t step) {
-  const int levels = model.grid_levels, anneal = grid_anneal_steps;
+  const int levels = model.static_field.grid.num_levels, anneal = grid_anneal_steps;
   std::vector<float> w(levels, 1.f);
   if (anneal <= 0 || step >= anneal) return w;
   constexpr double kFirst = 4;  // levels on from the start

@@ -17,7 +17,7 @@ inline constexpr int kDefaultAnnealSteps = 500;
 inline constexpr int kDefaultGridAnnealSteps = 0;
 
 // The deformation encoding's coarse-to-fine parameter alpha after `step` steps (all
-// model.deform_frequencies on once step >= anneal_steps, or when anneal_steps is 0).
+// model.deformation.num_frequencies on once step >= anneal_steps, or when anneal_steps is 0).
 double DeformationAnnealing(const ModelConfig& model, int anneal_steps, int64_t step);
 
 // Per-level weights of the static field's hash grid after `step` steps (all ones once step >=

@@ -24,12 +24,12 @@ const std::vector<std::string> kTerms = {"photo", "mask", "distortion", "occlusi
 // parameter), as the finite-difference checks need (see symmetry_loss_test.cc).
 std::unique_ptr<AvatarModel> MakeModel(const std::string& method, bool coarse = false) {
   ModelConfig config = TinyModelConfig(method);
-  config.deform_init_scale = 0.05f;
+  config.deformation.output_init_scale = 0.05f;
   config.bf16_inference = false;
   if (coarse) {
-    config.grid_levels = 2;
-    config.grid_finest_resolution = 6;
-    config.density_bias = 1.f;
+    config.static_field.grid.num_levels = 2;
+    config.static_field.grid.finest_resolution = 6;
+    config.static_field.density_bias = 1.f;
   }
   auto model = AvatarModel::Create(config, TinySetup(), Executor(1));
   ICEF_CHECK(model.ok(), model.status().message());

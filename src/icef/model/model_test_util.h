@@ -39,17 +39,17 @@ inline std::vector<Vec3f> FaceLandmarks() {
 inline ModelConfig TinyModelConfig(const std::string& method) {
   ModelConfig c;
   c.method = method;
-  c.grid_levels = 4;
-  c.grid_log2_table_size = 10;
-  c.grid_base_resolution = 4;
-  c.grid_finest_resolution = 32;
-  c.density_hidden = 16;
-  c.geo_features = 8;
-  c.color_hidden = {16};
-  c.deform_hidden = {16, 16};
-  c.deform_frequencies = 3;
-  c.samples_per_ray = 16;
-  c.occupancy_resolution = 16;
+  c.static_field.grid.num_levels = 4;
+  c.static_field.grid.log2_table_size = 10;
+  c.static_field.grid.base_resolution = 4;
+  c.static_field.grid.finest_resolution = 32;
+  c.static_field.density_hidden = 16;
+  c.static_field.geo_features = 8;
+  c.static_field.color_hidden = {16};
+  c.deformation.hidden = {16, 16};
+  c.deformation.num_frequencies = 3;
+  c.sampler.num_samples = 16;
+  c.occupancy.resolution = 16;
   return c;
 }
 

@@ -47,7 +47,7 @@ class TestPrior final : public DeformationPrior {
 
 std::unique_ptr<AvatarModel> MakePriorModel(const std::string& method, float deform_scale) {
   ModelConfig config = TinyModelConfig(method);
-  config.deform_init_scale = deform_scale;
+  config.deformation.output_init_scale = deform_scale;
   const ModelSetup setup = TinySetup();
   auto model = AvatarModel::Create(config, setup, Executor(2), std::make_unique<TestPrior>(setup.expression_dim));
   ICEF_CHECK(model.ok(), model.status().message());
@@ -119,7 +119,7 @@ TEST(PriorGuidedTest, ConfidenceBlendsOnlyTheResidual) {
   auto with_prior = MakePriorModel("icef-prior", 0.3f);
   // The same residual without the prior: icef with the same seed and config.
   ModelConfig config = TinyModelConfig("icef");
-  config.deform_init_scale = 0.3f;
+  config.deformation.output_init_scale = 0.3f;
   auto plain = std::move(AvatarModel::Create(config, TinySetup(), Executor(2))).value();
   plain->Initialize(7);
   const int n = 48;

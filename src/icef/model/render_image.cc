@@ -11,7 +11,7 @@ RenderedImage RenderImage(const AvatarModel& model, const Camera& camera, std::s
   std::optional<OccupancyGrid> occupancy;
   if (occupancy_mode == RenderOccupancyMode::kExpression) occupancy = model.RenderOccupancy(beta, executor);
   const int w = camera.width(), h = camera.height();
-  const int s = model.config().render_supersample, s2 = s * s;
+  const int s = model.config().render.supersample, s2 = s * s;
   RenderedImage img;
   img.color = Image(w, h, 3);
   img.depth = Image(w, h, 1);

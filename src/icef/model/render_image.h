@@ -1,5 +1,5 @@
 // Renders whole images from an AvatarModel at one expression: s x s rays per pixel on a regular
-// sub-pixel grid (s = the model config's render_supersample; 1 = the pixel centre), averaged.
+// sub-pixel grid (s = the model config's render.supersample; 1 = the pixel centre), averaged.
 #pragma once
 
 #include <span>

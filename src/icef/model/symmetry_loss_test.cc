@@ -97,10 +97,11 @@ TEST(SymmetryLossTest, ModelGradientMatchesFiniteDifferences) {
   for (const char* method : {"icef", "nerface"}) {
     ModelConfig config = testing_model::TinyModelConfig(method);
     const bool applies = std::string(method) != "nerface";  // no canonical space: the prior is off
-    config.deform_init_scale = 0.05f;
-    config.grid_levels = 2;  // coarse cells: few samples cross a cell face under a parameter step
-    config.grid_finest_resolution = 6;
-    config.density_bias = 1.f;  // visible opacities in the tiny box
+    config.deformation.output_init_scale = 0.05f;
+    config.static_field.grid.num_levels =
+        2;  // coarse cells: few samples cross a cell face under a parameter step
+    config.static_field.grid.finest_resolution = 6;
+    config.static_field.density_bias = 1.f;  // visible opacities in the tiny box
     auto created = AvatarModel::Create(config, testing_model::TinySetup(), Executor(1));
     ASSERT_TRUE(created.ok()) << created.status().message();
     AvatarModel& model = **created;

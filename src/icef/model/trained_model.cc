@@ -36,36 +36,34 @@ Result<int64_t> ParseCheckpointStep(const std::string& trainer_text, const std::
 }
 
 const std::vector<std::string>& InferenceModelKeys() {
-  static const std::vector<std::string> keys = {"render_supersample", "samples_per_ray",
-                                                "render_transmittance_eps", "bf16_inference"};
+  static const std::vector<std::string> keys = {"render.supersample", "sampler.num_samples",
+                                                "render.transmittance_eps", "bf16_inference"};
   return keys;
 }
 
 Status ApplyInferenceOverride(const std::string& assignment, ModelConfig* config) {
   ICEF_ASSIGN_OR_RETURN(const ConfigOverride o, ParseConfigOverride(assignment));
+  const std::string origin = "--set " + assignment;
+  const Json patch = o.SectionPatch();
+  ICEF_ASSIGN_OR_RETURN(const JsonObjectView view, JsonObjectView::Make(patch, origin, "model"));
+  ModelConfig updated = *config;
   const std::vector<std::string>& allowed = InferenceModelKeys();
   if (o.section != "model" || std::find(allowed.begin(), allowed.end(), o.key) == allowed.end()) {
     std::string why = "not a model key";
     if (o.section == "model") {
-      ModelConfig probe;
       ConfigSchema schema;
-      probe.Bind(schema);
+      updated.Bind(schema);
       const std::vector<std::string> keys = schema.Keys();
-      if (std::find(keys.begin(), keys.end(), o.key) != keys.end())
-        why = "fixed when the model was trained";
-      else
-        why = "no such model key";
+      const Status read = schema.Read(view);  // an old spelling names the current key
+      why = std::find(keys.begin(), keys.end(), o.key) != keys.end() ? "fixed when the model was trained"
+            : read.ok()                                              ? "no such model key"
+                                                                     : read.message();
     }
     std::string can;
     for (const std::string& k : allowed) can += (can.empty() ? "model." : ", model.") + k;
-    return Status::Error("--set " + assignment + ": " + o.section + "." + o.key +
-                         " cannot be changed on a trained model (" + why + "); only " + can + " can");
+    return Status::Error(origin + ": " + o.section + "." + o.key + " cannot be changed on a trained model (" +
+                         why + "); only " + can + " can");
   }
-  Json patch;
-  patch[o.key] = o.value;
-  const std::string origin = "--set " + assignment;
-  ICEF_ASSIGN_OR_RETURN(const JsonObjectView view, JsonObjectView::Make(patch, origin, "model"));
-  ModelConfig updated = *config;
   ICEF_RETURN_IF_ERROR(ReadConfig(view, &updated));
   ICEF_RETURN_IF_ERROR(updated.Validate().WithContext(origin));
   *config = updated;
@@ -110,7 +108,7 @@ Result<TrainedModel> LoadTrainedModel(const Checkpoint& ckpt, const std::string&
   ICEF_ASSIGN_OR_RETURN(const JsonObjectView root, JsonObjectView::Make(config_json, config_origin, ""));
   if (root.Has("model")) {
     ICEF_ASSIGN_OR_RETURN(const JsonObjectView m, root.Object("model"));
-    ICEF_RETURN_IF_ERROR(ReadConfig(m, &out.config));
+    ICEF_RETURN_IF_ERROR(ReadConfig(m, &out.config, ConfigSchema::OldKeys::kRead));
   }
   ICEF_RETURN_IF_ERROR(out.config.Validate().WithContext("model").WithContext(config_origin));
   ICEF_ASSIGN_OR_RETURN(const Schedule schedule, ReadSchedule(root));

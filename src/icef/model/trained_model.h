@@ -5,7 +5,7 @@
 // read; train/model_io.h's LoadModel builds on this and adds them for training and --resume.
 //
 // Inference-only model keys (InferenceModelKeys()) may be overridden before the model is built
-// (`--set model.render_supersample=4`); keys that fix the architecture or the trained parameters
+// (`--set model.render.supersample=4`); keys that fix the architecture or the trained parameters
 // may not.
 #pragma once
 
@@ -47,7 +47,7 @@ Result<int64_t> ParseCheckpointStep(const std::string& trainer_text, const std::
                                     const std::string& origin);
 
 // The model keys that change how a trained model is rendered but not its architecture or
-// parameters: render_supersample, samples_per_ray, render_transmittance_eps, bf16_inference.
+// parameters: render.supersample, sampler.num_samples, render.transmittance_eps, bf16_inference.
 const std::vector<std::string>& InferenceModelKeys();
 
 // Applies one "model.KEY=VALUE" override of an inference-only key (VALUE as for `icef train

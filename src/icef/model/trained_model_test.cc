@@ -31,10 +31,12 @@ std::string Params(const AvatarModel& model) {
   return os.str();
 }
 
-// Writes dir/checkpoint.icef of `model` after `step` steps with the given coarse-to-fine schedule.
-fs::path WriteCheckpoint(const fs::path& dir, const AvatarModel& model, int64_t step, int anneal_steps) {
+// Writes dir/checkpoint.icef of `model` after `step` steps with the given coarse-to-fine schedule;
+// its config's model block is `model_json` when given (default: the model's config as written now).
+fs::path WriteCheckpoint(const fs::path& dir, const AvatarModel& model, int64_t step, int anneal_steps,
+                         const Json& model_json = Json()) {
   Json config;
-  config["model"] = WriteConfig(model.config());
+  config["model"] = model_json.is_null() ? WriteConfig(model.config()) : model_json;
   config["train"] = {{"steps", 10}, {"anneal_steps", anneal_steps}, {"grid_anneal_steps", 0}};
   const std::string config_text = config.dump();
   CheckpointWriter w;
@@ -69,6 +71,22 @@ void ExpectErrorNaming(const Status& s, const fs::path& path, const std::string&
   ASSERT_FALSE(s.ok()) << "expected an error about " << what;
   EXPECT_NE(s.message().find(path.string()), std::string::npos) << s.message();
   EXPECT_NE(s.message().find(what), std::string::npos) << s.message();
+}
+
+// Checkpoints written before the model config had one block per component store flat keys; they
+// still load, into the same config and parameters.
+TEST(TrainedModel, LoadsCheckpointsWithTheFlatKeysOfEarlierVersions) {
+  const ModelConfig config = testing_model::TinyModelConfig("icef");
+  const auto model = TinyModel(config);
+  const Json flat = Json::parse(R"({"method": "icef", "grid_levels": 4, "grid_log2_table_size": 10,
+      "grid_base_resolution": 4.0, "grid_finest_resolution": 32.0, "density_hidden": 16, "geo_features": 8,
+      "color_hidden": [16], "deform_hidden": [16, 16], "deform_frequencies": 3, "samples_per_ray": 16,
+      "occupancy_resolution": 16, "visual_hull": true, "render_supersample": 1, "transmittance_eps": 0.0001})");
+  const fs::path path = WriteCheckpoint(testing::MakeTempDir("flat_keys"), *model, 4, 8, flat);
+  auto loaded = LoadTrainedModel(path, Executor(1));
+  ASSERT_TRUE(loaded.ok()) << loaded.status().message();
+  EXPECT_EQ(WriteConfig(loaded->config), WriteConfig(config));
+  EXPECT_EQ(Params(*loaded->model), Params(*model));
 }
 
 TEST(TrainedModel, LoadsParametersConfigAndScheduleFromAFileOrItsDirectory) {
@@ -150,48 +168,52 @@ TEST(TrainedModel, BadModelBlockAndTrainerFieldsNameTheField) {
 
 TEST(TrainedModel, InferenceOverridesChangeTheLoadedConfig) {
   const fs::path path = WriteTinyCheckpoint("trained_model_override");
-  Result<TrainedModel> loaded = LoadTrainedModel(
-      path, Executor(1),
-      {"model.render_supersample=3", "model.render_transmittance_eps=0.001", "model.bf16_inference=false",
-       "model.samples_per_ray=24"});
+  Result<TrainedModel> loaded =
+      LoadTrainedModel(path, Executor(1),
+                       {"model.render.supersample=3", "model.render.transmittance_eps=0.001",
+                        "model.bf16_inference=false", "model.sampler.num_samples=24"});
   ASSERT_TRUE(loaded.ok()) << loaded.status().message();
-  EXPECT_EQ(loaded->config.render_supersample, 3);
-  EXPECT_EQ(loaded->config.render_transmittance_eps, 0.001);
+  EXPECT_EQ(loaded->config.render.supersample, 3);
+  EXPECT_EQ(loaded->config.render.transmittance_eps, 0.001);
   EXPECT_FALSE(loaded->config.bf16_inference);
-  EXPECT_EQ(loaded->config.samples_per_ray, 24);
-  EXPECT_EQ(loaded->model->config().render_supersample, 3);  // the model is built from it
-  EXPECT_EQ(loaded->model->config().samples_per_ray, 24);
-  EXPECT_EQ(loaded->config.grid_levels, testing_model::TinyModelConfig("icef").grid_levels);
+  EXPECT_EQ(loaded->config.sampler.num_samples, 24);
+  EXPECT_EQ(loaded->model->config().render.supersample, 3);  // the model is built from it
+  EXPECT_EQ(loaded->model->config().sampler.num_samples, 24);
+  EXPECT_EQ(loaded->config.static_field.grid.num_levels,
+            testing_model::TinyModelConfig("icef").static_field.grid.num_levels);
 }
 
 TEST(TrainedModel, ArchitectureKeysAreRefusedNamingTheKey) {
   ModelConfig config;
-  for (const std::string key : {"model.grid_levels=8", "model.density_hidden=32", "model.method=warp",
-                                "model.color_hidden=[8]", "train.steps=5", "model.no_such_key=1"}) {
+  for (const std::string key :
+       {"model.static_field.grid.num_levels=8", "model.static_field.density_hidden=32", "model.method=warp",
+        "model.static_field.color_hidden=[8]", "train.steps=5", "model.no_such_key=1"}) {
     const Status s = ApplyInferenceOverride(key, &config);
     ASSERT_FALSE(s.ok()) << key << " was accepted";
     const std::string name = key.substr(0, key.find('='));
     EXPECT_NE(s.message().find(name + " cannot be changed on a trained model"), std::string::npos) << s.message();
-    EXPECT_NE(s.message().find("model.render_supersample"), std::string::npos) << s.message();
+    EXPECT_NE(s.message().find("model.render.supersample"), std::string::npos) << s.message();
     EXPECT_EQ(s.message().find('\n'), std::string::npos) << "one line: " << s.message();
   }
   EXPECT_EQ(WriteConfig(config), WriteConfig(ModelConfig{}));  // nothing changed
   // A load with a refused key fails before building anything.
   const fs::path path = WriteTinyCheckpoint("trained_model_refuse");
-  const Status s = LoadTrainedModel(path, Executor(1), {"model.grid_levels=8"}).status();
-  EXPECT_NE(s.message().find("model.grid_levels cannot be changed"), std::string::npos) << s.message();
+  const Status s = LoadTrainedModel(path, Executor(1), {"model.static_field.grid.num_levels=8"}).status();
+  EXPECT_NE(s.message().find("model.static_field.grid.num_levels cannot be changed"), std::string::npos)
+      << s.message();
 }
 
 TEST(TrainedModel, OverrideValuesAreParsedAndValidatedAsForTrain) {
   ModelConfig config;
-  Status s = ApplyInferenceOverride("model.render_supersample=99", &config);
+  Status s = ApplyInferenceOverride("model.render.supersample=99", &config);
   ASSERT_FALSE(s.ok());
-  EXPECT_NE(s.message().find("--set model.render_supersample=99: render_supersample must be in 1..8"),
+  EXPECT_NE(s.message().find("--set model.render.supersample=99: render.supersample must be in 1..8"),
             std::string::npos)
       << s.message();
-  s = ApplyInferenceOverride("model.render_supersample=two", &config);
+  s = ApplyInferenceOverride("model.render.supersample=two", &config);
   ASSERT_FALSE(s.ok());
-  EXPECT_NE(s.message().find("render_supersample"), std::string::npos) << s.message();
+  EXPECT_NE(s.message().find("model.render.supersample: expected a number"), std::string::npos)
+      << s.message();
   s = ApplyInferenceOverride("render_supersample", &config);
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.message().find("expected SECTION.KEY=VALUE"), std::string::npos) << s.message();

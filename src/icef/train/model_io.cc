@@ -61,7 +61,8 @@ Result<LoadedModel> LoadModel(const fs::path& given, const Executor& executor) {
   ICEF_ASSIGN_OR_RETURN(const std::string trainer_text, ckpt.Section("trainer"));
   ICEF_ASSIGN_OR_RETURN(out.state, ParseTrainerSection(trainer_text, config_text, origin));
   ICEF_ASSIGN_OR_RETURN(const Json config_json, ParseJson(config_text, origin + " [config]"));
-  ICEF_ASSIGN_OR_RETURN(out.config, RunConfig::FromJson(config_json, origin + " [config]"));
+  ICEF_ASSIGN_OR_RETURN(out.config,
+                        RunConfig::FromJson(config_json, origin + " [config]", ConfigSchema::OldKeys::kRead));
   // The model, as inference loads it (with the coarse-to-fine state of out.state.step).
   ICEF_ASSIGN_OR_RETURN(TrainedModel trained, LoadTrainedModel(ckpt, origin, executor));
   out.model = std::move(trained.model);

@@ -109,7 +109,7 @@ Json RunConfig::ToJson() const {
 
 namespace {
 Status ApplyJson(const Json& json, const std::string& origin, const std::filesystem::path& base_dir,
-                 std::set<std::string>* visited, RunConfig* config) {
+                 ConfigSchema::OldKeys old_keys, std::set<std::string>* visited, RunConfig* config) {
   ICEF_ASSIGN_OR_RETURN(const JsonObjectView root, JsonObjectView::Make(json, origin, ""));
   const std::vector<std::string> unknown = root.UnknownKeys({"parent", "model", "train"});
   if (!unknown.empty()) return root.Error(unknown.front(), "unknown key (valid keys: parent, model, train)");
@@ -119,11 +119,12 @@ Status ApplyJson(const Json& json, const std::string& origin, const std::filesys
     if (!visited->insert(std::filesystem::weakly_canonical(path).string()).second)
       return root.Error("parent", "cycle of parent configs through " + path.string());
     ICEF_ASSIGN_OR_RETURN(const Json parent_json, ReadJsonFile(path));
-    ICEF_RETURN_IF_ERROR(ApplyJson(parent_json, path.string(), path.parent_path(), visited, config));
+    ICEF_RETURN_IF_ERROR(
+        ApplyJson(parent_json, path.string(), path.parent_path(), old_keys, visited, config));
   }
   if (root.Has("model")) {
     ICEF_ASSIGN_OR_RETURN(const JsonObjectView m, root.Object("model"));
-    ICEF_RETURN_IF_ERROR(ReadConfig(m, &config->model));
+    ICEF_RETURN_IF_ERROR(ReadConfig(m, &config->model, old_keys));
   }
   if (root.Has("train")) {
     ICEF_ASSIGN_OR_RETURN(const JsonObjectView t, root.Object("train"));
@@ -133,10 +134,11 @@ Status ApplyJson(const Json& json, const std::string& origin, const std::filesys
 }
 }  // namespace
 
-Result<RunConfig> RunConfig::FromJson(const Json& json, const std::string& origin) {
+Result<RunConfig> RunConfig::FromJson(const Json& json, const std::string& origin,
+                                      ConfigSchema::OldKeys old_keys) {
   RunConfig config;
   std::set<std::string> visited;
-  ICEF_RETURN_IF_ERROR(ApplyJson(json, origin, std::filesystem::path("."), &visited, &config));
+  ICEF_RETURN_IF_ERROR(ApplyJson(json, origin, std::filesystem::path("."), old_keys, &visited, &config));
   ICEF_RETURN_IF_ERROR(config.Validate().WithContext(origin));
   return config;
 }
@@ -145,7 +147,8 @@ Result<RunConfig> RunConfig::FromFile(const std::filesystem::path& path) {
   ICEF_ASSIGN_OR_RETURN(const Json json, ReadJsonFile(path));
   RunConfig config;
   std::set<std::string> visited = {std::filesystem::weakly_canonical(path).string()};
-  ICEF_RETURN_IF_ERROR(ApplyJson(json, path.string(), path.parent_path(), &visited, &config));
+  ICEF_RETURN_IF_ERROR(
+      ApplyJson(json, path.string(), path.parent_path(), ConfigSchema::OldKeys::kReject, &visited, &config));
   ICEF_RETURN_IF_ERROR(config.Validate().WithContext(path.string()));
   return config;
 }
@@ -153,10 +156,11 @@ Result<RunConfig> RunConfig::FromFile(const std::filesystem::path& path) {
 Status RunConfig::ApplyOverride(const std::string& assignment) {
   ICEF_ASSIGN_OR_RETURN(const ConfigOverride o, ParseConfigOverride(assignment));
   Json patch;
-  patch[o.section][o.key] = o.value;
+  patch[o.section] = o.SectionPatch();
   std::set<std::string> visited;
   RunConfig updated = *this;
-  ICEF_RETURN_IF_ERROR(ApplyJson(patch, "--set " + assignment, ".", &visited, &updated));
+  ICEF_RETURN_IF_ERROR(
+      ApplyJson(patch, "--set " + assignment, ".", ConfigSchema::OldKeys::kReject, &visited, &updated));
   ICEF_RETURN_IF_ERROR(updated.Validate().WithContext("--set " + assignment));
   *this = updated;
   return Status::Ok();

@@ -60,8 +60,12 @@ struct RunConfig {
   Json ToJson() const;
   // Reads a config file (following "parent" links); keys absent everywhere keep their defaults.
   static Result<RunConfig> FromFile(const std::filesystem::path& path);
-  static Result<RunConfig> FromJson(const Json& json, const std::string& origin);
-  // Applies one "section.key=value" override, e.g. "train.steps=500" or "model.method=warp"
+  // `old_keys`: kRead for configs stored by earlier versions (checkpoints), whose model keys were
+  // flat ("grid_levels"); a user's config naming one is an error that gives its current path.
+  static Result<RunConfig> FromJson(const Json& json, const std::string& origin,
+                                    ConfigSchema::OldKeys old_keys = ConfigSchema::OldKeys::kReject);
+  // Applies one "section.key=value" override, e.g. "train.steps=500", "model.method=warp" or
+  // "model.static_field.grid.finest_resolution=256"
   // (value parsed as JSON, or taken as a string when it is not valid JSON).
   Status ApplyOverride(const std::string& assignment);
   // Stable hash of the resolved config (for checkpoint headers).

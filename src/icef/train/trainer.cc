@@ -88,14 +88,15 @@ Result<std::unique_ptr<Trainer>> Trainer::Create(const Dataset& dataset, const f
   }
   ICEF_ASSIGN_OR_RETURN(std::unique_ptr<AvatarModel> model, AvatarModel::Create(config.model, setup, executor));
   model->Initialize(static_cast<uint64_t>(config.train.seed));
-  if (config.model.visual_hull && data.has_alpha()) {
+  if (config.model.visual_hull.enabled && data.has_alpha()) {
     std::vector<Image> alphas;
     for (int k = 0; k < data.num_frames(); ++k) alphas.push_back(data.Alpha(k));
     VisualHullOptions hull;
-    hull.margin_px = config.model.hull_margin_px;
-    hull.min_views = config.model.hull_min_views > 0 ? config.model.hull_min_views : (data.num_frames() + 1) / 2;
+    hull.margin_px = config.model.visual_hull.margin_px;
+    const int min_views = config.model.visual_hull.min_views;
+    hull.min_views = min_views > 0 ? min_views : (data.num_frames() + 1) / 2;
     ICEF_RETURN_IF_ERROR(model->occupancy().SetAllowed(VisualHullCells(
-        setup.aabb, config.model.occupancy_resolution, data.cameras(), alphas, hull, executor)));
+        setup.aabb, config.model.occupancy.resolution, data.cameras(), alphas, hull, executor)));
   }
   // Only now that the data and the model are good is anything written.
   std::error_code ec;

@@ -36,11 +36,11 @@ const Dataset& TinySubject() {
 RunConfig SmallConfig(const std::string& method) {
   RunConfig c;
   c.model.method = method;
-  c.model.grid_levels = 8;
-  c.model.grid_log2_table_size = 14;
-  c.model.grid_finest_resolution = 128;
-  c.model.samples_per_ray = 24;
-  c.model.occupancy_resolution = 32;
+  c.model.static_field.grid.num_levels = 8;
+  c.model.static_field.grid.log2_table_size = 14;
+  c.model.static_field.grid.finest_resolution = 128;
+  c.model.sampler.num_samples = 24;
+  c.model.occupancy.resolution = 32;
   c.train.batch_rays = 512;
   c.train.threads = 2;
   c.train.log_every = 10;
@@ -205,12 +205,13 @@ TEST(TrainerTest, EveryMethodTrainsAndWritesItsModelDirectory) {
 
 TEST(RunConfigTest, ParentsOverridesAndStrictKeys) {
   const fs::path dir = testing::MakeTempDir("run_config");
-  std::ofstream(dir / "base.json") << R"({"model": {"method": "warp", "samples_per_ray": 40}, "train": {"steps": 7}})";
+  std::ofstream(dir / "base.json")
+      << R"({"model": {"method": "warp", "sampler": {"num_samples": 40}}, "train": {"steps": 7}})";
   std::ofstream(dir / "child.json") << R"({"parent": "base.json", "train": {"steps": 9, "lambda_id": 0.5}})";
   auto c = RunConfig::FromFile(dir / "child.json");
   ASSERT_TRUE(c.ok()) << c.status().message();
   EXPECT_EQ(c->model.method, "warp");
-  EXPECT_EQ(c->model.samples_per_ray, 40);
+  EXPECT_EQ(c->model.sampler.num_samples, 40);
   EXPECT_EQ(c->train.steps, 9);
   EXPECT_EQ(c->train.lambda_id, 0.5);
   ASSERT_TRUE(c->ApplyOverride("train.batch_rays=1024").ok());
