@@ -97,6 +97,12 @@ void ConfigSchema::Renamed(const std::string& old_key, const std::string& curren
   renamed_.emplace_back(old_key, current);
 }
 
+std::string ConfigSchema::RenamedTo(const std::string& old_key) const {
+  for (const auto& [old_name, current] : renamed_)
+    if (old_name == old_key) return current;
+  return "";
+}
+
 namespace {
 std::vector<std::string> SplitPath(const std::string& dotted) {
   std::vector<std::string> parts;

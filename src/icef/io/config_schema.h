@@ -34,6 +34,8 @@ class ConfigSchema {
   // "static_field.grid.num_levels"). Read() rejects it with an error naming `current`, unless told
   // to read stored configs (checkpoints written before the rename), where it is read as `current`.
   void Renamed(const std::string& old_key, const std::string& current);
+  // The current path of an old spelling declared with Renamed(); "" for any other key.
+  std::string RenamedTo(const std::string& old_key) const;
 
   enum class OldKeys { kReject, kRead };
   // Overwrites the bound values from the keys present in `object` (absent keys keep their

@@ -136,6 +136,11 @@ TEST(ConfigSchemaTest, RenamedKeysAreReadOnlyWhenAskedAndNeverTwice) {
   auto twice = ParseOuter(R"({"inner_width": 7, "inner": {"width": 8}})", ConfigSchema::OldKeys::kRead);
   ASSERT_FALSE(twice.ok());
   EXPECT_NE(twice.status().message().find("given twice"), std::string::npos) << twice.status().message();
+  ConfigSchema schema;
+  Outer probe;
+  probe.Bind(schema);
+  EXPECT_EQ(schema.RenamedTo("inner_width"), "inner.width");
+  EXPECT_EQ(schema.RenamedTo("steps"), "");
   // Old names are not written.
   EXPECT_FALSE(WriteConfig(*read).contains("inner_width"));
 }

@@ -54,10 +54,10 @@ Status ApplyInferenceOverride(const std::string& assignment, ModelConfig* config
       ConfigSchema schema;
       updated.Bind(schema);
       const std::vector<std::string> keys = schema.Keys();
-      const Status read = schema.Read(view);  // an old spelling names the current key
+      const std::string renamed = schema.RenamedTo(o.key);
       why = std::find(keys.begin(), keys.end(), o.key) != keys.end() ? "fixed when the model was trained"
-            : read.ok()                                              ? "no such model key"
-                                                                     : read.message();
+            : renamed.empty()                                        ? "no such model key"
+                                                                     : "renamed to model." + renamed;
     }
     std::string can;
     for (const std::string& k : allowed) can += (can.empty() ? "model." : ", model.") + k;

@@ -198,6 +198,12 @@ TEST(TrainedModel, ArchitectureKeysAreRefusedNamingTheKey) {
   EXPECT_EQ(WriteConfig(config), WriteConfig(ModelConfig{}));  // nothing changed
   // A load with a refused key fails before building anything.
   const fs::path path = WriteTinyCheckpoint("trained_model_refuse");
+  const Status renamed = LoadTrainedModel(path, Executor(1), {"model.render_supersample=2"}).status();
+  EXPECT_NE(
+      renamed.message().find("model.render_supersample cannot be changed on a trained model (renamed to "
+                             "model.render.supersample)"),
+      std::string::npos)
+      << renamed.message();
   const Status s = LoadTrainedModel(path, Executor(1), {"model.static_field.grid.num_levels=8"}).status();
   EXPECT_NE(s.message().find("model.static_field.grid.num_levels cannot be changed"), std::string::npos)
       << s.message();
