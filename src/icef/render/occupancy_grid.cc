@@ -50,6 +50,8 @@ Status OccupancyGrid::SetAllowed(std::vector<uint8_t> allowed) {
     return Status::Error("occupancy grid: expected " + std::to_string(num_cells()) + " allowed flags, got " +
                          std::to_string(allowed.size()));
   allowed_ = std::move(allowed);
+  queried_ = allowed_;
+  if (!queried_.empty()) Dilate(&queried_);
   RecomputeBits();
   return Status::Ok();
 }
@@ -69,6 +71,7 @@ void OccupancyGrid::Update(const DensityQuery& query, uint64_t seed, int64_t ste
   std::vector<int64_t> selected;
   selected.reserve(options_.update_fraction >= 1.f ? cells : int64_t(cells * options_.update_fraction * 1.1f) + 16);
   for (int64_t c = 0; c < cells; ++c) {
+    if (!queried_.empty() && !queried_[c]) continue;
     if (options_.update_fraction >= 1.f ||
         Rng(seed, StreamId("occupancy_subset"), uint64_t(step), uint64_t(c)).Uniform() < options_.update_fraction)
       selected.push_back(c);
@@ -161,6 +164,7 @@ OccupancyGrid OccupancyGrid::WithQueriedCells(const DensityQuery& query, int str
   Dilate(&hit);
   OccupancyGrid out = *this;
   out.allowed_.clear();
+  out.queried_.clear();
   for (int64_t c = 0; c < cells; ++c) out.bits_[c] = bits_[c] | (hit[c] & allowed[c]);
   return out;
 }

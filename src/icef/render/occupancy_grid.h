@@ -42,7 +42,8 @@ class OccupancyGrid {
   // Decays every stored density by `decay`, queries one jittered point per selected cell (Rng keyed
   // on (seed, "occupancy", step, cell); with update_fraction < 1 a cell is selected with that
   // probability) and keeps max(decayed, queried); then recomputes the occupied bits (threshold +
-  // dilation). Deterministic for (seed, step) and the query.
+  // dilation). With an allowed set, cells farther than the dilation from every allowed cell are
+  // not queried (they could not change a bit). Deterministic for (seed, step) and the query.
   void Update(const DensityQuery& query, uint64_t seed, int64_t step);
 
   // The grid for rendering one expression: the cells occupied here (bits, hull included) plus the
@@ -105,6 +106,10 @@ class OccupancyGrid {
   std::vector<float> density_;   // [R^3]
   std::vector<uint8_t> bits_;    // [R^3] 1 = occupied (after dilation)
   std::vector<uint8_t> allowed_; // [R^3] or empty: 0 = never occupied
+  // [R^3] or empty (query every cell): the cells Update queries, the allowed set dilated as the
+  // bits are. A cell beyond it cannot make an allowed cell occupied, so its density is not asked
+  // for: with a visual hull that carves most of the box, most of the cost of an update.
+  std::vector<uint8_t> queried_;
 };
 
 }  // namespace icef

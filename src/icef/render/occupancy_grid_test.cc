@@ -129,6 +129,60 @@ TEST(OccupancyGridTest, AllowedCellsAreAHardPrior) {
   EXPECT_EQ(grid.NumOccupied(), grid.num_cells());
 }
 
+// With an allowed set, Update asks only for the cells within the dilation of an allowed cell, and
+// the bits are exactly those of a grid that asked for every cell (restricted to the allowed set).
+TEST(OccupancyGridTest, UpdatesQueryOnlyCellsThatCanReachAnAllowedCell) {
+  OccupancyGridOptions o;
+  o.resolution = 16;
+  o.dilation = 1;
+  o.decay = 0.5f;
+  o.threshold = 1.f;
+  o.query_batch = 100;  // several batches
+  for (const float fraction : {1.f, 0.5f}) {
+    o.update_fraction = fraction;
+    OccupancyGrid every(Aabb(), o), restricted(Aabb(), o);
+    std::vector<uint8_t> allowed(every.num_cells(), 0);
+    for (int z = 4; z < 9; ++z)
+      for (int y = 5; y < 11; ++y)
+        for (int x = 3; x < 7; ++x) allowed[every.CellIndex(x, y, z)] = 1;
+    ASSERT_TRUE(restricted.SetAllowed(allowed).ok());
+    every.Fill(false);
+    restricted.Fill(false);
+    // A dense ball that straddles the allowed box's faces, then moves away (decay must act alike).
+    int64_t queried = 0;
+    for (int step = 0; step < 4; ++step) {
+      const Vec3f centre(-0.4f + 0.3f * float(step), -0.1f, -0.2f);
+      const auto ball = Sphere(centre, 0.35f, 6.f);
+      every.Update(ball, 7, step);
+      restricted.Update(
+          [&](const float* p, int64_t n, float* sigma) {
+            queried += n;
+            for (int64_t i = 0; i < n; ++i) {
+              const Vec3f q(p[3 * i], p[3 * i + 1], p[3 * i + 2]);
+              const Vec3f cell = ((q - Aabb().min).cwiseQuotient(Aabb().Extent()) * 16.f);
+              // Only cells at Chebyshev distance <= 1 from the box [3,7) x [5,11) x [4,9).
+              EXPECT_TRUE(cell.x() >= 2 && cell.x() < 8 && cell.y() >= 4 && cell.y() < 12 && cell.z() >= 3 &&
+                          cell.z() < 10)
+                  << q.transpose();
+            }
+            ball(p, n, sigma);
+          },
+          7, step);
+      int64_t expected_occupied = 0;
+      for (int64_t c = 0; c < every.num_cells(); ++c) {
+        const int x = int(c % 16), y = int((c / 16) % 16), z = int(c / 256);
+        const bool want = allowed[c] && every.IsCellOccupied(x, y, z);
+        EXPECT_EQ(restricted.IsCellOccupied(x, y, z), want) << "cell " << x << "," << y << "," << z;
+        expected_occupied += want;
+      }
+      EXPECT_GT(expected_occupied, 0) << "step " << step;
+    }
+    // 6 x 8 x 7 cells can reach the box; all 16^3 would be 4096 per update.
+    EXPECT_LE(queried, 4 * 6 * 8 * 7) << fraction;
+    EXPECT_GT(queried, 0);
+  }
+}
+
 TEST(OccupancyGridTest, QueriedCellsAddCellsOutsideTheAllowedSet) {
   OccupancyGridOptions o;
   o.resolution = 8;
