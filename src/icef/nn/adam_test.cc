@@ -47,6 +47,39 @@ TEST(AdamTest, MatchesReferenceUpdateAndSkipsZeroGradientsInSparseGroups) {
   EXPECT_EQ(adam.step(), 3);
 }
 
+// A sparse group over a long table with a few entries hit per step: exactly those entries get
+// Adam's update (bias-corrected with the optimiser's step count), and nothing else moves.
+TEST(AdamTest, SparseGroupsUpdateExactlyTheEntriesWithAGradient) {
+  ParameterStore store;
+  const int table = store.Register("grid", 200, 0);
+  AdamOptions o;
+  o.groups = {AdamGroup{}};
+  o.groups[0].learning_rate = 1e-2;
+  o.groups[0].sparse = true;
+  Adam adam(o, &store);
+  for (int i = 0; i < 200; ++i) store.params(table)[i] = 0.01f * float(i);
+  const std::vector<int> hit_first = {3, 17, 18, 199}, hit_second = {3, 120};
+  double m[200] = {}, v[200] = {}, p[200];
+  for (int i = 0; i < 200; ++i) p[i] = 0.01f * float(i);
+  Executor ex(2);
+  for (int t = 1; t <= 2; ++t) {
+    const std::vector<int>& hit = t == 1 ? hit_first : hit_second;
+    for (int i : hit) store.grads(table)[i] = 0.1f * float(i + 1);
+    adam.Step(ex);
+    for (int i : hit) {
+      const double g = 0.1f * float(i + 1);
+      m[i] = 0.9 * m[i] + 0.1 * g;
+      v[i] = 0.99 * v[i] + 0.01 * g * g;
+      p[i] -= 1e-2 * (m[i] / (1 - std::pow(0.9, t))) / (std::sqrt(v[i] / (1 - std::pow(0.99, t))) + 1e-15);
+    }
+    for (int i = 0; i < 200; ++i) {
+      EXPECT_NEAR(store.params(table)[i], p[i], 1e-6) << "entry " << i << " step " << t;
+      EXPECT_EQ(store.grads(table)[i], 0.0f);
+    }
+  }
+  EXPECT_EQ(store.params(table)[50], 0.5f);  // never hit: bit-for-bit untouched
+}
+
 TEST(AdamTest, Schedules) {
   ParameterStore store;
   store.Register("a", 1);
