@@ -92,6 +92,28 @@ TEST(ParallelTest, RangesCoverEverythingOnceInThreadOrder) {
   for (int h : chunk_hits) EXPECT_EQ(h, 1);
 }
 
+// Chunk sizes cut every batch into enough chunks for two threads to finish together (a batch of
+// 4096 samples used to be one chunk on one thread), in whole granules, never above the maximum.
+TEST(ParallelTest, BalancedChunksSplitSmallAndLargeBatches) {
+  EXPECT_EQ(BalancedChunk(0, 128, 4096), 128);
+  EXPECT_EQ(BalancedChunk(1, 128, 4096), 128);
+  EXPECT_EQ(BalancedChunk(4096, 128, 4096), 256);  // 16 chunks, not 1
+  EXPECT_EQ(BalancedChunk(1 << 20, 128, 4096), 4096);
+  for (int64_t n : {100, 2048, 4097, 28600, 65536, 65537, 200000}) {
+    const int64_t chunk = BalancedChunk(n, 128, 4096);
+    EXPECT_EQ(chunk % 128, 0) << n;
+    EXPECT_LE(chunk, 4096) << n;
+    const int64_t chunks = (n + chunk - 1) / chunk;
+    // At least half the target count after rounding up to granules; never more than the target.
+    if (n >= kBalancedChunks * 128) {
+      EXPECT_GE(chunks, kBalancedChunks / 2) << n;
+    }
+    if (n <= kBalancedChunks * 4096) {
+      EXPECT_LE(chunks, kBalancedChunks) << n;
+    }
+  }
+}
+
 TEST(ParallelTest, ExceptionsReachTheCaller) {
   Executor ex(2);
   EXPECT_THROW(ParallelFor(ex, 10, [](int64_t, int64_t, int t) {

@@ -31,4 +31,18 @@ void ParallelFor(const Executor& executor, int64_t n,
 void ParallelForChunks(const Executor& executor, int64_t n, int64_t chunk,
                        const std::function<void(int64_t begin, int64_t end)>& fn);
 
+// Chunks ParallelForChunks should cut a batch into so that the threads finish together: with
+// whole-batch chunks of a fixed size, a batch of one chunk ran on one thread, and one of 7.5
+// chunks left a thread idle for half a chunk.
+inline constexpr int64_t kBalancedChunks = 16;
+
+// Items per chunk for a batch of n: n / kBalancedChunks rounded up to whole granules, within
+// [granule, max_chunk] (max_chunk a multiple of granule). A function of its arguments alone, never
+// of the thread count, so chunk-ordered reductions stay bit-identical for any thread count.
+constexpr int64_t BalancedChunk(int64_t n, int64_t granule, int64_t max_chunk) {
+  const int64_t granules = (n + kBalancedChunks * granule - 1) / (kBalancedChunks * granule);
+  const int64_t chunk = (granules < 1 ? 1 : granules) * granule;
+  return chunk < max_chunk ? chunk : max_chunk;
+}
+
 }  // namespace icef

@@ -46,7 +46,10 @@ std::span<const float> LossContext::RegionMaskValues() {
     if (traits.uniform_mask) {
       std::fill(ws.mask_values.begin(), ws.mask_values.begin() + n, 0.f);
     } else {
-      mask.EvaluateBatch(ws.samples.positions.data(), n, ws.mask_values.data());
+      const float* positions = ws.samples.positions.data();
+      ParallelFor(executor, n, [&](int64_t i0, int64_t i1, int) {
+        mask.EvaluateBatch(positions + 3 * i0, i1 - i0, ws.mask_values.data() + i0);
+      });
     }
     mask_values_ready = true;
   }

@@ -60,7 +60,7 @@ void FrequencyMlp::Forward(const Executor& executor, int64_t n, const float* x, 
     ctx->mlp.bf16.Pack(s, w);
     bf = &ctx->mlp.bf16;
   }
-  ParallelForChunks(executor, n, kMlpChunk, [&](int64_t begin, int64_t end) {
+  ParallelForChunks(executor, n, MlpChunkSize(n), [&](int64_t begin, int64_t end) {
     const SlotAllocator::Slot slot(&slots);
     const int t = slot.index();
     float* scratch = ctx->scratch.data() + per_thread * t;
@@ -85,7 +85,7 @@ void FrequencyMlp::Backward(const Executor& executor, int64_t n, const float* x,
   const int64_t per_thread = PerThread(s);
   if (ctx->scratch.size() < static_cast<size_t>(per_thread * threads)) ctx->scratch.resize(per_thread * threads);
   const int64_t np = s.num_params();
-  const int64_t chunks = (n + kMlpChunk - 1) / kMlpChunk;
+  const int64_t chunk = MlpChunkSize(n), chunks = (n + chunk - 1) / chunk;
   MlpContext& mc = ctx->mlp;
   if (mc.weight_grads.size() < static_cast<size_t>(np * chunks)) mc.weight_grads.resize(np * chunks);
   if (mc.w_transposed.size() < static_cast<size_t>(np)) mc.w_transposed.resize(np);
@@ -93,13 +93,13 @@ void FrequencyMlp::Backward(const Executor& executor, int64_t n, const float* x,
   const int w0 = s.input_dims(), hps = s.hidden_per_sample(), out = s.output_dims();
   const int d = options_.encoding.input_dims, dc = options_.condition_dims;
   const float* fw = encoding_.weights().data();
-  ParallelForChunks(executor, n, kMlpChunk, [&](int64_t begin, int64_t end) {
+  ParallelForChunks(executor, n, MlpChunkSize(n), [&](int64_t begin, int64_t end) {
     const SlotAllocator::Slot slot(&slots);
     float* scratch = ctx->scratch.data() + per_thread * slot.index();
-    for (int64_t c0 = begin; c0 < end; c0 += kMlpChunk) {
-      float* dw = mc.weight_grads.data() + np * (c0 / kMlpChunk);
+    for (int64_t c0 = begin; c0 < end; c0 += chunk) {
+      float* dw = mc.weight_grads.data() + np * (c0 / chunk);
       std::fill(dw, dw + np, 0.0f);
-      const int64_t c1 = std::min(end, c0 + kMlpChunk);
+      const int64_t c1 = std::min(end, c0 + chunk);
       for (int64_t r = c0; r < c1; r += kMlpTile) {
         const int64_t m = std::min(kMlpTile, c1 - r);
         FrequencyMlpBackward<float>(options_.encoding, fw, s, mc.w_transposed.data(), m, x + r * d,
@@ -133,7 +133,7 @@ void FrequencyMlp::Jvp(const Executor& executor, int64_t n, const float* x, cons
     ctx->mlp.bf16.Pack(s, w);
     bf = &ctx->mlp.bf16;
   }
-  ParallelForChunks(executor, n, kMlpChunk, [&](int64_t begin, int64_t end) {
+  ParallelForChunks(executor, n, MlpChunkSize(n), [&](int64_t begin, int64_t end) {
     const SlotAllocator::Slot slot(&slots);
     const int t = slot.index();
     float* scratch = ctx->scratch.data() + per_thread * t;

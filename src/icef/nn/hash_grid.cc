@@ -114,7 +114,7 @@ void HashGridEncoding::BackwardParamsLevels(int64_t n, const float* positions,
 void HashGridEncoding::Forward(const Executor& executor, int64_t n, const float* positions,
                                float* features, float* d_features_d_positions) const {
   const int out = output_dims();
-  ParallelForChunks(executor, n, 4096, [&](int64_t begin, int64_t end) {
+  ParallelForChunks(executor, n, BalancedChunk(n, 64, 4096), [&](int64_t begin, int64_t end) {
     ForwardTile(end - begin, positions + 3 * begin, features + begin * out,
                 d_features_d_positions ? d_features_d_positions + begin * out * 3 : nullptr);
   });
@@ -136,7 +136,7 @@ void HashGridEncoding::BackwardInput(const Executor& executor, int64_t n,
                                      const float* d_features_d_positions, const float* d_features,
                                      float* d_positions) const {
   const int out = output_dims();
-  ParallelForChunks(executor, n, 4096, [&](int64_t begin, int64_t end) {
+  ParallelForChunks(executor, n, BalancedChunk(n, 64, 4096), [&](int64_t begin, int64_t end) {
     HashGridBackwardInput<float>(layout_, end - begin, d_features_d_positions + begin * out * 3,
                                  d_features + begin * out, d_positions + 3 * begin);
   });

@@ -100,7 +100,7 @@ void Mlp::Forward(const Executor& executor, int64_t n, const float* x, float* y,
   }
   const int hps = shape_.hidden_per_sample();
   const int in_w = input_dims(), out_w = output_dims();
-  ParallelForChunks(executor, n, kMlpChunk, [&](int64_t begin, int64_t end) {
+  ParallelForChunks(executor, n, MlpChunkSize(n), [&](int64_t begin, int64_t end) {
     const SlotAllocator::Slot slot(&slots);
     const int t = slot.index();
     float* scratch = ctx->scratch.data() + per_thread * t;
@@ -121,20 +121,20 @@ void Mlp::Backward(const Executor& executor, int64_t n, const float* x, const fl
   const int64_t per_thread = ScratchPerThread(shape_);
   GrowTo(&ctx->scratch, static_cast<size_t>(per_thread * threads));
   const int64_t np = num_params();
-  const int64_t chunks = (n + kMlpChunk - 1) / kMlpChunk;
+  const int64_t chunk = MlpChunkSize(n), chunks = (n + chunk - 1) / chunk;
   GrowTo(&ctx->weight_grads, static_cast<size_t>(np * chunks));
   GrowTo(&ctx->w_transposed, static_cast<size_t>(np));
   MlpTransposeWeights<float>(shape_, weights(), ctx->w_transposed.data());
   const int hps = shape_.hidden_per_sample();
   const int in_w = input_dims(), out_w = output_dims();
-  ParallelForChunks(executor, n, kMlpChunk, [&](int64_t begin, int64_t end) {
+  ParallelForChunks(executor, n, MlpChunkSize(n), [&](int64_t begin, int64_t end) {
     const SlotAllocator::Slot slot(&slots);
     float* scratch = ctx->scratch.data() + per_thread * slot.index();
     // [begin, end) is one chunk, or all of them on a single thread.
-    for (int64_t c0 = begin; c0 < end; c0 += kMlpChunk) {
-      float* dw = ctx->weight_grads.data() + np * (c0 / kMlpChunk);
+    for (int64_t c0 = begin; c0 < end; c0 += chunk) {
+      float* dw = ctx->weight_grads.data() + np * (c0 / chunk);
       std::fill(dw, dw + np, 0.0f);
-      const int64_t c1 = std::min(end, c0 + kMlpChunk);
+      const int64_t c1 = std::min(end, c0 + chunk);
       for (int64_t s = c0; s < c1; s += kMlpTile) {
         const int64_t m = std::min(kMlpTile, c1 - s);
         MlpBackward<float>(shape_, ctx->w_transposed.data(), m, x + s * in_w,
@@ -160,7 +160,7 @@ void Mlp::Jvp(const Executor& executor, int64_t n, const float* x, int slice_beg
   GrowTo(&ctx->scratch, static_cast<size_t>(per_thread * threads));
   const float* w = weights();
   const int in_w = input_dims(), out_w = output_dims();
-  ParallelForChunks(executor, n, kMlpChunk, [&](int64_t begin, int64_t end) {
+  ParallelForChunks(executor, n, MlpChunkSize(n), [&](int64_t begin, int64_t end) {
     const SlotAllocator::Slot slot(&slots);
     const int t = slot.index();
     float* scratch = ctx->scratch.data() + per_thread * t;

@@ -7,10 +7,11 @@
 // output_init_scale (e.g. 1e-3 to start a residual deformation near the identity). Draws come
 // from Rng(seed, "mlp_init", block index, weight index): independent of threads.
 //
-// Threading: samples are split into fixed chunks of kMlpChunk samples handed to threads
+// Threading: samples are split into chunks of MlpChunkSize(n) samples handed to threads
 // dynamically (ParallelForChunks), each chunk into tiles of kMlpTile samples that stay in L1/L2
 // through all layers. Weight gradients accumulate per chunk and are added to the slab in chunk
-// order: results are bit-identical for any thread count and scheduling. Nothing is allocated per
+// order; the chunk size depends on n alone, so results are bit-identical for any thread count and
+// scheduling. Nothing is allocated per
 // batch once the MlpContext has grown to the batch size.
 #pragma once
 
@@ -29,9 +30,11 @@ namespace icef::nn {
 
 // Samples per tile in the threaded Mlp entry points.
 inline constexpr int64_t kMlpTile = 128;
-// Samples per dynamically scheduled work chunk (a multiple of kMlpTile); weight gradients
-// accumulate per chunk and are reduced in chunk order.
+// The most samples per dynamically scheduled work chunk (a multiple of kMlpTile); weight
+// gradients accumulate per chunk and are reduced in chunk order.
 inline constexpr int64_t kMlpChunk = 4096;
+// Samples per chunk for a batch of n (core/parallel.h's BalancedChunk in whole tiles).
+constexpr int64_t MlpChunkSize(int64_t n) { return BalancedChunk(n, kMlpTile, kMlpChunk); }
 
 struct MlpOptions {
   // Layer widths: input, hidden..., output (at least input and output).

@@ -59,9 +59,9 @@ TEST(TrainingDataTest, JitteredRaysStayInsideTheirPixelAndAreDeterministic) {
   auto data = TrainingData::Load(TinySubject());
   ASSERT_TRUE(data.ok()) << data.status().message();
   TrainRays centre, jittered, again;
-  data->SampleBatch(256, 9, 4, false, false, &centre);
-  data->SampleBatch(256, 9, 4, false, true, &jittered);
-  data->SampleBatch(256, 9, 4, false, true, &again);
+  data->SampleBatch(256, 9, 4, false, false, &centre, Executor(2));
+  data->SampleBatch(256, 9, 4, false, true, &jittered, Executor(2));
+  data->SampleBatch(256, 9, 4, false, true, &again, Executor(1));  // any thread count: the same rays
   int off_centre = 0;
   for (int r = 0; r < 256; ++r) {
     ASSERT_EQ(centre.frame[r], jittered.frame[r]);  // same pixels and targets, only the ray moves

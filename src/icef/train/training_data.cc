@@ -50,32 +50,48 @@ Image TrainingData::Alpha(int k) const {
 }
 
 void TrainingData::SampleBatch(int num_rays, uint64_t seed, int64_t step, bool random_background, bool jitter,
-                               TrainRays* batch) const {
+                               TrainRays* batch, const Executor& executor) const {
   batch->rays.resize(num_rays);
   batch->frame.resize(num_rays);
   batch->target_rgb.resize(3 * size_t(num_rays));
   batch->target_alpha.resize(has_alpha_ ? num_rays : 0);
   batch->background.resize(3 * size_t(num_rays));
   const bool random = random_background && has_alpha_;
+  // The draws in ray order on the caller (three streams, each consumed in order), then the rays and
+  // targets in parallel: the same batch for any thread count.
   Rng rng(seed, StreamId("ray_batch"), uint64_t(step));
   Rng bg_rng(seed, StreamId("random_background"), uint64_t(step));
   Rng jitter_rng(seed, StreamId("pixel_jitter"), uint64_t(step));
   const uint64_t total = frame_of_pixel_.size();
+  struct PixelDraw {
+    uint64_t pixel;
+    double ju, jv;
+  };
+  std::vector<PixelDraw> draws(num_rays);
   for (int r = 0; r < num_rays; ++r) {
-    const uint64_t p = rng.Below(total);
-    const int k = frame_of_pixel_[p];
-    batch->frame[r] = k;
-    // The target is the pixel's average colour, so the ray goes through a random point of the pixel.
-    const double ju = jitter ? jitter_rng.Uniform() : 0.5, jv = jitter ? jitter_rng.Uniform() : 0.5;
-    batch->rays[r] = cameras_[k].RayThrough(pixel_x_[p] + ju, pixel_y_[p] + jv);
-    const float alpha = has_alpha_ ? alpha_[p] : 1.f;
-    for (int a = 0; a < 3; ++a) {
-      const float bg = random ? bg_rng.Uniform() : background_[3 * p + a];
-      batch->background[3 * r + a] = bg;
-      batch->target_rgb[3 * r + a] = premultiplied_[3 * p + a] + (1.f - alpha) * bg;
-    }
-    if (has_alpha_) batch->target_alpha[r] = alpha;
+    PixelDraw& d = draws[r];
+    d.pixel = rng.Below(total);
+    d.ju = jitter ? jitter_rng.Uniform() : 0.5;
+    d.jv = jitter ? jitter_rng.Uniform() : 0.5;
+    for (int a = 0; a < 3 && random; ++a) batch->background[3 * r + a] = static_cast<float>(bg_rng.Uniform());
   }
+  ParallelFor(executor, num_rays, [&](int64_t r0, int64_t r1, int) {
+    for (int64_t r = r0; r < r1; ++r) {
+      const PixelDraw& d = draws[r];
+      const uint64_t p = d.pixel;
+      const int k = frame_of_pixel_[p];
+      batch->frame[r] = k;
+      // The target is the pixel's average colour, so the ray goes through a random point of the pixel.
+      batch->rays[r] = cameras_[k].RayThrough(pixel_x_[p] + d.ju, pixel_y_[p] + d.jv);
+      const float alpha = has_alpha_ ? alpha_[p] : 1.f;
+      for (int a = 0; a < 3; ++a) {
+        const float bg = random ? batch->background[3 * r + a] : background_[3 * p + a];
+        batch->background[3 * r + a] = bg;
+        batch->target_rgb[3 * r + a] = premultiplied_[3 * p + a] + (1.f - alpha) * bg;
+      }
+      if (has_alpha_) batch->target_alpha[r] = alpha;
+    }
+  });
 }
 
 }  // namespace icef

@@ -28,9 +28,9 @@ class TrainingData {
   // alpha), each ray's target is its foreground composited over a random colour that the model
   // also renders over, so the field cannot fake the background with haze (instant-ngp's trick).
   // With jitter, each ray passes through a uniformly random point of its pixel (the target is the
-  // pixel's average), else through the pixel centre.
+  // pixel's average), else through the pixel centre. The same batch for any executor.
   void SampleBatch(int num_rays, uint64_t seed, int64_t step, bool random_background, bool jitter,
-                   TrainRays* batch) const;
+                   TrainRays* batch, const Executor& executor) const;
 
  private:
   std::vector<Camera> cameras_;
