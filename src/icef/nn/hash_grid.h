@@ -23,7 +23,7 @@ struct HashGridOptions {
   // Features per level F.
   int features_per_level = 2;
   // log2 of the hashed table size T per level.
-  int log2_table_size = 17;
+  int log2_table_size = 16;
   // Resolution of the coarsest level (cells per axis).
   double base_resolution = 16.0;
   // Resolution of the finest level; levels grow geometrically in between.
