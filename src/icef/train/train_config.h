@@ -22,7 +22,7 @@ struct TrainConfig {
   // Adam learning rate of the hash grid: 3e-2, against 1e-2 before, is +0.49 to +1.62 dB on every
   // diverse validation identity at 1000 steps (docs/results/priors_validation.md, 2026-11-24) and
   // shortens the slow start of a nearly empty field.
-  double lr_grid = 3e-2;
+  double lr_grid = 5e-2;
   double lr_mlp = 1e-3;              // Adam learning rate of the static field's MLPs
   double lr_deform = 1e-3;           // Adam learning rate of the deformation MLP
   double lr_final_factor = 0.1;      // learning rates decay exponentially to this factor at the last step
