@@ -5,9 +5,9 @@
 #
 #   scripts/validation_runs.sh --variant NAME [--set SECTION.KEY=VALUE ...] [--out DIR]
 #       [--seeds "101 102 103 104 105 106"] [--train-seeds "0 1"] [--method icef] [--res 128]
-#       [--steps 1000] [--icef build/icef] [--threads 0]
+#       [--k 5] [--steps 1000] [--icef build/icef] [--threads 0]
 #
-# Writes DIR/data/seed<S>_<res>/ (`icef synth --diverse`, made once) and
+# Writes DIR/data/seed<S>_<res>/ (`icef synth --diverse`, made once; seed<S>_<res>_k<K>/ when K is not 5) and
 # DIR/runs/<NAME>_<S>_t<T>/ (model, eval/metrics.json); runs that already have eval/metrics.json
 # are kept. scripts/validation_table.py DIR tabulates them. Seeds must be validation identities
 # (101 and up): the bench's test identities are never tuned on.
@@ -20,6 +20,7 @@ seeds="101 102 103 104 105 106"
 train_seeds="0 1"
 method=icef
 res=128
+k=5
 steps=1000
 threads=0
 sets=()
@@ -32,6 +33,7 @@ while [ $# -gt 0 ]; do
     --train-seeds) train_seeds=$2; shift 2 ;;
     --method) method=$2; shift 2 ;;
     --res) res=$2; shift 2 ;;
+    --k) k=$2; shift 2 ;;
     --steps) steps=$2; shift 2 ;;
     --icef) icef=$2; shift 2 ;;
     --threads) threads=$2; shift 2 ;;
@@ -53,8 +55,9 @@ done
 mkdir -p "$out/data" "$out/runs"
 for seed in $seeds; do
   data="$out/data/seed${seed}_${res}"
+  [ "$k" = 5 ] || data="${data}_k${k}"
   [ -f "$data/transforms_test.json" ] ||
-    "$icef" synth --diverse --out "$data" --identity-seed "$seed" --k 5 --res "$res" --threads "$threads" >/dev/null
+    "$icef" synth --diverse --out "$data" --identity-seed "$seed" --k "$k" --res "$res" --threads "$threads" >/dev/null
   for ts in $train_seeds; do
     run="$out/runs/${variant}_${seed}_t${ts}"
     [ -f "$run/eval/metrics.json" ] && continue
