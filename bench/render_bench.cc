@@ -116,10 +116,13 @@ BENCHMARK(BM_RenderImage256)->Unit(benchmark::kMillisecond)->UseRealTime();
 // icef train's full default step (batch, forward, every loss, backward, Adam, schedules, and the
 // occupancy-grid update every train.occupancy_every steps) on 2 threads, after warm-up steps of a
 // fresh trainer past train.occupancy_warmup, so that the timed steps are those of most of a run.
+// bf16:1 is the default config (model.bf16_training: the MLP products of training in BF16 with FP32
+// sums); bf16:0 the same step in FP32.
 void BM_TrainStep(benchmark::State& state) {
   const Subject& s = TrainedSubject();
   if (!s.error.empty()) return state.SkipWithError(s.error.c_str());
   icef::RunConfig config;
+  config.model.bf16_training = state.range(0) != 0;
   config.train.steps = 1000000;
   config.train.threads = 2;
   config.train.checkpoint_every = 0;
@@ -141,7 +144,13 @@ void BM_TrainStep(benchmark::State& state) {
   state.counters["samples/s"] = benchmark::Counter(static_cast<double>(samples), benchmark::Counter::kIsRate);
   std::filesystem::remove_all(dir);
 }
-BENCHMARK(BM_TrainStep)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
+BENCHMARK(BM_TrainStep)
+    ->ArgName("bf16")
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(3.0);
 
 // icef eval's work per test frame (the far frame of the subject): its render and the model's
 // neutral render of the same view, PSNR, SSIM, the expression-fidelity measures and, where the

@@ -19,6 +19,7 @@ nn::FrequencyMlpOptions MlpOptionsFor(const DeformationFieldOptions& o, int expr
   m.output_activation = nn::Activation::kNone;
   m.output_init_scale = o.output_init_scale;
   m.bf16_inference = o.bf16_inference;
+  m.bf16_training = o.bf16_training;
   return m;
 }
 }  // namespace

@@ -30,6 +30,8 @@ struct DeformationFieldOptions {
   float output_init_scale = 1e-2f;
   // Inference passes (renders, occupancy) in BF16 with FP32 sums (nn::MlpOptions::bf16_inference).
   bool bf16_inference = true;
+  // Training passes in BF16 with FP32 sums (nn::MlpOptions::bf16_training).
+  bool bf16_training = true;
 
   bool operator==(const DeformationFieldOptions&) const = default;
   Status Validate() const;

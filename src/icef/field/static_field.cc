@@ -15,6 +15,7 @@ nn::MlpOptions DensityMlpOptions(const StaticFieldOptions& o, int grid_dims) {
   m.widths = {grid_dims + o.condition_dims, o.density_hidden, o.geo_features};
   m.output_activation = nn::Activation::kNone;
   m.bf16_inference = o.bf16_inference;
+  m.bf16_training = o.bf16_training;
   return m;
 }
 nn::MlpOptions ColorMlpOptions(const StaticFieldOptions& o) {
@@ -24,6 +25,7 @@ nn::MlpOptions ColorMlpOptions(const StaticFieldOptions& o) {
   m.widths.push_back(3);
   m.output_activation = nn::Activation::kSigmoid;
   m.bf16_inference = o.bf16_inference;
+  m.bf16_training = o.bf16_training;
   return m;
 }
 }  // namespace

@@ -40,6 +40,8 @@ struct StaticFieldOptions {
   float density_bias = -4.f;
   // Inference passes (renders, occupancy) in BF16 with FP32 sums (nn::MlpOptions::bf16_inference).
   bool bf16_inference = true;
+  // Training passes in BF16 with FP32 sums (nn::MlpOptions::bf16_training).
+  bool bf16_training = true;
 
   bool operator==(const StaticFieldOptions&) const = default;
   Status Validate() const;

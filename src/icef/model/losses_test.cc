@@ -26,6 +26,7 @@ std::unique_ptr<AvatarModel> MakeModel(const std::string& method, bool coarse = 
   ModelConfig config = TinyModelConfig(method);
   config.deformation.output_init_scale = 0.05f;
   config.bf16_inference = false;
+  config.bf16_training = false;  // finite differences need more than BF16's 8 bits
   if (coarse) {
     config.static_field.grid.num_levels = 2;
     config.static_field.grid.finest_resolution = 6;

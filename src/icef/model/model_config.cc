@@ -118,8 +118,15 @@ void ModelConfig::Bind(ConfigSchema& s) {
   });
   s.Block("render", [this](ConfigSchema& b) { BindRender(b, &render); });
   s.Bool("bf16_inference", &bf16_inference,
-         "renders, evaluation and occupancy updates multiply in BF16 with FP32 sums on CPUs with AVX512-BF16 (about 2x "
-         "the MLP throughput); training passes are always FP32");
+         "renders, evaluation and occupancy updates multiply in BF16 with FP32 sums on CPUs with AVX512-BF16 "
+         "(about "
+         "1.6x the FP32 products' throughput)");
+  s.Bool("bf16_training", &bf16_training,
+         "training's forward and backward MLP products (weight gradients included) in BF16 with FP32 sums on "
+         "CPUs "
+         "with AVX512-BF16 (about 11% more samples/s; observed PSNR on the validation identities +0.04 dB); "
+         "weights, "
+         "gradients and Adam stay FP32");
   BindFlatSpellings(s);
 }
 
@@ -146,6 +153,7 @@ Method ModelConfig::ParsedMethod() const { return ParseMethod(method).value(); }
 StaticFieldOptions ModelConfig::StaticOptions(int expression_dims) const {
   StaticFieldOptions o = static_field;
   o.bf16_inference = bf16_inference;
+  o.bf16_training = bf16_training;
   auto m = ParseMethod(method);
   o.condition_dims = (m.ok() && TraitsOf(*m).entangled_beta) ? expression_dims : 0;
   return o;
@@ -154,6 +162,7 @@ StaticFieldOptions ModelConfig::StaticOptions(int expression_dims) const {
 DeformationFieldOptions ModelConfig::DeformationOptions() const {
   DeformationFieldOptions o = deformation;
   o.bf16_inference = bf16_inference;
+  o.bf16_training = bf16_training;
   return o;
 }
 

@@ -41,7 +41,7 @@ struct VisualHullConfig {
 // One nested block per component, each the component's own Options struct ("static_field":
 // {"grid": {"finest_resolution": 512}} is StaticFieldOptions::grid.finest_resolution): the
 // defaults are the structs' in-class ones, one source checked by train/config_defaults_test.cc.
-// Options fields that are not config keys (static_field.condition_dims and bf16_inference,
+// Options fields that are not config keys (static_field.condition_dims, bf16_inference and bf16_training,
 // sampler.stratified) are filled in by the accessors below, which every user of the config calls.
 struct ModelConfig {
   std::string method = "icef-prior";  // icef-prior | warp-prior | icef | icef-no-id | icef-no-conf | icef-uniform | warp | nerface
@@ -56,6 +56,8 @@ struct ModelConfig {
   ImageRenderOptions render;
   // Renders, eval and occupancy updates: MLP products in BF16 with FP32 sums (AVX512-BF16 CPUs).
   bool bf16_inference = StaticFieldOptions{}.bf16_inference;
+  // Training passes (forward, backward, weight gradients) likewise; weights and Adam stay FP32.
+  bool bf16_training = StaticFieldOptions{}.bf16_training;
 
   void Bind(ConfigSchema& s);
   Status Validate() const;

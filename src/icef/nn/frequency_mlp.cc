@@ -20,6 +20,7 @@ MlpOptions FrequencyMlpOptions::ToMlpOptions() const {
   m.output_activation = output_activation;
   m.output_init_scale = output_init_scale;
   m.bf16_inference = bf16_inference;
+  m.bf16_training = bf16_training;
   return m;
 }
 
@@ -56,7 +57,7 @@ void FrequencyMlp::Forward(const Executor& executor, int64_t n, const float* x, 
   const float* w = mlp_.weights();
   const float* fw = encoding_.weights().data();
   const MlpBf16Weights* bf = nullptr;
-  if (!keep_for_backward && options_.bf16_inference && Bf16Supported()) {
+  if ((keep_for_backward ? options_.bf16_training : options_.bf16_inference) && Bf16Supported()) {
     ctx->mlp.bf16.Pack(s, w);
     bf = &ctx->mlp.bf16;
   }
@@ -90,6 +91,11 @@ void FrequencyMlp::Backward(const Executor& executor, int64_t n, const float* x,
   if (mc.weight_grads.size() < static_cast<size_t>(np * chunks)) mc.weight_grads.resize(np * chunks);
   if (mc.w_transposed.size() < static_cast<size_t>(np)) mc.w_transposed.resize(np);
   MlpTransposeWeights<float>(s, mlp_.weights(), mc.w_transposed.data());
+  const MlpBf16Weights* bf_t = nullptr;
+  if (options_.bf16_training && Bf16Supported()) {
+    mc.bf16_transposed.PackTransposed(s, mc.w_transposed.data());
+    bf_t = &mc.bf16_transposed;
+  }
   const int w0 = s.input_dims(), hps = s.hidden_per_sample(), out = s.output_dims();
   const int d = options_.encoding.input_dims, dc = options_.condition_dims;
   const float* fw = encoding_.weights().data();
@@ -103,9 +109,9 @@ void FrequencyMlp::Backward(const Executor& executor, int64_t n, const float* x,
       for (int64_t r = c0; r < c1; r += kMlpTile) {
         const int64_t m = std::min(kMlpTile, c1 - r);
         FrequencyMlpBackward<float>(options_.encoding, fw, s, mc.w_transposed.data(), m, x + r * d,
-                                    ctx->input.data() + r * w0, mc.hidden.data() + r * hps,
-                                    y + r * out, dy + r * out, dw, dx ? dx + r * d : nullptr,
-                                    dc_out ? dc_out + r * dc : nullptr, scratch);
+                                    ctx->input.data() + r * w0, mc.hidden.data() + r * hps, y + r * out,
+                                    dy + r * out, dw, dx ? dx + r * d : nullptr,
+                                    dc_out ? dc_out + r * dc : nullptr, scratch, bf_t);
       }
     }
   });

@@ -46,16 +46,16 @@ void FrequencyMlpForward(const FrequencyEncodingOptions& fo, const T* freq_weigh
 
 // Tile backward: accumulates dw; writes dx [n, d] and dc_out [n, dc] unless null.
 template <typename T>
-void FrequencyMlpBackward(const FrequencyEncodingOptions& fo, const T* freq_weights,
-                          const MlpShape& s, const T* w_transposed, int64_t n, const T* x,
-                          const T* in, const T* hidden, const T* y, const T* dy, T* dw, T* dx,
-                          T* dc_out, T* scratch) {
+void FrequencyMlpBackward(const FrequencyEncodingOptions& fo, const T* freq_weights, const MlpShape& s,
+                          const T* w_transposed, int64_t n, const T* x, const T* in, const T* hidden,
+                          const T* y, const T* dy, T* dw, T* dx, T* dc_out, T* scratch,
+                          const MlpBf16Weights* bf_t = nullptr) {
   const int D = fo.output_dims(), w0 = s.input_dims(), dc = w0 - D;
   const bool need_input = dx != nullptr || dc_out != nullptr;
   T* d_in = scratch;                 // [n, w0]
   T* d_enc = scratch + n * w0;       // [n, D]
   T* mlp_scratch = scratch + 2 * n * w0;
-  MlpBackward<T>(s, w_transposed, n, in, hidden, y, dy, dw, need_input ? d_in : nullptr, mlp_scratch);
+  MlpBackward<T>(s, w_transposed, n, in, hidden, y, dy, dw, need_input ? d_in : nullptr, mlp_scratch, bf_t);
   if (!need_input) return;
   for (int64_t r = 0; r < n; ++r) {
     std::copy(d_in + r * w0, d_in + r * w0 + D, d_enc + r * D);
@@ -113,6 +113,8 @@ struct FrequencyMlpOptions {
   float output_init_scale = 1.0f;
   // Forward and JVP passes without a backward pass in BF16 (MlpOptions::bf16_inference).
   bool bf16_inference = false;
+  // Training passes (forward and backward) in BF16 (MlpOptions::bf16_training).
+  bool bf16_training = false;
 
   Status Validate() const;
   std::string ToString() const;

@@ -1,6 +1,6 @@
-// Inference products in BF16 with FP32 accumulation (AVX512-BF16's vdpbf16ps: 32 products per
-// instruction where the FP32 kernel does 16), for the layers of an Mlp evaluated without a
-// backward pass (renders, evaluation, occupancy updates):
+// Products in BF16 with FP32 accumulation (AVX512-BF16's vdpbf16ps: 32 products per instruction
+// where the FP32 kernel does 16), for the layers of an Mlp in inference (renders, evaluation,
+// occupancy updates) and, with MlpOptions::bf16_training, in training:
 //   C[n, m] = bf16(A)[n, k] · bf16(B)[k, m]   accumulated in FP32.
 // Both operands are rounded to BF16 (8 significant bits, round to nearest even); the products and
 // sums are FP32. B, a layer's Wt, is packed once per batch into pairs of consecutive k rows,
@@ -28,5 +28,10 @@ void PackBf16Pairs(int k, int m, const float* b, uint16_t* packed);
 // C[n, m] = A[n, k] · B[k, m] from B packed by PackBf16Pairs; m must be a multiple of 16 and the
 // build must have the kernel (Bf16Supported()).
 void GemmNNBf16(int64_t n, int k, int m, const float* a, const uint16_t* packed, float* c);
+
+// The weight gradient in BF16: C[k, m] += bf16(A)[n, k]^T · bf16(B)[n, m], FP32 sums (per pass
+// of 256 samples, then added to C). Both operands are packed internally into pairs of samples;
+// m must be a multiple of 16 and the build must have the kernel.
+void GemmTNAccBf16(int64_t n, int k, int m, const float* a, const float* b, float* c);
 
 }  // namespace icef::nn

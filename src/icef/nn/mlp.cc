@@ -94,7 +94,7 @@ void Mlp::Forward(const Executor& executor, int64_t n, const float* x, float* y,
   }
   const float* w = weights();
   const MlpBf16Weights* bf = nullptr;
-  if (!keep_for_backward && options_.bf16_inference && Bf16Supported()) {
+  if ((keep_for_backward ? options_.bf16_training : options_.bf16_inference) && Bf16Supported()) {
     ctx->bf16.Pack(shape_, w);
     bf = &ctx->bf16;
   }
@@ -125,6 +125,11 @@ void Mlp::Backward(const Executor& executor, int64_t n, const float* x, const fl
   GrowTo(&ctx->weight_grads, static_cast<size_t>(np * chunks));
   GrowTo(&ctx->w_transposed, static_cast<size_t>(np));
   MlpTransposeWeights<float>(shape_, weights(), ctx->w_transposed.data());
+  const MlpBf16Weights* bf_t = nullptr;
+  if (options_.bf16_training && Bf16Supported()) {
+    ctx->bf16_transposed.PackTransposed(shape_, ctx->w_transposed.data());
+    bf_t = &ctx->bf16_transposed;
+  }
   const int hps = shape_.hidden_per_sample();
   const int in_w = input_dims(), out_w = output_dims();
   ParallelForChunks(executor, n, MlpChunkSize(n), [&](int64_t begin, int64_t end) {
@@ -137,9 +142,8 @@ void Mlp::Backward(const Executor& executor, int64_t n, const float* x, const fl
       const int64_t c1 = std::min(end, c0 + chunk);
       for (int64_t s = c0; s < c1; s += kMlpTile) {
         const int64_t m = std::min(kMlpTile, c1 - s);
-        MlpBackward<float>(shape_, ctx->w_transposed.data(), m, x + s * in_w,
-                           ctx->hidden.data() + s * hps, y + s * out_w, dy + s * out_w, dw,
-                           dx ? dx + s * in_w : nullptr, scratch);
+        MlpBackward<float>(shape_, ctx->w_transposed.data(), m, x + s * in_w, ctx->hidden.data() + s * hps,
+                           y + s * out_w, dy + s * out_w, dw, dx ? dx + s * in_w : nullptr, scratch, bf_t);
       }
     }
   });

@@ -44,8 +44,12 @@ struct MlpOptions {
   // Multiplies the initial output-layer weights.
   float output_init_scale = 1.0f;
   // Forward passes without a backward pass (inference) multiply in BF16 with FP32 sums
-  // (nn/gemm_bf16.h) when the build has the kernel; training passes are always FP32.
+  // (nn/gemm_bf16.h) when the build has the kernel.
   bool bf16_inference = false;
+  // Training passes too: the forward pass kept for the backward pass, the backward data products
+  // and the weight gradients multiply in BF16 with FP32 sums (the weights, their gradients and
+  // Adam stay FP32); layers whose widths are not multiples of 16 stay FP32.
+  bool bf16_training = false;
 
   Status Validate() const;
   std::string ToString() const;
@@ -60,7 +64,8 @@ struct MlpContext {
   AlignedVector<float> scratch;      // per thread: tile-sized work buffers
   AlignedVector<float> weight_grads; // per chunk: [num_params] gradient accumulators
   AlignedVector<float> w_transposed; // untransposed weights for the backward pass
-  MlpBf16Weights bf16;               // the weights packed for BF16 inference
+  MlpBf16Weights bf16;               // the weights packed for BF16 products
+  MlpBf16Weights bf16_transposed;    // w_transposed packed for BF16 backward products
 };
 
 class Mlp {

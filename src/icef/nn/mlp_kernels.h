@@ -68,6 +68,20 @@ struct MlpBf16Weights {
     for (int l = 0; l < s.num_layers(); ++l)
       if (offsets[l] >= 0) PackBf16Pairs(s.widths()[l], s.widths()[l + 1], w + s.WeightOffset(l), packed.data() + offsets[l]);
   }
+  // The untransposed layers W_l [w_{l+1}, w_l] (MlpTransposeWeights) for the backward pass's data
+  // products; layers whose INPUT width is not a multiple of 16 stay FP32.
+  void PackTransposed(const MlpShape& s, const float* w_transposed) {
+    offsets.assign(s.num_layers(), -1);
+    int64_t size = 0;
+    for (int l = 0; l < s.num_layers(); ++l)
+      if (s.widths()[l] % 16 == 0)
+        offsets[l] = size, size += Bf16PackedSize(s.widths()[l + 1], s.widths()[l]);
+    packed.resize(size);
+    for (int l = 0; l < s.num_layers(); ++l)
+      if (offsets[l] >= 0)
+        PackBf16Pairs(s.widths()[l + 1], s.widths()[l], w_transposed + s.WeightOffset(l),
+                      packed.data() + offsets[l]);
+  }
   const uint16_t* layer(int l) const { return offsets[l] < 0 ? nullptr : packed.data() + offsets[l]; }
 };
 
@@ -79,6 +93,30 @@ inline void LayerProduct(const MlpShape& s, int l, const T* w, const MlpBf16Weig
     if (bf && bf->layer(l)) return GemmNNBf16(n, in_w, out_w, in, bf->layer(l), out);
   }
   GemmNN<T>(n, in_w, out_w, in, w + s.WeightOffset(l), out);
+}
+
+// Layer l's weight gradient, dW_l += in^T · d: BF16 when bf_t is given (float only) and the
+// layer's output width is a multiple of 16, else GemmTNAcc.
+template <typename T>
+inline void LayerWeightGrad(const MlpShape& s, int l, const MlpBf16Weights* bf_t, int64_t n, const T* in,
+                            const T* d, T* dw) {
+  const int in_w = s.widths()[l], out_w = s.widths()[l + 1];
+  if constexpr (std::is_same_v<T, float>) {
+    if (bf_t && out_w % 16 == 0) return GemmTNAccBf16(n, in_w, out_w, in, d, dw + s.WeightOffset(l));
+  }
+  GemmTNAcc<T>(n, in_w, out_w, in, d, dw + s.WeightOffset(l));
+}
+
+// Layer l's data product of the backward pass, dest [n, w_l] = d [n, w_{l+1}] · W_l: BF16 when
+// bf_t packs the layer (float only), else GemmNN on w_transposed.
+template <typename T>
+inline void LayerDataProduct(const MlpShape& s, int l, const T* w_transposed, const MlpBf16Weights* bf_t,
+                             int64_t n, const T* d, T* dest) {
+  const int in_w = s.widths()[l], out_w = s.widths()[l + 1];
+  if constexpr (std::is_same_v<T, float>) {
+    if (bf_t && bf_t->layer(l)) return GemmNNBf16(n, out_w, in_w, d, bf_t->layer(l), dest);
+  }
+  GemmNN<T>(n, out_w, in_w, d, w_transposed + s.WeightOffset(l), dest);
 }
 
 // Writes W_l [w_{l+1}, w_l] (the untransposed layer) for every layer into wt_out, same offsets.
@@ -122,9 +160,11 @@ inline int64_t MlpBackwardScratch(const MlpShape& s, int64_t n) { return 2 * n *
 
 // Given dy = d loss / d y [n, w_L], ACCUMULATES d loss / d Wt into dw (flat, same layout as w) and,
 // when dx is not null, WRITES d loss / d x [n, w_0]. w_transposed from MlpTransposeWeights.
+// bf_t (float only, may be null): w_transposed packed by PackTransposed; then every product whose
+// output width is a multiple of 16 runs in BF16 with FP32 sums, weight gradients included.
 template <typename T>
-void MlpBackward(const MlpShape& s, const T* w_transposed, int64_t n, const T* x, const T* hidden,
-                 const T* y, const T* dy, T* dw, T* dx, T* scratch) {
+void MlpBackward(const MlpShape& s, const T* w_transposed, int64_t n, const T* x, const T* hidden, const T* y,
+                 const T* dy, T* dw, T* dx, T* scratch, const MlpBf16Weights* bf_t = nullptr) {
   const int layers = s.num_layers();
   T* bufs[2] = {scratch, scratch + n * s.max_width()};
   int cur = 0;
@@ -139,12 +179,12 @@ void MlpBackward(const MlpShape& s, const T* w_transposed, int64_t n, const T* x
     }
   }
   for (int l = layers - 1; l >= 0; --l) {
-    const int in_w = s.widths()[l], out_w = s.widths()[l + 1];
+    const int in_w = s.widths()[l];
     const T* in = l == 0 ? x : hidden + n * s.HiddenOffset(l - 1);
-    GemmTNAcc<T>(n, in_w, out_w, in, d, dw + s.WeightOffset(l));
+    LayerWeightGrad<T>(s, l, bf_t, n, in, d, dw);
     if (l == 0 && dx == nullptr) break;
     T* dest = l == 0 ? dx : bufs[1 - cur];
-    GemmNN<T>(n, out_w, in_w, d, w_transposed + s.WeightOffset(l), dest);
+    LayerDataProduct<T>(s, l, w_transposed, bf_t, n, d, dest);
     if (l > 0) {
       const int64_t count = n * in_w;
       for (int64_t i = 0; i < count; ++i) dest[i] = in[i] > T(0) ? dest[i] : T(0);
