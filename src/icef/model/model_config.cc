@@ -120,7 +120,7 @@ void ModelConfig::Bind(ConfigSchema& s) {
   s.Bool("bf16_inference", &bf16_inference,
          "renders, evaluation and occupancy updates multiply in BF16 with FP32 sums on CPUs with AVX512-BF16 "
          "(about "
-         "1.6x the FP32 products' throughput)");
+         "1.6-2x the FP32 products' rate, depending on the CPU)");
   s.Bool("bf16_training", &bf16_training,
          "training's forward and backward MLP products (weight gradients included) in BF16 with FP32 sums on "
          "CPUs "
