@@ -25,10 +25,15 @@ test: deps
 	@$(MAKE) --no-print-directory build
 	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) --timeout 900
 
-bench: deps
+# The benchmarks, then the same reference step in PyTorch on the same cores and the ratios
+# (build/bench/results.json, build/bench/torch_reference.json).
+bench:
+	@bash scripts/install-deps.sh --bench
 	@$(MAKE) --no-print-directory build
 	@mkdir -p $(BUILD_DIR)/bench
 	./$(BUILD_DIR)/bench/icef_bench --benchmark_out=$(BUILD_DIR)/bench/results.json --benchmark_out_format=json
+	/usr/bin/python3 scripts/torch_reference_bench.py --cpp-results $(BUILD_DIR)/bench/results.json \
+		--json $(BUILD_DIR)/bench/torch_reference.json
 
 # Sanitizer run (AddressSanitizer + UndefinedBehaviorSanitizer, CMakePresets "asan"): builds only
 # the unit-test binaries of the modules that read files and do the rendering arithmetic (a full

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Installs every Debian package ICEF needs to build, test and run. Idempotent; run as root on
-# Debian 12 (or with sudo). Skips apt entirely when everything is already present.
+# Installs every Debian package ICEF needs to build, test and run (with --bench: and to run
+# `make bench`). Idempotent; run as root on Debian 12 (or with sudo). Skips apt entirely when everything is already present.
 set -euo pipefail
 
 PACKAGES=(
@@ -14,6 +14,8 @@ PACKAGES=(
   libdlib-dev libdlib-data opencv-doc python3-skimage python-matplotlib-data  # eval: face alignment, test photos
   gnuplot-nox  # bench: report plots (PNG + SVG)
 )
+# --bench: also what `make bench` compares against (PyTorch, for scripts/torch_reference_bench.py).
+if [ "${1:-}" = "--bench" ]; then PACKAGES+=(python3-torch libopenblas0-pthread); fi
 
 missing=()
 for p in "${PACKAGES[@]}"; do
