@@ -422,7 +422,9 @@ TEST(EvaluateTest, TrainingFitFaceRegionIsTheLandmarkHull) {
     EXPECT_TRUE(f.render_path.empty());
     ASSERT_TRUE(f.psnr.has_value());
     EXPECT_LT(*f.psnr, 15.0) << f.file_path;  // at least 0.5 off on every channel outside the hull
-    if (f.face_psnr) EXPECT_GT(*f.face_psnr, 50.0) << f.file_path;  // null: identical (infinite)
+    if (f.face_psnr) {
+      EXPECT_GT(*f.face_psnr, 50.0) << f.file_path;  // null: identical (infinite)
+    }
   }
   // Only the training views were changed: the test frames' numbers are those of the original.
   const Result<EvalResult> reference = EvaluateModel(model, original, options, EvalNetworks{}, executor, nullptr);

@@ -337,7 +337,9 @@ TEST(AvatarModelTest, Bf16InferenceRendersCloseToFp32) {
   }
   EXPECT_LT(max_diff, 0.03);
   EXPECT_GT(-10 * std::log10(std::max(mse, 1e-20)), 40.0);
-  if (nn::Bf16Supported()) EXPECT_GT(max_diff, 0.0);
+  if (nn::Bf16Supported()) {
+    EXPECT_GT(max_diff, 0.0);
+  }
 }
 
 TEST(AvatarModelTest, TrainLossGradientMatchesFiniteDifferences) {
