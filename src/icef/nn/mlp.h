@@ -48,7 +48,7 @@ struct MlpOptions {
   bool bf16_inference = false;
   // Training passes too: the forward pass kept for the backward pass, the backward data products
   // and the weight gradients multiply in BF16 with FP32 sums (the weights, their gradients and
-  // Adam stay FP32); layers whose widths are not multiples of 16 stay FP32.
+  // Adam stay FP32); products whose output width is not a multiple of 16 stay FP32.
   bool bf16_training = false;
 
   Status Validate() const;
