@@ -34,7 +34,7 @@ Status WriteSweepComparison(const synth::HeadModel& head, const Camera& camera, 
     for (int y = 0; y < truth.height; ++y)
       for (int x = 0; x < truth.width; ++x)
         for (int c = 0; c < 3; ++c) pair.At(render.width + x, y, c) = truth.At(x, y, c);
-    char name[32];
+    char name[48];  // "compare_" + up to 20 digits + ".png"
     std::snprintf(name, sizeof name, "compare_%03zu.png", i);
     ICEF_RETURN_IF_ERROR(WritePng(dir / name, pair));
     pairs.push_back(std::move(pair));
