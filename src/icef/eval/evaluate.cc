@@ -77,6 +77,7 @@ Json FrameMetrics::ToJson() const {
   j["expr_true_rms"] = OptionalJson(expr_true_rms);
   j["region_psnr"] = OptionalJson(region_psnr);
   j["psnr_neutral_floor"] = OptionalJson(psnr_neutral_floor);
+  j["face_detail"] = OptionalJson(face_detail);
   j["nearest_index"] = nearest_index;
   j["model_delta"] = model_delta;
   j["kappa"] = kappa;
@@ -114,7 +115,8 @@ Result<FrameMetrics> FrameMetrics::FromJson(const Json& j, const std::string& wh
                             std::pair{"expr_corr", &f.expr_corr}, std::pair{"expr_true_rms", &f.expr_true_rms},
                             std::pair{"expr_gain_coarse", &f.expr_gain_coarse},
                             std::pair{"region_psnr", &f.region_psnr},
-                            std::pair{"psnr_neutral_floor", &f.psnr_neutral_floor}}) {
+                            std::pair{"psnr_neutral_floor", &f.psnr_neutral_floor},
+                            std::pair{"face_detail", &f.face_detail}}) {
     if (j.contains(key)) {
       ICEF_ASSIGN_OR_RETURN(*field, OptionalNumber(j, where, key));
     }
@@ -145,6 +147,7 @@ Json TierMetrics::ToJson() const {
   j["expr_gain_coarse"] = OptionalJson(expr_gain_coarse);
   j["region_psnr"] = OptionalJson(region_psnr);
   j["psnr_neutral_floor"] = OptionalJson(psnr_neutral_floor);
+  j["face_detail"] = OptionalJson(face_detail);
   j["expr_count"] = expr_count;
   j["expr_negligible"] = expr_negligible;
   j["id_count"] = id_count;
@@ -171,7 +174,8 @@ Result<TierMetrics> TierMetrics::FromJson(const Json& j, const std::string& wher
   for (auto [key, field] : {std::pair{"id_excess", &t.id_excess}, std::pair{"expr_gain", &t.expr_gain},
                             std::pair{"expr_corr", &t.expr_corr}, std::pair{"region_psnr", &t.region_psnr},
                             std::pair{"expr_gain_coarse", &t.expr_gain_coarse},
-                            std::pair{"psnr_neutral_floor", &t.psnr_neutral_floor}}) {
+                            std::pair{"psnr_neutral_floor", &t.psnr_neutral_floor},
+                            std::pair{"face_detail", &t.face_detail}}) {
     if (j.contains(key)) {
       ICEF_ASSIGN_OR_RETURN(*field, OptionalNumber(j, where, key));
     }
@@ -195,7 +199,7 @@ std::array<TierMetrics, kNumTiers> AggregateTiers(const std::vector<FrameMetrics
   };
   struct TierAcc {
     Acc psnr, ssim, lpips, id_cosine, id_distance, id_distance_gt, under, delta, reference, excess, gain, corr,
-        gain_coarse, region_psnr, floor;
+        gain_coarse, region_psnr, floor, detail;
     int negligible = 0;
   };
   std::array<TierAcc, kNumTiers> acc;
@@ -218,6 +222,7 @@ std::array<TierMetrics, kNumTiers> AggregateTiers(const std::vector<FrameMetrics
     a.gain_coarse.Add(f.expr_gain_coarse);
     a.region_psnr.Add(f.region_psnr);
     a.floor.Add(f.psnr_neutral_floor);
+    a.detail.Add(f.face_detail);
     if (f.expr_true_rms && !f.expr_gain) ++a.negligible;
     if (f.id_distance) a.under.Add(*f.id_distance < kSamePersonThreshold ? 1.0 : 0.0);
   }
@@ -238,6 +243,7 @@ std::array<TierMetrics, kNumTiers> AggregateTiers(const std::vector<FrameMetrics
     m.expr_gain_coarse = a.gain_coarse.Mean();
     m.region_psnr = a.region_psnr.Mean();
     m.psnr_neutral_floor = a.floor.Mean();
+    m.face_detail = a.detail.Mean();
     m.expr_count = a.gain.n;
     m.expr_negligible = a.negligible;
     m.id_count = a.id_distance.n;
@@ -401,16 +407,18 @@ std::string EvalResult::Table() const {
   std::ostringstream s;
   char line[256];
   if (expression_scale != 1) s << "every frame rendered at " << expression_scale << " x its expression\n";
-  std::snprintf(line, sizeof line, "%-9s %5s %7s %7s %6s %6s %9s %9s %11s %10s %9s\n", "tier", "count", "psnr",
-                "floor", "ssim", "lpips", "expr_gain", "expr_corr", "expr_coarse", "region_psnr", "expr_n");
+  std::snprintf(line, sizeof line, "%-9s %5s %7s %7s %6s %6s %9s %9s %11s %10s %9s %11s\n", "tier", "count", "psnr",
+                "floor", "ssim", "lpips", "expr_gain", "expr_corr", "expr_coarse", "region_psnr", "expr_n",
+                "face_detail");
   s << line;
   for (Tier t : AllTiers()) {
     const TierMetrics& m = tiers[TierIndex(t)];
     const std::string expr_n = std::to_string(m.expr_count) + (m.expr_negligible ? "+" + std::to_string(m.expr_negligible) : "");
-    std::snprintf(line, sizeof line, "%-9s %5d %7s %7s %6s %6s %9s %9s %11s %10s %9s\n", TierName(t), m.count,
+    std::snprintf(line, sizeof line, "%-9s %5d %7s %7s %6s %6s %9s %9s %11s %10s %9s %11s\n", TierName(t), m.count,
                   Fmt(m.psnr, "%.2f").c_str(), Fmt(m.psnr_neutral_floor, "%.2f").c_str(), Fmt(m.ssim, "%.3f").c_str(),
                   Fmt(m.lpips, "%.3f").c_str(), Fmt(m.expr_gain, "%.3f").c_str(), Fmt(m.expr_corr, "%.3f").c_str(),
-                  Fmt(m.expr_gain_coarse, "%.3f").c_str(), Fmt(m.region_psnr, "%.2f").c_str(), expr_n.c_str());
+                  Fmt(m.expr_gain_coarse, "%.3f").c_str(), Fmt(m.region_psnr, "%.2f").c_str(), expr_n.c_str(),
+                  Fmt(m.face_detail, "%.2f").c_str());
     s << line;
   }
   std::snprintf(line, sizeof line, "%-9s %9s %7s %10s %7s %9s %7s\n", "tier", "id_cosine", "id_dist", "id_dist_gt",
@@ -683,6 +691,11 @@ Result<EvalResult> EvaluateModel(const AvatarModel& model, const Dataset& datase
     m.psnr = Finite(psnr);
     ICEF_ASSIGN_OR_RETURN(const double ssim, Ssim(render.color, gt));
     m.ssim = Finite(ssim);
+    if (frame.landmarks_2d) {
+      const Image face = FaceRegion(gt.width, gt.height, *frame.landmarks_2d);
+      Result<double> detail = DetailRatio(render.color, gt, &face);
+      if (detail.ok()) m.face_detail = Finite(*detail);
+    }
     if (networks.lpips) {
       ICEF_ASSIGN_OR_RETURN(const double lpips, networks.lpips->Distance(render.color, gt));
       m.lpips = Finite(lpips);

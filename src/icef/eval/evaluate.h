@@ -63,6 +63,10 @@ struct FrameMetrics {
   std::optional<double> expr_gain_coarse;  // expr_gain at the features' scale (eval/expression_fidelity.h)
   std::optional<double> expr_true_rms;  // RMS of ground truth - ground-truth neutral in the region
   std::optional<double> region_psnr;    // PSNR inside the expression region, dB
+  // Fine detail inside the face region (the hull of the frame's landmarks) relative to the truth's
+  // (eval/metrics.h DetailRatio: 1 = as sharp, below 1 = blurred, above 1 = blocks or noise); null
+  // without landmarks.
+  std::optional<double> face_detail;
   // PSNR of the ground-truth neutral of the view against the ground truth: what a model that
   // renders no expression at all would score (null without a neutral image).
   std::optional<double> psnr_neutral_floor;
@@ -96,6 +100,7 @@ struct TierMetrics {
   std::optional<double> expr_gain_coarse;
   std::optional<double> region_psnr;
   std::optional<double> psnr_neutral_floor;
+  std::optional<double> face_detail;         // mean over the frames with landmarks
   int expr_count = 0;                        // frames in the expr_gain mean
   int expr_negligible = 0;                   // frames left out of it: negligible true change
   int id_count = 0;                          // frames with identity metrics

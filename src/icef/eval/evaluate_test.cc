@@ -274,6 +274,10 @@ TEST(EvaluateTest, EvaluatesTinyTrainedModel) {
     const Image gt = CompositeOver(*LoadFrameImage(dataset, frame), dataset.background);
     EXPECT_DOUBLE_EQ(*f.psnr, *Psnr(r.color, gt));
     EXPECT_DOUBLE_EQ(*f.ssim, *Ssim(r.color, gt));
+    // Fine detail inside the face region (the hull of the frame's landmarks).
+    const Image face = FaceRegion(gt.width, gt.height, *frame.landmarks_2d);
+    ASSERT_TRUE(f.face_detail.has_value()) << f.file_path;
+    EXPECT_DOUBLE_EQ(*f.face_detail, *DetailRatio(r.color, gt, &face));
     EXPECT_NEAR(f.model_delta, *frame.delta, 1e-5);
     EXPECT_EQ(f.nearest_index, r.nearest.index);
   }
@@ -286,6 +290,10 @@ TEST(EvaluateTest, EvaluatesTinyTrainedModel) {
   }
   const TierMetrics& far = result->tiers[TierIndex(Tier::kFar)];
   EXPECT_EQ(far.expr_count + far.expr_negligible, far.count);
+  double far_detail = 0;
+  for (const FrameMetrics& f : result->frames) far_detail += f.tier == Tier::kFar ? *f.face_detail : 0.0;
+  ASSERT_TRUE(far.face_detail.has_value());
+  EXPECT_DOUBLE_EQ(*far.face_detail, far_detail / far.count);
   // The training-view fit: every training frame rendered back, with finite values equal to an
   // independent render's; the face region is the hull of the frame's landmarks.
   const TrainingFit& fit = result->train_fit;

@@ -51,8 +51,8 @@ void BindOccupancy(ConfigSchema& s, OccupancyGridOptions* o) {
 
 void BindRender(ConfigSchema& s, ImageRenderOptions* o) {
   s.Int("supersample", &o->supersample,
-        "image renders average s x s rays per pixel (1 = the pixel centre: with train.pixel_jitter the field "
-        "already returns each pixel's average, and averaging again blurs)");
+        "image renders average s x s rays per pixel (1 = the pixel centre, where training rays learn each "
+        "pixel's value; averaging rays around it blurs)");
   s.Number("transmittance_eps", &o->transmittance_eps,
            "renders and evaluation: stop a ray once its transmittance is below this (what is left behind can "
            "change a pixel by at most this fraction: 1e-2 is at most 2.5/255); training composites to "

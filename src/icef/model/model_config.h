@@ -20,9 +20,9 @@ namespace icef {
 
 // Image renders and evaluation (model/render_image.h).
 struct ImageRenderOptions {
-  // s x s rays per pixel, averaged. 1 (the pixel centre): training rays already learn each pixel's
-  // average (train.pixel_jitter), and averaging again blurs; 2 was 0.31 dB worse on the diverse
-  // validation suite (docs/results/priors_validation.md) at 4x the cost.
+  // s x s rays per pixel, averaged. 1 (the pixel centre): training rays through pixel centres
+  // learn each pixel's value there, and averaging around it blurs; 2 was 0.31 dB worse on the
+  // diverse validation suite (docs/results/priors_validation.md) at 4x the cost.
   int supersample = 1;
   double transmittance_eps = 1e-2;  // stop a ray once its transmittance is below this
 

@@ -34,7 +34,9 @@ void TrainConfig::Bind(ConfigSchema& s) {
   s.Bool("random_background", &random_background,
          "composite targets over a random colour per ray, rendered over the same (images with alpha only)");
   s.Bool("pixel_jitter", &pixel_jitter,
-         "cast each training ray through a random point of its pixel (the targets are pixel averages)");
+         "cast each training ray through a random point of its pixel instead of its centre (off: the field "
+         "then learns each pixel's average over the whole pixel, and a render at the centre averages the "
+         "truth's pixel a second time: softer faces, -0.28 dB held-out on the validation identities)");
   s.Int("grid_anneal_steps", &grid_anneal_steps,
         "coarse-to-fine hash grid: levels beyond the 4 coarsest switch on over these steps (0 = off)");
   s.Int("anneal_steps", &anneal_steps, "coarse-to-fine: deformation frequencies switch on over these steps (0 = off)");

@@ -36,7 +36,11 @@ struct TrainConfig {
   double lambda_symmetry = 0.1;      // weight of the left-right symmetry prior L_sym (0 = off)
   double symmetry_colour = LossWeights{}.symmetry_colour;  // weight of L_sym's colour part relative to its opacity part
   int symmetry_max_samples = LossWeights{}.symmetry_max_samples;  // samples per step mirrored by L_sym
-  bool pixel_jitter = true;          // training rays through random points of their pixels
+  // Training rays through random points of their pixels (true) or through the centres (false, the
+  // default: a jittered ray learns its pixel's average at every point of the pixel, so a render at
+  // the centre shows the truth's pixel averaged a second time, and the face comes out soft;
+  // docs/results/priors_validation.md, 2026-11-25).
+  bool pixel_jitter = false;
   bool random_background = true;     // train over random background colours (images with alpha only)
   int grid_anneal_steps = kDefaultGridAnnealSteps;  // coarse-to-fine hash grid: levels beyond the 4 coarsest switch on over these steps (0 = off)
   int anneal_steps = kDefaultAnnealSteps;  // coarse-to-fine: deformation frequencies are switched on over these steps (0 = off)
