@@ -10,6 +10,7 @@
 #include <cstdlib>
 
 #include "icef/core/progress.h"
+#include "icef/eval/training_view_sheet.h"
 
 #include "icef/io/atomic_file.h"
 #include "icef/model/method.h"
@@ -626,14 +627,24 @@ std::optional<WorstIdentity> FindWorstIdentity(const std::vector<IdentityRow>& r
   return worst;
 }
 
-std::string WorstIdentityLine(const std::optional<WorstIdentity>& w, const std::string& what) {
+std::string WorstIdentityLine(const std::optional<WorstIdentity>& w, const std::string& what,
+                              const std::map<std::string, std::string>& run_sheets) {
   if (!w) return "**Worst identity by " + what + "**: no values.";
   char buf[320];
   std::snprintf(buf, sizeof buf,
                 "**Worst identity by %s**: seed %llu (mean %.2f dB over its %d run%s; lowest run `%s`, %.2f dB).",
                 what.c_str(), static_cast<unsigned long long>(w->seed), w->mean, w->runs, w->runs == 1 ? "" : "s",
                 w->worst_run->id.Name().c_str(), w->worst_value);
-  return buf;
+  std::string line = buf;
+  const auto sheet = run_sheets.find(w->worst_run->id.Name());
+  if (sheet != run_sheets.end())
+    line += " Its training views, truth left and render right: [" + sheet->second + "](" + sheet->second + ")";
+  return line;
+}
+
+// The worst identities of a per-identity report: by training-view face PSNR, then by observed PSNR.
+std::array<std::optional<WorstIdentity>, 2> WorstIdentities(const std::vector<IdentityRow>& rows) {
+  return {FindWorstIdentity(rows, &IdentityRow::train_face_psnr), FindWorstIdentity(rows, &IdentityRow::observed_psnr)};
 }
 
 }  // namespace
@@ -787,10 +798,9 @@ std::string ReportMarkdown(const Aggregate& a, const std::vector<RunRecord>& run
         << Opt(row.train_face_detail, "%.2f") << " | " << Opt(row.observed_psnr, "%.2f") << " | "
         << Opt(row.far_psnr, "%.2f") << " | " << Opt(row.observed_region_psnr, "%.2f") << " | "
         << Opt(row.observed_id_distance_gt, "%.3f") << " | " << Opt(row.far_expr_gain, "%.3f") << " |\n";
-    const auto worst_fit = FindWorstIdentity(rows, &IdentityRow::train_face_psnr);
-    const auto worst_psnr = FindWorstIdentity(rows, &IdentityRow::observed_psnr);
-    s << "\n- " << WorstIdentityLine(worst_fit, "training-view face PSNR") << "\n- "
-      << WorstIdentityLine(worst_psnr, "observed PSNR") << "\n";
+    const auto [worst_fit, worst_psnr] = WorstIdentities(rows);
+    s << "\n- " << WorstIdentityLine(worst_fit, "training-view face PSNR", ctx.run_sheets) << "\n- "
+      << WorstIdentityLine(worst_psnr, "observed PSNR", ctx.run_sheets) << "\n";
   }
   if (!plots.empty()) {
     s << "\n## Plots\n\nEach metric against delta (x = mean delta of each tier), one line per method, error bars "
@@ -842,10 +852,15 @@ Json ReportJson(const Aggregate& a, const std::vector<RunRecord>& runs, const Re
   if (ctx.PerIdentity()) {
     const std::vector<RunRecord> pooled = PoolReplicates(runs);
     const std::vector<IdentityRow> rows = IdentityRows(pooled);
-    const auto worst_fit = FindWorstIdentity(rows, &IdentityRow::train_face_psnr);
-    const auto worst_psnr = FindWorstIdentity(rows, &IdentityRow::observed_psnr);
-    j["worst_identity"] = Json{{"train_fit_face_psnr", worst_fit ? worst_fit->ToJson() : Json(nullptr)},
-                               {"observed_psnr", worst_psnr ? worst_psnr->ToJson() : Json(nullptr)}};
+    const auto [worst_fit, worst_psnr] = WorstIdentities(rows);
+    const auto worst_json = [&](const std::optional<WorstIdentity>& w) {
+      if (!w) return Json(nullptr);
+      Json out = w->ToJson();
+      const auto sheet = ctx.run_sheets.find(w->worst_run->id.Name());
+      if (sheet != ctx.run_sheets.end()) out["training_views"] = sheet->second;
+      return out;
+    };
+    j["worst_identity"] = Json{{"train_fit_face_psnr", worst_json(worst_fit)}, {"observed_psnr", worst_json(worst_psnr)}};
   }
   if (!ctx.identity_role.empty()) j["identity_role"] = ctx.identity_role;
   if (ctx.tier_thresholds) j["tier_thresholds"] = *ctx.tier_thresholds;
@@ -1007,6 +1022,15 @@ Result<std::vector<std::string>> WritePlots(const fs::path& dir, const Aggregate
 
 Status WriteReport(const fs::path& dir, const std::vector<RunRecord>& runs, ReportContext context) {
   const Aggregate aggregate = AggregateRuns(runs);
+  if (context.PerIdentity()) {
+    const std::vector<RunRecord> pooled = PoolReplicates(runs);
+    for (const std::optional<WorstIdentity>& w : WorstIdentities(IdentityRows(pooled))) {
+      if (!w) continue;
+      const std::string run = w->worst_run->id.Name();
+      ICEF_ASSIGN_OR_RETURN(const std::optional<std::string> sheet, WriteTrainingViewSheet(dir, run));
+      if (sheet) context.run_sheets[run] = *sheet;
+    }
+  }
   std::string note;
   ICEF_ASSIGN_OR_RETURN(const std::vector<std::string> plots, WritePlots(dir, aggregate, &note));
   if (!note.empty()) context.notes.push_back(note);

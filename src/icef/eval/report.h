@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <optional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -183,6 +184,9 @@ struct ReportContext {
   // identity_role starts with "validation".
   bool per_identity = false;
   bool PerIdentity() const;
+  // Run name -> a picture of its training views beside their truth, relative to the report's
+  // directory (WriteReport makes one for each worst identity's lowest run; eval/training_view_sheet.h).
+  std::map<std::string, std::string> run_sheets;
 };
 
 // The verdict lines (markdown bullets): per novel tier, icef against the baselines (warp, nerface)

@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "icef/io/atomic_file.h"
+#include "icef/io/image.h"
 
 namespace icef::eval {
 namespace {
@@ -362,6 +363,47 @@ TEST(ReportTest, TrainingViewFitAndPerIdentityTable) {
   EXPECT_EQ(old_md.find("training-view fit\n\n| method"), std::string::npos) << old_md;
   EXPECT_NE(old_md.find("| id2_k3_warp | 100 | 2.0s | 0.5s | 2 | 0 | - |"), std::string::npos) << old_md;
   EXPECT_NE(old_md.find("**Worst identity by training-view face PSNR**: no values."), std::string::npos) << old_md;
+}
+
+TEST(ReportTest, WorstIdentityLinksItsTrainingViewsBesideTheirTruth) {
+  // Bench runs with icef eval's training-view pairs for the worst run by training-view fit
+  // (id2_k3_warp) only; the worst run by observed PSNR (id1_k3_icef) has none.
+  const fs::path dir = TempDir("worst");
+  std::vector<RunRecord> runs = ThreeIdentities();
+  const double fit[] = {30, 33, 35, 32, 24, 34};
+  for (size_t i = 0; i < runs.size(); ++i) runs[i] = WithTrainFit(runs[i], fit[i]);
+  const fs::path renders = dir / "runs" / "id2_k3_warp" / "renders";
+  fs::create_directories(renders);
+  ASSERT_TRUE(WritePng(renders / "fit_train_000_vs_truth.png", Image(4, 2, 3, 0.5f)).ok());
+  ASSERT_TRUE(WritePng(renders / "fit_train_001_vs_truth.png", Image(4, 2, 3, 0.25f)).ok());
+  ReportContext validation;
+  validation.identity_role = "validation identities: for tuning";
+  ASSERT_TRUE(WriteReport(dir, runs, validation).ok());
+
+  const Result<Image> sheet = ReadImage(dir / "worst_id2_k3_warp_training_views.png");
+  ASSERT_TRUE(sheet.ok()) << sheet.status().message();
+  EXPECT_EQ(sheet->height, 4);
+  EXPECT_FALSE(fs::exists(dir / "worst_id1_k3_icef_training_views.png"));
+  const Result<std::string> md = ReadFile(dir / "report.md");
+  ASSERT_TRUE(md.ok());
+  EXPECT_NE(md->find("lowest run `id2_k3_warp`, 24.00 dB). Its training views, truth left and render right: "
+                     "[worst_id2_k3_warp_training_views.png](worst_id2_k3_warp_training_views.png)"),
+            std::string::npos)
+      << *md;
+  EXPECT_NE(md->find("lowest run `id1_k3_icef`, 30.00 dB).\n"), std::string::npos) << *md;
+  const Result<Json> json = ReadJsonFile(dir / "report.json");
+  ASSERT_TRUE(json.ok());
+  EXPECT_EQ((*json)["worst_identity"]["train_fit_face_psnr"]["training_views"], "worst_id2_k3_warp_training_views.png");
+  EXPECT_FALSE((*json)["worst_identity"]["observed_psnr"].contains("training_views"));
+
+  // A test bench has no worst identity and writes no sheet.
+  const fs::path test_dir = TempDir("worst_test_bench");
+  fs::create_directories(test_dir / "runs");
+  fs::copy(dir / "runs", test_dir / "runs", fs::copy_options::recursive);
+  ASSERT_TRUE(WriteReport(test_dir, runs, ReportContext()).ok());
+  EXPECT_FALSE(fs::exists(test_dir / "worst_id2_k3_warp_training_views.png"));
+  fs::remove_all(dir);
+  fs::remove_all(test_dir);
 }
 
 TEST(ReportTest, RunRecordErrors) {
