@@ -8,7 +8,7 @@ set grid
 set key top left box opaque
 set offsets 0.05, 0.05, 0, 0
 set title "K = 5"
-plot 'id_share_under_0_6.dat' index 0 using 1:2:3 with yerrorlines lw 2 pt 7 title "icef"
+plot 'id_share_under_0_6.dat' index 0 using 1:2:3 with yerrorlines lw 2 pt 7 title "icef", 'id_share_under_0_6.dat' index 1 using 1:2:3 with yerrorlines lw 2 pt 7 title "icef-prior"
 unset multiplot
 set terminal svg noenhanced size 460,420 font "sans,9"
 set output "id_share_under_0_6.svg"
@@ -19,5 +19,5 @@ set grid
 set key top left box opaque
 set offsets 0.05, 0.05, 0, 0
 set title "K = 5"
-plot 'id_share_under_0_6.dat' index 0 using 1:2:3 with yerrorlines lw 2 pt 7 title "icef"
+plot 'id_share_under_0_6.dat' index 0 using 1:2:3 with yerrorlines lw 2 pt 7 title "icef", 'id_share_under_0_6.dat' index 1 using 1:2:3 with yerrorlines lw 2 pt 7 title "icef-prior"
 unset multiplot
