@@ -46,7 +46,7 @@ CommandFn RegisterEval(CLI::App& app) {
   app.add_option(
       "--set", o->overrides,
       "Override an inference-only model key, model.KEY=VALUE with KEY render.supersample, "
-      "sampler.num_samples, "
+      "render.sample_factor, sampler.num_samples, "
       "render.transmittance_eps or bf16_inference (repeatable; keys fixed by training are refused)");
   app.add_option("--threads", *threads, "Worker threads (0 = all cores)")->capture_default_str();
   return [o, threads]() -> Status {

@@ -37,7 +37,7 @@ CommandFn RegisterRender(CLI::App& app) {
   app.add_option(
       "--set", o->overrides,
       "Override an inference-only model key, model.KEY=VALUE with KEY render.supersample, "
-      "sampler.num_samples, "
+      "render.sample_factor, sampler.num_samples, "
       "render.transmittance_eps or bf16_inference (repeatable; keys fixed by training are refused)");
   return [=]() -> Status {
     RenderAppOptions opts = *o;

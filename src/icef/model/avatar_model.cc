@@ -281,7 +281,7 @@ void AvatarModel::Render(std::span<const Ray> rays, std::span<const float> beta,
   constexpr int64_t kChunk = 1 << 14;
   for (int64_t r0 = 0; r0 < total_rays; r0 += kChunk) {
     const int64_t nr = std::min(kChunk, total_rays - r0);
-    SampleRays(rays.subspan(r0, nr), setup_.aabb, config_.SamplerOptions(false), occupancy ? occupancy : &occupancy_,
+    SampleRays(rays.subspan(r0, nr), setup_.aabb, config_.RenderSamplerOptions(), occupancy ? occupancy : &occupancy_,
                0, 0, executor, &ws.samples);
     RayMarch march;
     march.Start(ws.samples, 2);  // extras: the region mask M(x) and the warp's length ||D_final(x) - x||

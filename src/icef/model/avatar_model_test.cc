@@ -221,6 +221,47 @@ TEST(RenderImageTest, SupersamplingAveragesSubpixelRays) {
   EXPECT_GT(max_spread, 1e-3);  // the sub-pixel rays really saw different things
 }
 
+// Renders sample each ray render.sample_factor times as densely as training does.
+TEST(RenderImageTest, RendersSampleTheFactorTimesTheTrainingCount) {
+  ModelConfig config = TinyModelConfig("icef");
+  config.static_field.density_bias = -8.f;  // nearly empty: no ray stops early, every sample is evaluated
+  EXPECT_EQ(config.RenderSamplerOptions().num_samples, 2 * config.sampler.num_samples);  // the default
+  EXPECT_FALSE(config.RenderSamplerOptions().stratified);
+  const Intrinsics in{.width = 4, .height = 3, .fl_x = 4, .fl_y = 4, .cx = 2, .cy = 1.5};
+  Mat4d pose = Mat4d::Identity();
+  pose(2, 3) = 2.0;
+  const Camera cam(in, pose);
+  const std::vector<float> beta = {0.1f, 0.f, 0.2f};
+  std::vector<Ray> rays;
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 4; ++i) rays.push_back(cam.RayThrough(i + 0.5, j + 0.5));
+  int64_t evaluated[2] = {0, 0};
+  for (int f : {1, 3}) {
+    config.render.sample_factor = f;
+    ASSERT_TRUE(config.Validate().ok());
+    auto created = AvatarModel::Create(config, TinySetup(), Executor(1));
+    ASSERT_TRUE(created.ok()) << created.status().message();
+    (*created)->Initialize(5);
+    RenderOutput out;
+    (*created)->Render(rays, beta, Vec3f(1, 1, 1), Executor(1), &out);
+    evaluated[f == 1 ? 0 : 1] = out.samples_evaluated;
+  }
+  EXPECT_GT(evaluated[0], 0);
+  EXPECT_EQ(evaluated[1], 3 * evaluated[0]);
+  // Marching mode: steps shrink by the factor.
+  config.sampler.step_size = 0.03f;
+  config.sampler.cone_angle = 0.004f;
+  EXPECT_FLOAT_EQ(config.RenderSamplerOptions().step_size, 0.01f);
+  EXPECT_FLOAT_EQ(config.RenderSamplerOptions().cone_angle, 0.004f / 3);
+  EXPECT_EQ(config.RenderSamplerOptions().max_samples, 3 * config.sampler.max_samples);
+  for (int bad : {0, 9}) {
+    config.render.sample_factor = bad;
+    const Status v = config.Validate();
+    ASSERT_FALSE(v.ok()) << bad;
+    EXPECT_NE(v.message().find("render.sample_factor"), std::string::npos) << v.message();
+  }
+}
+
 // Large images render in bands of rows; every pixel must match a render of its own rays.
 TEST(RenderImageTest, BandedRenderMatchesPerPixelRays) {
   ModelConfig config = TinyModelConfig("icef");
@@ -276,7 +317,7 @@ TEST(AvatarModelTest, RenderEqualsCompositingEverySampleWhileSkippingOccludedOne
     model.Render(rays, beta, Vec3f(1, 1, 1), ex, &out);
 
     RaySamples samples;
-    SampleRays(rays, model.setup().aabb, config.SamplerOptions(false), &model.occupancy(), 0, 0, ex, &samples);
+    SampleRays(rays, model.setup().aabb, config.RenderSamplerOptions(), &model.occupancy(), 0, 0, ex, &samples);
     const int64_t n = samples.size();
     std::vector<float> dirs(3 * n), offsets(3 * n, 0.f), canonical(samples.positions), sigma(n), rgb(3 * n);
     for (int64_t r = 0; r < samples.num_rays(); ++r)

@@ -57,6 +57,9 @@ void BindRender(ConfigSchema& s, ImageRenderOptions* o) {
            "renders and evaluation: stop a ray once its transmittance is below this (what is left behind can "
            "change a pixel by at most this fraction: 1e-2 is at most 2.5/255); training composites to "
            "compositing.transmittance_eps");
+  s.Int("sample_factor", &o->sample_factor,
+        "renders and evaluation place this many times sampler.num_samples samples per ray (marching: steps "
+        "this many times shorter); the training count's midpoints step over surfaces a warp compresses");
 }
 
 // The flat keys of configs and checkpoints written before the blocks, and their current paths.
@@ -145,6 +148,9 @@ Status ModelConfig::Validate() const {
     return Status::Error("render.supersample must be in 1..8");
   if (!(render.transmittance_eps >= 0.0 && render.transmittance_eps < 1.0))
     return Status::Error("render.transmittance_eps must be in [0, 1)");
+  if (render.sample_factor < 1 || render.sample_factor > 8)
+    return Status::Error("render.sample_factor must be in 1..8");
+  ICEF_RETURN_IF_ERROR(RenderSamplerOptions().Validate().WithContext("render.sample_factor"));
   return Status::Ok();
 }
 
@@ -169,6 +175,16 @@ DeformationFieldOptions ModelConfig::DeformationOptions() const {
 RaySamplerOptions ModelConfig::SamplerOptions(bool stratified) const {
   RaySamplerOptions o = sampler;
   o.stratified = stratified;
+  return o;
+}
+
+RaySamplerOptions ModelConfig::RenderSamplerOptions() const {
+  RaySamplerOptions o = SamplerOptions(false);
+  const int f = render.sample_factor;
+  o.num_samples *= f;
+  o.max_samples *= f;
+  o.step_size /= static_cast<float>(f);
+  o.cone_angle /= static_cast<float>(f);
   return o;
 }
 

@@ -36,8 +36,9 @@ Result<int64_t> ParseCheckpointStep(const std::string& trainer_text, const std::
 }
 
 const std::vector<std::string>& InferenceModelKeys() {
-  static const std::vector<std::string> keys = {"render.supersample", "sampler.num_samples",
-                                                "render.transmittance_eps", "bf16_inference"};
+  static const std::vector<std::string> keys = {"render.supersample", "render.sample_factor",
+                                                "sampler.num_samples", "render.transmittance_eps",
+                                                "bf16_inference"};
   return keys;
 }
 

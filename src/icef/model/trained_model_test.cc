@@ -171,12 +171,14 @@ TEST(TrainedModel, InferenceOverridesChangeTheLoadedConfig) {
   Result<TrainedModel> loaded =
       LoadTrainedModel(path, Executor(1),
                        {"model.render.supersample=3", "model.render.transmittance_eps=0.001",
-                        "model.bf16_inference=false", "model.sampler.num_samples=24"});
+                        "model.bf16_inference=false", "model.sampler.num_samples=24",
+                        "model.render.sample_factor=1"});
   ASSERT_TRUE(loaded.ok()) << loaded.status().message();
   EXPECT_EQ(loaded->config.render.supersample, 3);
   EXPECT_EQ(loaded->config.render.transmittance_eps, 0.001);
   EXPECT_FALSE(loaded->config.bf16_inference);
   EXPECT_EQ(loaded->config.sampler.num_samples, 24);
+  EXPECT_EQ(loaded->config.render.sample_factor, 1);
   EXPECT_EQ(loaded->model->config().render.supersample, 3);  // the model is built from it
   EXPECT_EQ(loaded->model->config().sampler.num_samples, 24);
   EXPECT_EQ(loaded->config.static_field.grid.num_levels,
