@@ -29,11 +29,15 @@ struct Subject {
   // The same model loaded as `icef render --set model.render.transmittance_eps=1e-4` would: renders
   // composite rays as deep as training does (the render threshold's before/after).
   std::unique_ptr<icef::AvatarModel> deep;
+  // The same model sampling rays at the training count (`--set model.render.sample_factor=1`, the
+  // renders before the default became 2).
+  std::unique_ptr<icef::AvatarModel> sparse;
   std::string error;
   std::filesystem::path dir;  // removed at exit
   ~Subject() {
     trainer.reset();
     deep.reset();
+    sparse.reset();
     std::error_code ec;
     if (!dir.empty()) std::filesystem::remove_all(dir, ec);
   }
@@ -57,6 +61,9 @@ icef::Status Train(Subject* s) {
       icef::TrainedModel deep,
       icef::LoadTrainedModel(dir / "model", icef::Executor(2), {"model.render.transmittance_eps=1e-4"}));
   s->deep = std::move(deep.model);
+  ICEF_ASSIGN_OR_RETURN(icef::TrainedModel sparse,
+                        icef::LoadTrainedModel(dir / "model", icef::Executor(2), {"model.render.sample_factor=1"}));
+  s->sparse = std::move(sparse.model);
   return icef::Status::Ok();
 }
 
@@ -78,14 +85,16 @@ const icef::Frame& FarFrame(const Subject& s) {
 }
 
 // Arg: 0 = the grid of the rendered expression (default), 1 = the training grid, 2 = the default
-// grid with rays composited to the training threshold 1e-4 instead of model.render.transmittance_eps.
+// grid with rays composited to the training threshold 1e-4 instead of model.render.transmittance_eps,
+// 3 = the default grid with rays sampled at the training count (model.render.sample_factor = 1).
 void BM_RenderImage128(benchmark::State& state) {
   const Subject& s = TrainedSubject();
   if (!s.error.empty()) return state.SkipWithError(s.error.c_str());
   const icef::Frame& frame = FarFrame(s);
   const icef::Executor executor(2);
   const auto mode = state.range(0) == 1 ? icef::RenderOccupancyMode::kTraining : icef::RenderOccupancyMode::kExpression;
-  const icef::AvatarModel& model = state.range(0) == 2 ? *s.deep : s.trainer->model();
+  const icef::AvatarModel& model =
+      state.range(0) == 2 ? *s.deep : state.range(0) == 3 ? *s.sparse : s.trainer->model();
   int64_t samples = 0;
   for (auto _ : state) {
     const icef::RenderedImage img =
@@ -95,7 +104,7 @@ void BM_RenderImage128(benchmark::State& state) {
   state.counters["frames/s"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
   state.counters["samples/frame"] = static_cast<double>(samples) / static_cast<double>(state.iterations());
 }
-BENCHMARK(BM_RenderImage128)->ArgName("variant")->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_RenderImage128)->ArgName("variant")->Arg(0)->Arg(1)->Arg(2)->Arg(3)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // A 256x256 frame of the same view (intrinsics scaled by 2).
 void BM_RenderImage256(benchmark::State& state) {
