@@ -90,6 +90,11 @@ def evaluate_seed(icef, out, seed, photos, res, extra, synth_extra):
                      "true_expression": te.tolist(), "tracked_expression": pe.tolist(),
                      "mask_iou": iou, "landmark_rms_iod": p["landmark_rms_iod"],
                      "true_pose_deg": t.get("head_pose_deg")})
+    # The shape scales against the identity's true ones (truth.json "shape"), RMS over the 13.
+    if "shape" in truth:
+        err = [report["shape"][k] - v for k, v in truth["shape"].items()]
+        for r in rows:
+            r["shape_rms"] = float(np.sqrt(np.mean(np.square(err))))
     skipped = [{"seed": seed, "skipped": s} for s in report["skipped"]]
     return rows, skipped
 
@@ -113,7 +118,7 @@ def main():
         rows += r
         skipped += s
     keys = ["rotation_deg", "translation_frac", "expression_rms", "expression_rms_seen", "expression_rms_neutral",
-            "mask_iou", "landmark_rms_iod"]
+            "mask_iou", "landmark_rms_iod"] + (["shape_rms"] if rows and "shape_rms" in rows[0] else [])
     summary = {k: {"median": median([r[k] for r in rows]), "max": max(r[k] for r in rows),
                    "min": min(r[k] for r in rows)} for k in keys}
     # How much of the expressions the tracker finds: correlation of the tracked with the true weights

@@ -57,7 +57,7 @@ Result<DetectorCalibration> CalibrateDetector(const std::vector<uint64_t>& seeds
       for (double yaw : kYaws) {
         const Camera camera = synth::OrbitCamera(k, kDistance, yaw, pitch);
         const Image image = CompositeOver(synth::RenderGroundTruth(head, camera, neutral, executor, ro), ro.background);
-        const Result<FaceDetection> d = detector.DetectFace(image);
+        const Result<FaceDetection> d = detector.DetectFace(image, /*averaged=*/true);  // as the tracker detects
         if (!d.ok() || d->num_faces != 1) continue;
         ++views;
         const std::array<float, 4> f = track::ViewFeatures(camera.Center().cast<float>());

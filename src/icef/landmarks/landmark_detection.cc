@@ -41,7 +41,7 @@ Status LandmarkDetectionOptions::Validate() const {
 std::string LandmarkDetectionOptions::ToString() const {
   std::string s = "LandmarkDetectionOptions(splits=";
   for (size_t i = 0; i < splits.size(); ++i) s += (i ? "," : "") + splits[i];
-  return s + ", overwrite=" + (overwrite ? "true" : "false") +
+  return s + ", overwrite=" + (overwrite ? "true" : "false") + ", averaged=" + (averaged ? "true" : "false") +
          ", predictor=" + (predictor_path.empty() ? std::string(kDefaultShapePredictorPath) : predictor_path.string()) +
          ")";
 }
@@ -149,7 +149,7 @@ Result<LandmarkDetectionReport> DetectDatasetLandmarks(
         errors[j] = image.status();
         continue;
       }
-      Result<FaceDetection> face = detectors[thread].DetectFace(*image);
+      Result<FaceDetection> face = detectors[thread].DetectFace(*image, options.averaged);
       if (face.ok()) {
         out.outcome = LandmarkOutcome::kDetected;
         out.detection = std::move(face).value();

@@ -27,6 +27,8 @@ struct LandmarkDetectionOptions {
   bool overwrite = false;
   // dlib 68-point shape predictor; empty: kDefaultShapePredictorPath.
   std::filesystem::path predictor_path;
+  // FaceLandmarkDetector::DetectFace's averaged landmarks (icef track's) instead of one run's.
+  bool averaged = false;
   Status Validate() const;
   std::string ToString() const;
 };

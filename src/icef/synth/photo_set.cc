@@ -340,6 +340,11 @@ Json PhotoSetTruthJson(const PhotoSetOptions& options, const std::vector<SynthPh
   doc["options"] = options.ToJson();
   doc["style_file"] = kStyleInfoFile;
   doc["expression_names"] = face::ExpressionNames();
+  // The identity's true shape scales (kShapeParamNames order), for judging a tracker's shape fit.
+  Json shape = Json::object();
+  const std::array<float, face::ShapeParams::kCount> scales = PhotoSetIdentity(options).shape.ToArray();
+  for (int i = 0; i < face::ShapeParams::kCount; ++i) shape[face::kShapeParamNames[i]] = JsonFloat(scales[i]);
+  doc["shape"] = std::move(shape);
   Json list = Json::array();
   for (int i = 0; i < static_cast<int>(photos.size()); ++i) {
     const SynthPhoto& p = photos[i];

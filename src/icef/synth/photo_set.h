@@ -108,7 +108,8 @@ Result<std::vector<SynthPhoto>> RenderPhotoSet(const PhotoSetOptions& options, c
 
 // Writes, atomically, under out_dir (created): photos/photo_NNN.png (RGB), truth/alpha_NNN.png
 // (grey), truth/truth.json (kPhotoTruthFile: the options, then per photo its files, intrinsics,
-// camera_to_head 4x4, head pose, expression by name, landmarks_2d, visibility and landmarks_3d) and
+// camera_to_head 4x4, head pose, expression by name, landmarks_2d, visibility and landmarks_3d; and
+// the identity's true shape scales by name, "shape") and
 // style.json (kStyleInfoFile, as SynthesizeDataset writes it).
 inline constexpr char kPhotoTruthFile[] = "truth/truth.json";
 Status WritePhotoSet(const PhotoSetOptions& options, const std::vector<SynthPhoto>& photos,

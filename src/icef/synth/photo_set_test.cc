@@ -267,6 +267,11 @@ TEST(PhotoSetTest, WritesPhotosAlphaTruthAndStyle) {
   for (int r = 0; r < 4; ++r)
     for (int c = 0; c < 4; ++c) EXPECT_EQ(p1["camera_to_head"][r][c].get<double>(), m(r, c));
   EXPECT_DOUBLE_EQ(p1["fl_x"].get<double>(), SmallPhotos()[1].camera.intrinsics().fl_x);
+  // The identity's true shape scales, by name.
+  const auto scales = IdentityParams::FromSeed(o.identity_seed).shape.ToArray();
+  ASSERT_EQ((*truth)["shape"].size(), size_t(face::ShapeParams::kCount));
+  for (int i = 0; i < face::ShapeParams::kCount; ++i)
+    EXPECT_NEAR((*truth)["shape"][face::kShapeParamNames[i]].get<double>(), scales[i], 1e-6) << face::kShapeParamNames[i];
   const Result<Json> style = ReadJsonFile(dir / kStyleInfoFile);
   ASSERT_TRUE(style.ok()) << style.status().message();
   EXPECT_EQ((*style)["identity_seed"], 3);

@@ -56,6 +56,7 @@ Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions
     LandmarkDetectionOptions lo;
     lo.predictor_path = options.predictor_path;
     lo.overwrite = true;
+    lo.averaged = true;  // as icef track detects (and as detector_landmarks.inc was measured)
     if (log) log("detecting the landmarks of every frame (dlib)");
     ICEF_ASSIGN_OR_RETURN(const LandmarkDetectionReport report, DetectDatasetLandmarks(source, lo, executor));
     for (const FrameLandmarks& fl : report.frames) {

@@ -1,7 +1,7 @@
 // dlib's landmark convention on the face model. The face model's 68 landmarks are where its own
 // design puts them (the synthetic ground truth uses them); dlib's detector, run on renders of the
-// same head, puts some elsewhere: its jaw line follows the silhouette up to the temples, its brows
-// sit lower, its mouth corners wider. The tracker fits the model to dlib's landmarks, so it moves
+// same head (DetectFace averaged, as the tracker runs it), puts some elsewhere: its jaw line
+// follows the silhouette up to the temples, its brows sit lower, its mouth corners wider. The tracker fits the model to dlib's landmarks, so it moves
 // each landmark's canonical point by the offset measured here before the expression warp
 // (face::FaceModel::Landmarks with offsets). The offset depends on the view (dlib's jaw line is
 // the silhouette, its eye corners and nose drift as the head turns): it is linear in

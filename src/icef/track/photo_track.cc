@@ -58,7 +58,7 @@ Result<std::vector<Detected>> DetectAll(const std::vector<fs::path>& photos, con
       }
       const Image upright = Oriented(*image, ExifOrientation(photos[i]));
       out[i].photo = upright.HasAlpha() ? CompositeOver(upright, Vec3f::Ones()) : upright;
-      out[i].detection = local.DetectFace(out[i].photo);
+      out[i].detection = local.DetectFace(out[i].photo, /*averaged=*/true);
     }
   });
   for (size_t i = 0; i < photos.size(); ++i)

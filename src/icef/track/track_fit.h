@@ -38,7 +38,9 @@ struct TrackFrame {
 
 // The defaults were chosen on synthetic photos of validation identities 101-106 (scripts/track_eval.py).
 struct TrackFitOptions {
-  double landmark_sigma_iod = 0.06;     // landmark noise the priors are balanced against (IOD): dlib's, on our head
+  // Landmark noise the priors are balanced against (IOD): dlib's averaged landmarks' scatter on our
+  // head around detector_landmarks.inc (2.5 px at 360x480, about 0.05 IOD; one run's: 2.9 px, 0.06).
+  double landmark_sigma_iod = 0.05;
   double shape_prior_sigma = 0.1;       // std of each shape scale around 1
   double expression_prior_sigma = 0.3;  // std of each expression weight around 0 (neutral)
   double max_expression = 1.5;          // upper bound of the weights (lower bound 0)
