@@ -52,10 +52,10 @@ class FaceLandmarkDetector {
   static constexpr double kAveragedShift = 0.04;
 
   // DetectFace(image)->landmarks.
+  Result<std::vector<Vec2f>> Detect(const Image& image) const;
 
   // The iBUG-68 index of each landmark's mirror image (left and right swapped): 0 <-> 16, 36 <-> 45, ...
   static const std::array<int, 68>& MirrorIndex();
-  Result<std::vector<Vec2f>> Detect(const Image& image) const;
 
  private:
   struct Impl;
