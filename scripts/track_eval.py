@@ -8,13 +8,18 @@ with truth/truth.json:
 
 - rotation error: angle between the tracked and the true camera-to-head rotations (degrees);
 - translation error: distance between the tracked and the true position of the head (the head
-  frame's origin) in the camera frame, over the head's crown-to-chin height;
+  frame's origin) in the camera frame, over the head's crown-to-chin height; split into its part
+  along the line of sight (depth: with a known focal length, a head fitted x % too large is fitted
+  x % too far, so this part carries the size error the shape prior leaves) and its part across it
+  (lateral: where the head is in the image); `distance_ratio` is the tracked over the true
+  camera-to-head distance;
 - expression error: RMS over the 11 weights, and over the 10 the 68 landmarks can see (cheek_puff
   moves none of them), beside what predicting neutral would score; and the correlation of the
   tracked with the true weights over all photos;
 - mask IoU: the dataset image's alpha against the true coverage cropped the same way.
 
-Usage: scripts/track_eval.py --icef build/icef --out DIR [--seeds 1,2,3] [--photos 5] [--res 256]
+Usage: scripts/track_eval.py --icef build/icef --out DIR [--seeds 1,2,3] [--photos 5] [--res 256] [--reuse]
+(--reuse: evaluate DIR's photos and datasets as they are, without running icef again)
 Writes DIR/track_eval.json and prints a table; exit 1 when --check bounds are exceeded.
 """
 import argparse
@@ -40,18 +45,20 @@ def median(values):
     return float(np.median(np.asarray(values))) if values else float("nan")
 
 
-def evaluate_seed(icef, out, seed, photos, res, extra, synth_extra):
+def evaluate_seed(icef, out, seed, photos, res, extra, synth_extra, reuse=False):
     photo_dir = os.path.join(out, f"photos_{seed}")
     data_dir = os.path.join(out, f"track_{seed}")
-    for d in (photo_dir, data_dir):
-        subprocess.run(["rm", "-rf", d], check=True)
-    subprocess.run([icef, "synth", "--photos", str(photos), "--identity-seed", str(seed), "--out", photo_dir] + synth_extra,
-                   check=True, stdout=subprocess.DEVNULL)
+    if not reuse:
+        for d in (photo_dir, data_dir):
+            subprocess.run(["rm", "-rf", d], check=True)
+        subprocess.run([icef, "synth", "--photos", str(photos), "--identity-seed", str(seed), "--out", photo_dir] + synth_extra,
+                       check=True, stdout=subprocess.DEVNULL)
     truth = json.load(open(os.path.join(photo_dir, "truth", "truth.json")))
     # The true focal length (all photos of a set share it), unless the caller passes its own.
     focal = [] if "--focal" in extra else ["--focal", str(truth["photos"][0]["fl_x"])]
-    subprocess.run([icef, "track", os.path.join(photo_dir, "photos"), "--out", data_dir, "--res", str(res), "--skip-bad"] + focal + extra,
-                   check=True, stdout=subprocess.DEVNULL)
+    if not reuse:
+        subprocess.run([icef, "track", os.path.join(photo_dir, "photos"), "--out", data_dir, "--res", str(res), "--skip-bad"] + focal + extra,
+                       check=True, stdout=subprocess.DEVNULL)
     report = json.load(open(os.path.join(data_dir, "track", "report.json")))
     names = truth["expression_names"]
     frames = {}
@@ -71,6 +78,10 @@ def evaluate_seed(icef, out, seed, photos, res, extra, synth_extra):
         true_t = -true_c2h[:3, :3].T @ true_c2h[:3, 3]
         track_t = -track_c2h[:3, :3].T @ track_c2h[:3, 3]
         trans = float(np.linalg.norm(true_t - track_t)) / HEAD_HEIGHT
+        sight = true_t / np.linalg.norm(true_t)
+        depth = float(abs((track_t - true_t) @ sight)) / HEAD_HEIGHT
+        lateral = float(np.linalg.norm((track_t - true_t) - ((track_t - true_t) @ sight) * sight)) / HEAD_HEIGHT
+        distance_ratio = float(np.linalg.norm(track_t) / np.linalg.norm(true_t))
         te = np.array([t["expression"][n] for n in names])
         pe = np.array([p["expression"][n] for n in names])
         seen = [i for i, n in enumerate(names) if n != "cheek_puff"]
@@ -86,7 +97,8 @@ def evaluate_seed(icef, out, seed, photos, res, extra, synth_extra):
         a, b = true_crop > 0.5, mask > 0.5
         iou = float((a & b).sum() / max(1, (a | b).sum()))
         rows.append({"seed": seed, "photo": os.path.basename(p["photo"]), "rotation_deg": rot,
-                     "translation_frac": trans, "expression_rms": expr_all, "expression_rms_seen": expr_seen, "expression_rms_neutral": expr_zero,
+                     "translation_frac": trans, "depth_frac": depth, "lateral_frac": lateral,
+                     "distance_ratio": distance_ratio, "expression_rms": expr_all, "expression_rms_seen": expr_seen, "expression_rms_neutral": expr_zero,
                      "true_expression": te.tolist(), "tracked_expression": pe.tolist(),
                      "mask_iou": iou, "landmark_rms_iod": p["landmark_rms_iod"],
                      "true_pose_deg": t.get("head_pose_deg")})
@@ -109,15 +121,16 @@ def main():
     ap.add_argument("--check", default="", help="bounds 'rot,trans,expr,iou' on the medians (expr: the seen weights)")
     ap.add_argument("--track-args", default="", help="extra arguments for icef track")
     ap.add_argument("--synth-args", default="", help="extra arguments for icef synth --photos (e.g. --generic-style)")
+    ap.add_argument("--reuse", action="store_true", help="evaluate OUT's photos and datasets as they are (no icef runs)")
     args = ap.parse_args()
     os.makedirs(args.out, exist_ok=True)
     rows, skipped = [], []
     for seed in [int(s) for s in args.seeds.split(",")]:
         r, s = evaluate_seed(args.icef, args.out, seed, args.photos, args.res, args.track_args.split(),
-                             args.synth_args.split())
+                             args.synth_args.split(), args.reuse)
         rows += r
         skipped += s
-    keys = ["rotation_deg", "translation_frac", "expression_rms", "expression_rms_seen", "expression_rms_neutral",
+    keys = ["rotation_deg", "translation_frac", "depth_frac", "lateral_frac", "expression_rms", "expression_rms_seen", "expression_rms_neutral",
             "mask_iou", "landmark_rms_iod"] + (["shape_rms"] if rows and "shape_rms" in rows[0] else [])
     summary = {k: {"median": median([r[k] for r in rows]), "max": max(r[k] for r in rows),
                    "min": min(r[k] for r in rows)} for k in keys}
@@ -127,9 +140,11 @@ def main():
     t = np.array([r["true_expression"] for r in rows])[:, names_seen].ravel()
     p = np.array([r["tracked_expression"] for r in rows])[:, names_seen].ravel()
     summary["expression_correlation"] = float(np.corrcoef(t, p)[0, 1]) if t.std() > 0 and p.std() > 0 else 0.0
-    print(f"{'seed':>4} {'photo':>14} {'rot deg':>8} {'trans':>7} {'expr':>6} {'expr10':>6} {'IoU':>6} {'lm IOD':>7}")
+    summary["distance_ratio_error"] = {"median": median([abs(r["distance_ratio"] - 1) for r in rows])}
+    print(f"{'seed':>4} {'photo':>14} {'rot deg':>8} {'trans':>7} {'depth':>7} {'lateral':>7} {'expr':>6} {'expr10':>6} {'IoU':>6} {'lm IOD':>7}")
     for r in rows:
         print(f"{r['seed']:>4} {r['photo']:>14} {r['rotation_deg']:8.2f} {r['translation_frac']:7.3f} "
+              f"{r['depth_frac']:7.3f} {r['lateral_frac']:7.3f} "
               f"{r['expression_rms']:6.3f} {r['expression_rms_seen']:6.3f} {r['mask_iou']:6.3f} {r['landmark_rms_iod']:7.3f}")
     for s in skipped:
         print(f"seed {s['seed']}: skipped {s['skipped']}")
