@@ -229,7 +229,11 @@ class IdTerm final : public Loss {
  public:
   std::string_view name() const override { return "id"; }
   LossStage stage() const override { return LossStage::kCanonical; }
-  double Weight(const LossContext& ctx) const override { return IdentityWeight(ctx, ctx.weights.lambda_id); }
+  // On the face-model prior L_id penalises the residual alone, a smaller quantity than icef's whole
+  // deformation, under a weight of its own (train.lambda_id_prior).
+  double Weight(const LossContext& ctx) const override {
+    return IdentityWeight(ctx, ctx.traits.prior ? ctx.weights.lambda_id_prior : ctx.weights.lambda_id);
+  }
   double Evaluate(LossContext& ctx, double weight) override {
     ModelWorkspace& ws = ctx.ws;
     const std::span<const float> mask = ctx.RegionMaskValues();

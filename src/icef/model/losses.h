@@ -31,6 +31,7 @@ namespace icef {
 // it where the method or the batch has nothing for it to act on.
 struct LossWeights {
   double lambda_id = 0.0;
+  double lambda_id_prior = 0.0;      // L_id's weight for the methods on the face-model prior (L_id on R_phi)
   double lambda_smooth = 0.0;
   double lambda_mask = 0.0;
   double lambda_distortion = 0.0;

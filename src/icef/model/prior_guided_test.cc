@@ -106,12 +106,33 @@ TEST(PriorGuidedTest, ZeroResidualIsThePriorAndCostsNoIdentityLoss) {
     for (int i = 0; i < 3 * n; ++i) ASSERT_NEAR(got[i], want[i], 1e-6f);
   }
   LossWeights w;
-  w.lambda_id = 1.0;
+  w.lambda_id_prior = 1.0;
   w.lambda_smooth = 1.0;
   const LossTerms terms = model->TrainForwardBackward(Batch(32, 1), w, 3, 0, Executor(1));
   EXPECT_GT(terms.samples, 0);
   EXPECT_EQ(terms.Get("id"), 0.0);
   EXPECT_EQ(terms.Get("smooth"), 0.0);
+}
+
+// On the prior, L_id (on R_phi) takes train.lambda_id_prior, not icef's lambda_id; warp-prior has none.
+TEST(PriorGuidedTest, IdentityLossOnThePriorHasItsOwnWeight) {
+  LossWeights w;
+  w.lambda_id = 0.25;
+  w.lambda_id_prior = 40.0;
+  w.lambda_smooth = 0.5;
+  for (const char* method : {"icef-prior", "warp-prior"}) {
+    auto model = MakePriorModel(method, 0.3f);
+    const LossTerms t = model->TrainForwardBackward(Batch(32, 2), w, 3, 0, Executor(1));
+    double id_weight = -1, smooth_weight = -1;
+    for (const LossValue& v : t.terms) {
+      if (v.name == "id") id_weight = v.weight;
+      if (v.name == "smooth") smooth_weight = v.weight;
+    }
+    const bool icef = std::string(method) == "icef-prior";
+    EXPECT_EQ(id_weight, icef ? 40.0 : 0.0) << method;
+    EXPECT_EQ(smooth_weight, icef ? 0.5 : 0.0) << method;
+    if (icef) EXPECT_GT(t.Get("id"), 0.0);  // a non-zero residual outside the regions costs
+  }
 }
 
 // D_final = P + kappa R_phi + (1 - kappa) R_lin: P enters with weight 1 at every kappa.
@@ -159,7 +180,7 @@ TEST(PriorGuidedTest, TrainLossGradientMatchesFiniteDifferences) {
   auto model = MakePriorModel("icef-prior", 0.05f);
   const TrainRays batch = Batch(24, 5);
   LossWeights w;
-  w.lambda_id = 0.5;
+  w.lambda_id_prior = 0.5;
   w.lambda_smooth = 0.3;
   w.lambda_mask = 0.2;
   w.lambda_distortion = 0.01 * std::sqrt(3.0);

@@ -38,6 +38,7 @@ TEST(ConfigDefaultsTest, EmptyConfigBuildsEveryComponentWithItsOwnDefaults) {
   EXPECT_EQ(w.symmetry_colour, d.symmetry_colour);
   EXPECT_EQ(w.symmetry_max_samples, d.symmetry_max_samples);
   EXPECT_EQ(w.lambda_id, config.train.lambda_id);
+  EXPECT_EQ(w.lambda_id_prior, config.train.lambda_id_prior);
   EXPECT_EQ(config.train.Losses(false).lambda_mask, 0.0);
 }
 

@@ -18,6 +18,9 @@ void TrainConfig::Bind(ConfigSchema& s) {
   s.Number("lr_deform", &lr_deform, "Adam learning rate of the deformation MLP");
   s.Number("lr_final_factor", &lr_final_factor, "learning rates decay exponentially to this factor at the last step");
   s.Number("lambda_id", &lambda_id, "weight of L_id, identity preservation outside the expression regions");
+  s.Number("lambda_id_prior", &lambda_id_prior,
+           "weight of L_id for the methods on the face-model prior (icef-prior), where it acts on the learned "
+           "residual R_phi alone: no residual warping outside mouth, eyes and brows");
   s.Number("lambda_smooth", &lambda_smooth, "weight of L_smooth, deformation smoothness at the region boundary");
   s.Number("lambda_mask", &lambda_mask, "weight of the alpha-mask loss (auxiliary; datasets with alpha only)");
   s.Number("lambda_distortion", &lambda_distortion, "weight of the mip-NeRF 360 distortion loss, distances in aabb diagonals (few-shot prior; 0 = off)");
@@ -56,6 +59,7 @@ void TrainConfig::Bind(ConfigSchema& s) {
 LossWeights TrainConfig::Losses(bool has_alpha) const {
   LossWeights w;
   w.lambda_id = lambda_id;
+  w.lambda_id_prior = lambda_id_prior;
   w.lambda_smooth = lambda_smooth;
   w.lambda_mask = has_alpha ? lambda_mask : 0.0;
   w.lambda_distortion = lambda_distortion;
@@ -78,6 +82,7 @@ Status TrainConfig::Validate() const {
     return Status::Error("train.lr_grid, lr_mlp and lr_deform must be positive");
   if (!positive(lr_final_factor) || lr_final_factor > 1) return Status::Error("train.lr_final_factor must be in (0, 1]");
   if (!non_negative(lambda_id)) return Status::Error("train.lambda_id must be a finite number >= 0");
+  if (!non_negative(lambda_id_prior)) return Status::Error("train.lambda_id_prior must be a finite number >= 0");
   if (!non_negative(lambda_smooth)) return Status::Error("train.lambda_smooth must be a finite number >= 0");
   if (!non_negative(lambda_mask)) return Status::Error("train.lambda_mask must be a finite number >= 0");
   if (!non_negative(lambda_distortion)) return Status::Error("train.lambda_distortion must be a finite number >= 0");

@@ -27,6 +27,9 @@ struct TrainConfig {
   double lr_deform = 1e-3;           // Adam learning rate of the deformation MLP
   double lr_final_factor = 0.1;      // learning rates decay exponentially to this factor at the last step
   double lambda_id = 1.0;            // weight of L_id (identity preservation outside the expression regions)
+  // Weight of L_id for the methods on the face-model prior (icef-prior), where it acts on the
+  // learned residual R_phi alone; chosen on validation identities 101-106 (docs/results/lambda_id_prior/).
+  double lambda_id_prior = 100.0;
   double lambda_smooth = 1e-4;       // weight of L_smooth (deformation smoothness at the region boundary)
   double lambda_mask = 0.1;          // weight of the alpha-mask loss (images with alpha only)
   double lambda_distortion = 0.035;  // weight of the mip-NeRF 360 distortion loss (0 = off)
