@@ -111,7 +111,9 @@ void ModelConfig::Bind(ConfigSchema& s) {
   s.Block("region_mask", [this](ConfigSchema& b) { BindRegionMask(b, &region_mask); });
   s.Block("visual_hull", [this](ConfigSchema& b) { BindVisualHull(b, &visual_hull); });
   s.Block("sampler", [this](ConfigSchema& b) {
-    b.Int("num_samples", &sampler.num_samples, "samples per ray over the ray/aabb interval");
+    b.Int("num_samples", &sampler.num_samples,
+          "samples per training ray over the ray/aabb interval, one per jittered stratum (fewer, deeper strata smear "
+          "the face's colour along the training rays and blur every other view: 48 did, docs/results/sampler_samples)");
   });
   s.Block("occupancy", [this](ConfigSchema& b) { BindOccupancy(b, &occupancy); });
   s.Block("compositing", [this](ConfigSchema& b) {

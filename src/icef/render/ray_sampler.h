@@ -27,7 +27,12 @@
 namespace icef {
 
 struct RaySamplerOptions {
-  int num_samples = 48;      // fixed-count mode: samples per ray over the ray/aabb interval
+  // Fixed-count mode: samples per ray over the ray/aabb interval. Training learns a colour that holds
+  // over a whole stratum along each training ray, so coarse strata smear the face over depth and blur
+  // it in every other view: 96 instead of 48 made the validation identities' renders sharper (face
+  // detail 0.71 -> 0.84) and their expressions stronger (expr_gain +0.10 to +0.13 in every tier) at
+  // about 1.7x the training time (docs/results/sampler_samples).
+  int num_samples = 96;
   float step_size = 0.f;     // marching mode: minimum step (world units); 0 = fixed-count mode unless cone_angle > 0
   float cone_angle = 0.f;    // marching mode: step grows as cone_angle * t (instant-ngp: 1/256); 0 = constant step
   int max_samples = 1024;    // marching mode: cap on samples per ray
