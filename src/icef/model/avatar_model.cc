@@ -168,11 +168,56 @@ void AvatarModel::FieldForward(ModelWorkspace& ws, int64_t n, const float* posit
   }
 }
 
+void AvatarModel::PlaceTrainingSamples(const TrainRays& batch, ModelWorkspace& ws, uint64_t seed, int64_t step,
+                                       const Executor& executor) const {
+  if (!config_.importance.enabled()) {
+    SampleRays(batch.rays, setup_.aabb, config_.SamplerOptions(true), &occupancy_, seed, step, executor, &ws.samples);
+    return;
+  }
+  // Coarse pass: the density at the stratified samples, through the warp at each ray's expression.
+  SampleRays(batch.rays, setup_.aabb, config_.SamplerOptions(true), &occupancy_, seed, step, executor, &ws.coarse);
+  const int64_t m = ws.coarse.size();
+  const int b = setup_.expression_dim;
+  const bool need_betas = warp_ || traits_.entangled_beta;
+  if (need_betas) {
+    Fit(ws.coarse_betas, m * b);
+    ParallelFor(executor, static_cast<int64_t>(batch.rays.size()), [&](int64_t r0, int64_t r1, int) {
+      for (int64_t r = r0; r < r1; ++r) {
+        const std::vector<float>& beta = setup_.training_expressions[batch.frame[r]];
+        for (int64_t i = ws.coarse.ray_offset[r]; i < ws.coarse.ray_offset[r] + ws.coarse.ray_count[r]; ++i)
+          std::copy(beta.begin(), beta.end(), ws.coarse_betas.begin() + i * b);
+      }
+    });
+  }
+  const float* positions = ws.coarse.positions.data();
+  const float* canonical = positions;
+  if (warp_) {
+    Fit(ws.coarse_offsets, 3 * m);
+    Fit(ws.coarse_canonical, 3 * m);
+    warp_->ForwardTrain(executor, m, positions, ws.coarse_betas.data(), ws.coarse_offsets.data(), nullptr,
+                        &ws.coarse_deform_ctx, false);
+    ParallelFor(executor, 3 * m, [&](int64_t i0, int64_t i1, int) {
+      for (int64_t i = i0; i < i1; ++i) ws.coarse_canonical[i] = positions[i] + ws.coarse_offsets[i];
+    });
+    canonical = ws.coarse_canonical.data();
+  }
+  Fit(ws.coarse_sigma, m);
+  static_field_->Density(executor, m, canonical, traits_.entangled_beta ? ws.coarse_betas.data() : nullptr,
+                         ws.coarse_sigma.data(), &ws.coarse_static_ctx);
+  if (warp_ && warp_->has_prior()) {
+    Fit(ws.coarse_cavity, m);
+    warp_->Cavity(executor, m, positions, ws.coarse_betas.data(), ws.coarse_cavity.data());
+    for (int64_t i = 0; i < m; ++i)
+      if (ws.coarse_cavity[i]) ws.coarse_sigma[i] = kCavityDensity;
+  }
+  ResampleRays(batch.rays, ws.coarse, ws.coarse_sigma, config_.importance, seed, step, executor, &ws.samples);
+}
+
 LossTerms AvatarModel::TrainForwardBackward(const TrainRays& batch, const LossWeights& weights, uint64_t seed,
                                             int64_t step, const Executor& executor) {
   ModelWorkspace& ws = *train_ws_;
   const int64_t num_rays = static_cast<int64_t>(batch.rays.size());
-  SampleRays(batch.rays, setup_.aabb, config_.SamplerOptions(true), &occupancy_, seed, step, executor, &ws.samples);
+  PlaceTrainingSamples(batch, ws, seed, step, executor);
   const int64_t n = ws.samples.size();
   ExpandRays(batch, ws, executor);
   if (warp_) {  // observation -> canonical

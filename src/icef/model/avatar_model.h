@@ -122,6 +122,10 @@ class AvatarModel {
  private:
   AvatarModel(const ModelConfig& config, const ModelSetup& setup, RegionMask mask, ExpressionConfidence confidence);
   // Pieces of TrainForwardBackward / Render.
+  // The training step's samples into ws.samples: the stratified sampler's, or (config importance)
+  // those importance resampling draws from them by the current density (render/importance_sampler.h).
+  void PlaceTrainingSamples(const TrainRays& batch, ModelWorkspace& ws, uint64_t seed, int64_t step,
+                            const Executor& executor) const;
   void ExpandRays(const TrainRays& batch, ModelWorkspace& ws, const Executor& executor) const;
   // Static field (and the prior's cavity) at n samples: canonical = positions + ws.offsets; reads
   // ws.dirs and ws.betas, writes ws.sigma and ws.rgb.

@@ -413,6 +413,28 @@ TEST(AvatarModelTest, TrainLossGradientMatchesFiniteDifferences) {
   }
 }
 
+// Importance sampling (config importance): the training step evaluates exactly importance_samples
+// per ray that crosses the grid, drawn from the coarse samples by the model's density, and the step
+// is deterministic.
+TEST(AvatarModelTest, ImportanceSamplingTrainsOnTheResampledSamples) {
+  const TrainRays batch = testing_model::RandomBatch(24, 5);
+  const LossWeights w;
+  auto step = [&](int importance) {
+    ModelConfig config = TinyModelConfig("icef");
+    config.importance.num_samples = importance;
+    auto model = AvatarModel::Create(config, TinySetup(), Executor(2));
+    ICEF_CHECK(model.ok(), model.status().message());
+    (*model)->Initialize(7);
+    return (*model)->TrainForwardBackward(batch, w, 3, 0, Executor(2));
+  };
+  const LossTerms plain = step(0), fine = step(12), again = step(12);
+  EXPECT_EQ(plain.samples, 24 * 16);  // sampler.num_samples of the tiny config, none skipped
+  EXPECT_EQ(fine.samples, 24 * 12);
+  EXPECT_EQ(fine.total, again.total);
+  EXPECT_NE(fine.total, plain.total);
+  EXPECT_TRUE(fine.AllFinite());
+}
+
 }  // namespace
 }  // namespace icef
 

@@ -114,6 +114,13 @@ void ModelConfig::Bind(ConfigSchema& s) {
     b.Int("num_samples", &sampler.num_samples,
           "samples per training ray over the ray/aabb interval, one per jittered stratum (fewer, deeper strata smear "
           "the face's colour along the training rays and blur every other view: 48 did, docs/results/sampler_samples)");
+    b.Int("importance_samples", &importance.num_samples,
+          "training: fine samples per ray placed by the num_samples coarse samples' compositing weights (each coarse "
+          "stratum cut into as many sub-strata as its share of the weight; render/importance_sampler.h); 0 = train on "
+          "the coarse samples themselves. Measured on a validation identity: sharper but grainy, 0.5-1.7 dB below 144 "
+          "stratified samples at the same cost; off by default (docs/results/importance_sampling)");
+    b.Float("importance_uniform", &importance.uniform,
+            "share of each ray's importance samples spread over its coarse strata by length rather than weight");
   });
   s.Block("occupancy", [this](ConfigSchema& b) { BindOccupancy(b, &occupancy); });
   s.Block("compositing", [this](ConfigSchema& b) {
@@ -144,6 +151,7 @@ Status ModelConfig::Validate() const {
   if (visual_hull.margin_px < 0) return Status::Error("visual_hull.margin_px must be >= 0");
   if (visual_hull.min_views < 0) return Status::Error("visual_hull.min_views must be >= 0");
   ICEF_RETURN_IF_ERROR(SamplerOptions(true).Validate().WithContext("sampler"));
+  ICEF_RETURN_IF_ERROR(importance.Validate().WithContext("sampler"));
   ICEF_RETURN_IF_ERROR(occupancy.Validate().WithContext("occupancy"));
   ICEF_RETURN_IF_ERROR(compositing.Validate().WithContext("compositing"));
   if (render.supersample < 1 || render.supersample > 8)

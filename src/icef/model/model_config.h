@@ -14,6 +14,7 @@
 #include "icef/model/method.h"
 #include "icef/render/compositing.h"
 #include "icef/render/occupancy_grid.h"
+#include "icef/render/importance_sampler.h"
 #include "icef/render/ray_sampler.h"
 
 namespace icef {
@@ -56,6 +57,7 @@ struct ModelConfig {
   RegionMaskOptions region_mask;
   VisualHullConfig visual_hull;
   RaySamplerOptions sampler;
+  ImportanceOptions importance;  // bound as sampler.importance_*: training rays only
   OccupancyGridOptions occupancy;
   CompositeOptions compositing;  // training rays (renders: render.transmittance_eps)
   ImageRenderOptions render;

@@ -21,6 +21,13 @@ void Fit(V& v, size_t size) {
 // One batch's state, [n] = samples, [R] = rays. World frame unless named canonical.
 struct ModelWorkspace {
   RaySamples samples;
+  // Importance sampling's coarse pass (config importance): its samples, expressions [m, B], warp
+  // and the density at each (no gradients).
+  RaySamples coarse;
+  std::vector<float> coarse_betas, coarse_offsets, coarse_canonical, coarse_sigma;
+  std::vector<uint8_t> coarse_cavity;
+  StaticFieldContext coarse_static_ctx;
+  DeformationContext coarse_deform_ctx;
   std::vector<float> positions, dirs, betas;  // [n, 3], [n, 3], [n, expression_dim]
   std::vector<float> offsets, residual;       // [n, 3] D_final(x) - x and its learned residual R_phi
   std::vector<float> canonical;               // [n, 3] x + offsets

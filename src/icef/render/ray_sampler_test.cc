@@ -6,20 +6,12 @@
 #include <vector>
 
 #include "icef/core/rng.h"
+#include "icef/render/render_test_util.h"
 
 namespace icef {
 namespace {
 
-std::vector<Ray> RandomRays(int n, uint64_t seed) {
-  Rng rng(seed, StreamId("test_rays"));
-  std::vector<Ray> rays;
-  for (int i = 0; i < n; ++i) {
-    Vec3f target(rng.Uniform(-0.8, 0.8), rng.Uniform(-0.8, 0.8), rng.Uniform(-0.8, 0.8));
-    Vec3f origin(rng.Uniform(-3, 3), rng.Uniform(-3, 3), 3.f);
-    rays.push_back(Ray{origin, (target - origin).normalized()});
-  }
-  return rays;
-}
+using testing_render::RandomRays;
 
 TEST(RaySamplerTest, FixedCountStratifiedInsideAabbSortedAndContiguous) {
   const Aabb aabb;
