@@ -953,7 +953,7 @@ std::string PlotCommands(const Aggregate& a, Metric m, const std::string& dat) {
   s << "set multiplot layout 1," << a.ks.size() << " title \"" << MetricName(m) << " against delta (mean +- std over "
     << a.identities.size() << " identities)\"\n";
   s << "set xlabel \"delta (distance to the nearest training expression)\"\n";
-  s << "set ylabel \"" << MetricLabel(m) << "\"\nset grid\nset key top left box opaque\nset offsets 0.05, 0.05, 0, 0\n";
+  s << "set ylabel \"" << MetricLabel(m) << "\"\nset grid\nset key below horizontal box\nset offsets 0.05, 0.05, 0, 0\n";
   for (size_t ki = 0; ki < a.ks.size(); ++ki) {
     s << "set title \"K = " << a.ks[ki] << "\"\nplot ";
     for (size_t mi = 0; mi < a.methods.size(); ++mi) {
@@ -1002,8 +1002,8 @@ Result<std::vector<std::string>> WritePlots(const fs::path& dir, const Aggregate
     const std::string commands = PlotCommands(a, m, name + ".dat");
     std::ostringstream gp;
     gp << "# gnuplot " << name << ".gp (run in this directory) draws " << name << ".png and " << name << ".svg\n"
-       << "set terminal pngcairo noenhanced size " << width << ",420 font \"sans,9\"\nset output \"" << name << ".png\"\n"
-       << commands << "set terminal svg noenhanced size " << width << ",420 font \"sans,9\"\nset output \"" << name
+       << "set terminal pngcairo noenhanced size " << width << ",480 font \"sans,9\"\nset output \"" << name << ".png\"\n"
+       << commands << "set terminal svg noenhanced size " << width << ",480 font \"sans,9\"\nset output \"" << name
        << ".svg\"\n" << commands;
     ICEF_RETURN_IF_ERROR(WriteFileAtomic(plot_dir / (name + ".gp"), gp.str()));
     if (!have_gnuplot) continue;

@@ -57,7 +57,8 @@ void ResampleRays(std::span<const Ray> rays, const RaySamples& coarse, std::span
                   const ImportanceOptions& options, uint64_t seed, int64_t step, const Executor& executor,
                   RaySamples* out) {
   const Status status = options.Validate();
-  ICEF_CHECK(status.ok() && options.enabled(), "ResampleRays: " + status.ToString());
+  ICEF_CHECK(status.ok(), "ResampleRays: " + status.ToString());
+  ICEF_CHECK(options.enabled(), "ResampleRays: importance sampling is off (num_samples 0)");
   ICEF_CHECK(out != &coarse, "ResampleRays: out aliases coarse");
   ICEF_CHECK(int64_t(sigma.size()) == coarse.size(), "ResampleRays: one density per coarse sample");
   const int64_t num_rays = int64_t(rays.size());
