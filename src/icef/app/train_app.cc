@@ -88,6 +88,11 @@ Result<TrainSummary> RunTrain(const TrainAppOptions& o, std::ostream& out) {
   out << (o.resume ? ", resuming at step " + std::to_string(trainer->step()) : "") << "\n";
   if (const std::optional<face::FaceFit>& fit = trainer->model().setup().face_fit) {
     out << fit->BriefReport() << "\n";
+    if (const std::optional<Vec3f>& light = trainer->model().prior_light())
+      out << "prior shading: light [" << light->x() << ", " << light->y() << ", " << light->z() << "] (strength "
+          << light->norm() << ", fitted to the training images' skin)\n";
+    if (!trainer->prior_shading_note().empty())
+      out << "prior shading: off, no light fitted (" << trainer->prior_shading_note() << ")\n";
     if (fit->Poor())
       out << "warning: the face model fits the landmarks poorly (RMS above 0.1 inter-ocular distances): the prior "
              "will pull expressions to the wrong places; check the dataset's landmarks and expression vectors\n";

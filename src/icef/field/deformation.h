@@ -62,6 +62,12 @@ class Deformation {
   // inside [n] (see DeformationPrior::Cavity); all 0 without a prior.
   void Cavity(const Executor& executor, int64_t n, const float* positions, const float* betas, uint8_t* inside) const;
 
+  // The prior's surface normals (DeformationPrior::Normals); false without a prior that has them.
+  bool Normals(const Executor& executor, int64_t n, const float* positions, const float* betas, float* observed,
+               float* canonical) const {
+    return prior_ && prior_->Normals(executor, n, positions, betas, observed, canonical);
+  }
+
   // kappa of the blend at beta (1 without the blend).
   double Kappa(std::span<const float> beta) const;
   std::string ToString() const;

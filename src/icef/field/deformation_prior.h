@@ -24,6 +24,14 @@ class DeformationPrior {
   virtual void Cavity(const Executor& executor, int64_t n, const float* positions, const float* betas,
                       uint8_t* inside) const = 0;
 
+  // Surface normals of the face model, world frame: observed [n, 3] of the expressed surface at x_i
+  // (beta_i), canonical [n, 3] of the neutral surface at P(x_i, beta_i). False: the prior has none.
+  virtual bool Normals(const Executor& executor, int64_t n, const float* positions, const float* betas,
+                       float* observed, float* canonical) const {
+    (void)executor, (void)n, (void)positions, (void)betas, (void)observed, (void)canonical;
+    return false;
+  }
+
   virtual int expression_dims() const = 0;
   virtual std::string ToString() const = 0;
 };

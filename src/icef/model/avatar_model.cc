@@ -17,6 +17,8 @@ namespace {
 // mouth interior. Neither is learned: no training frame needs to show an open mouth.
 constexpr float kCavityDensity = 400.f;
 constexpr float kCavityColor[3] = {0.12f, 0.04f, 0.04f};
+// Density (1/world units) below which a sample is left unshaded by the prior shading.
+constexpr float kShadeMinDensity = 0.05f;
 
 // Samples inside the cavity take its density and colour; their gradients are dropped (the static
 // field did not produce them).
@@ -85,6 +87,7 @@ Result<std::unique_ptr<AvatarModel>> AvatarModel::Create(const ModelConfig& conf
     model->warp_ = std::make_unique<Deformation>(model->residual_field_.get(), model->prior_.get(),
                                                  &model->confidence_, model->traits_.confidence);
   }
+  if (model->prior_ && config.prior_shading) model->light_ = setup.prior_light;
   return model;
 }
 
@@ -161,11 +164,54 @@ void AvatarModel::FieldForward(ModelWorkspace& ws, int64_t n, const float* posit
   Fit(ws.rgb, 3 * n);
   static_field_->Forward(executor, n, canonical, ws.dirs.data(), traits_.entangled_beta ? ws.betas.data() : nullptr,
                          ws.sigma.data(), ws.rgb.data(), &ws.static_ctx, train, train && warp_ != nullptr);
+  ws.shade.clear();
+  if (light_ && ShadingNormals(ws, n, positions, executor)) {
+    Fit(ws.shade, n);
+    if (train) ws.rgb_unshaded.assign(ws.rgb.begin(), ws.rgb.begin() + 3 * n);
+    ApplyPriorShading(executor, n, ws.normals_obs.data(), ws.normals_can.data(), *light_, ws.rgb.data(),
+                      ws.shade.data());
+  }
   if (warp_ && warp_->has_prior()) {
     Fit(ws.cavity, n);
     warp_->Cavity(executor, n, positions, ws.betas.data(), ws.cavity.data());
     ApplyCavity(n, ws.cavity.data(), ws.sigma.data(), ws.rgb.data());
   }
+}
+
+bool AvatarModel::ShadingNormals(ModelWorkspace& ws, int64_t n, const float* positions,
+                                 const Executor& executor) const {
+  // The face model's normals cost eight signed-distance evaluations: only at samples dense enough to
+  // show (each weighs at most 1 - exp(-kShadeMinDensity dt) in its ray, below 1e-3 at this
+  // aabb's sample spacing); elsewhere both normals are zero, which makes s = 1.
+  const int b = setup_.expression_dim;
+  ws.shade_index.clear();
+  for (int64_t i = 0; i < n; ++i)
+    if (ws.sigma[i] > kShadeMinDensity) ws.shade_index.push_back(i);
+  const int64_t m = static_cast<int64_t>(ws.shade_index.size());
+  Fit(ws.shade_positions, 3 * m);
+  Fit(ws.shade_betas, m * b);
+  ParallelFor(executor, m, [&](int64_t j0, int64_t j1, int) {
+    for (int64_t j = j0; j < j1; ++j) {
+      const int64_t i = ws.shade_index[j];
+      std::copy(positions + 3 * i, positions + 3 * i + 3, ws.shade_positions.begin() + 3 * j);
+      std::copy(ws.betas.begin() + i * b, ws.betas.begin() + (i + 1) * b, ws.shade_betas.begin() + j * b);
+    }
+  });
+  Fit(ws.shade_obs, 3 * m);
+  Fit(ws.shade_can, 3 * m);
+  if (!warp_->Normals(executor, m, ws.shade_positions.data(), ws.shade_betas.data(), ws.shade_obs.data(),
+                      ws.shade_can.data()))
+    return false;
+  ws.normals_obs.assign(3 * n, 0.f);
+  ws.normals_can.assign(3 * n, 0.f);
+  for (int64_t j = 0; j < m; ++j) {
+    const int64_t i = ws.shade_index[j];
+    for (int a = 0; a < 3; ++a) {
+      ws.normals_obs[3 * i + a] = ws.shade_obs[3 * j + a];
+      ws.normals_can[3 * i + a] = ws.shade_can[3 * j + a];
+    }
+  }
+  return true;
 }
 
 void AvatarModel::PlaceTrainingSamples(const TrainRays& batch, ModelWorkspace& ws, uint64_t seed, int64_t step,
@@ -252,7 +298,13 @@ LossTerms AvatarModel::TrainForwardBackward(const TrainRays& batch, const LossWe
   RunLosses(LossStage::kSamples, ctx, &terms);
   if (warp_ && warp_->has_prior()) DropCavityGradients(n, ws.cavity.data(), ws.d_sigma.data(), ws.d_rgb.data());
   if (warp_) Fit(ws.d_canonical, 3 * n);
-  static_field_->Backward(executor, n, ws.sigma.data(), ws.rgb.data(), ws.d_sigma.data(), ws.d_rgb.data(),
+  const bool shaded = !ws.shade.empty();
+  if (shaded)  // d rgb_unshaded = s d rgb
+    ParallelFor(executor, n, [&](int64_t i0, int64_t i1, int) {
+      for (int64_t i = i0; i < i1; ++i)
+        for (int a = 0; a < 3; ++a) ws.d_rgb[3 * i + a] *= ws.shade[i];
+    });
+  static_field_->Backward(executor, n, ws.sigma.data(), shaded ? ws.rgb_unshaded.data() : ws.rgb.data(), ws.d_sigma.data(), ws.d_rgb.data(),
                           &ws.static_ctx, warp_ ? ws.d_canonical.data() : nullptr);
   for (Loss* loss : evaluated_losses_) loss->AfterStaticBackward(ctx);
   RunLosses(LossStage::kCanonical, ctx, &terms);  // the terms on the warp have weight 0 without one

@@ -18,6 +18,7 @@
 #include "icef/field/confidence.h"
 #include "icef/field/deformation.h"
 #include "icef/field/deformation_field.h"
+#include "icef/field/prior_shading.h"
 #include "icef/field/region_mask.h"
 #include "icef/field/static_field.h"
 #include "icef/field/symmetry_plane.h"
@@ -117,6 +118,9 @@ class AvatarModel {
   DeformationField* residual_field() { return residual_field_.get(); }
   const DeformationField* residual_field() const { return residual_field_.get(); }
   const Deformation* warp() const { return warp_.get(); }
+  // The light of the prior shading (field/prior_shading.h): a *-prior method with
+  // model.prior_shading and a fitted light in the setup; else nullopt (no shading).
+  const std::optional<Vec3f>& prior_light() const { return light_; }
   std::string ToString() const;
 
  private:
@@ -127,10 +131,14 @@ class AvatarModel {
   void PlaceTrainingSamples(const TrainRays& batch, ModelWorkspace& ws, uint64_t seed, int64_t step,
                             const Executor& executor) const;
   void ExpandRays(const TrainRays& batch, ModelWorkspace& ws, const Executor& executor) const;
-  // Static field (and the prior's cavity) at n samples: canonical = positions + ws.offsets; reads
-  // ws.dirs and ws.betas, writes ws.sigma and ws.rgb.
+  // Static field (and the prior's shading and cavity) at n samples: canonical = positions +
+  // ws.offsets; reads ws.dirs and ws.betas, writes ws.sigma and ws.rgb (and, when shaded, ws.shade and
+  // in training ws.rgb_unshaded).
   void FieldForward(ModelWorkspace& ws, int64_t n, const float* positions, bool train, const Executor& executor) const;
   // Runs the terms of one stage (model/losses.h) and records their values in `terms`.
+  // The face model's normals at the samples of FieldForward dense enough to show (others: zero
+  // normals, no shading) into ws.normals_obs / normals_can; false when the prior has none.
+  bool ShadingNormals(ModelWorkspace& ws, int64_t n, const float* positions, const Executor& executor) const;
   void RunLosses(LossStage stage, LossContext& ctx, LossTerms* terms);
   void WarpOffsets(const Executor& executor, int64_t n, const float* positions, std::span<const float> beta,
                    float* offsets, WarpPart part) const;
@@ -144,6 +152,7 @@ class AvatarModel {
   std::unique_ptr<DeformationField> residual_field_;
   std::unique_ptr<DeformationPrior> prior_;
   std::unique_ptr<Deformation> warp_;
+  std::optional<Vec3f> light_;
   RegionMask mask_;
   ExpressionConfidence confidence_;
   OccupancyGrid occupancy_;

@@ -16,6 +16,8 @@ class FacePrior final : public DeformationPrior {
     head_from_world_ = (s.scale * s.rotation).cast<float>();
     world_from_head_ = (s.rotation.transpose() / s.scale).cast<float>();
     translation_ = s.translation.cast<float>();
+    rotation_t_ = s.rotation.transpose().cast<float>();
+    neutral_ = model_.Prepare(std::vector<float>(face::kNumExpressions, 0.f));
   }
 
   void Offsets(const Executor& executor, int64_t n, const float* positions, const float* betas,
@@ -47,6 +49,25 @@ class FacePrior final : public DeformationPrior {
     });
   }
 
+  bool Normals(const Executor& executor, int64_t n, const float* positions, const float* betas, float* observed,
+               float* canonical) const override {
+    ParallelFor(executor, n, [&](int64_t i0, int64_t i1, int) {
+      StateCache cache;
+      for (int64_t i = i0; i < i1; ++i) {
+        const Vec3f x(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]);
+        const face::ExpressionState& state = cache.Get(model_, betas + i * face::kNumExpressions);
+        const Vec3f x_h = head_from_world_ * x + translation_;
+        const Vec3f n_obs = rotation_t_ * model_.Normal(x_h, state);
+        const Vec3f n_can = rotation_t_ * model_.Normal(model_.PriorWarp(x_h, state), neutral_);
+        for (int a = 0; a < 3; ++a) {
+          observed[3 * i + a] = n_obs[a];
+          canonical[3 * i + a] = n_can[a];
+        }
+      }
+    });
+    return true;
+  }
+
   int expression_dims() const override { return face::kNumExpressions; }
   std::string ToString() const override {
     std::ostringstream os;
@@ -73,7 +94,8 @@ class FacePrior final : public DeformationPrior {
 
   face::FaceFit fit_;
   face::FaceModel model_;
-  Mat3f head_from_world_, world_from_head_;
+  Mat3f head_from_world_, world_from_head_, rotation_t_;
+  face::ExpressionState neutral_;
   Vec3f translation_;
 };
 

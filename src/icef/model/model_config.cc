@@ -129,6 +129,11 @@ void ModelConfig::Bind(ConfigSchema& s) {
              "render.transmittance_eps)");
   });
   s.Block("render", [this](ConfigSchema& b) { BindRender(b, &render); });
+  s.Bool("prior_shading", &prior_shading,
+         "icef-prior and warp-prior: scale each sample's colour by the change of light that the expression brings "
+         "to the face model's surface (its normal there against the neutral surface's at the canonical point), "
+         "under a light fitted to the training images' skin before training (field/prior_shading.h, "
+         "model/prior_light.h): the shading a warp of a static field cannot show");
   s.Bool("bf16_inference", &bf16_inference,
          "renders, evaluation and occupancy updates multiply in BF16 with FP32 sums on CPUs with AVX512-BF16 "
          "(about "

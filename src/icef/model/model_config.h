@@ -61,6 +61,10 @@ struct ModelConfig {
   OccupancyGridOptions occupancy;
   CompositeOptions compositing;  // training rays (renders: render.transmittance_eps)
   ImageRenderOptions render;
+  // The *-prior methods: scale each sample's colour by the change of light the face model's
+  // expression brings to its surface, under a light fitted to the training images
+  // (field/prior_shading.h, model/prior_light.h).
+  bool prior_shading = true;
   // Renders, eval and occupancy updates: MLP products in BF16 with FP32 sums (AVX512-BF16 CPUs).
   bool bf16_inference = StaticFieldOptions{}.bf16_inference;
   // Training passes (forward, backward, weight gradients) likewise; weights and Adam stay FP32.

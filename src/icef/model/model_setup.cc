@@ -42,6 +42,7 @@ Json ModelSetup::ToJson() const {
                     {"transform_matrix", m}});
   }
   j["training_cameras"] = cams;
+  if (prior_light) j["prior_light"] = {prior_light->x(), prior_light->y(), prior_light->z()};
   if (face_fit) {
     const face::FaceFit& f = *face_fit;
     Json shape = Json::object();
@@ -128,6 +129,12 @@ Result<ModelSetup> ModelSetup::FromJson(const Json& json, const std::string& ori
     ICEF_ASSIGN_OR_RETURN(f.landmarks_total, fv.Int("landmarks_total"));
     ICEF_ASSIGN_OR_RETURN(f.iterations, fv.Int("iterations"));
     s.face_fit = f;
+  }
+  if (v.Has("prior_light")) {
+    ICEF_ASSIGN_OR_RETURN(const auto l, v.NumberArray("prior_light", 3));
+    for (double x : l)
+      if (!std::isfinite(x)) return v.Error("prior_light", "must be 3 finite numbers");
+    s.prior_light = Vec3f(float(l[0]), float(l[1]), float(l[2]));
   }
   return s;
 }

@@ -28,6 +28,7 @@ struct ModelSetup {
   Vec3f background = Vec3f::Ones();
   std::vector<Camera> training_cameras;               // [K] (renders default to their intrinsics and views)
   std::optional<face::FaceFit> face_fit;              // the fitted face model (model/face_prior.h), if any
+  std::optional<Vec3f> prior_light;                   // the prior shading's light (model/prior_light.h), if fitted
 
   // From a loaded dataset's training split; the landmarks come from RegionMask::FromDataset's
   // rules (mean landmarks_3d, else triangulated landmarks_2d).

@@ -34,6 +34,11 @@ struct ModelWorkspace {
   std::vector<float> sigma, rgb;              // [n], [n, 3] the fields at the samples
   std::vector<float> mask_values, extras;     // [n] M(x); renders: [n, 2] per-sample extras
   std::vector<uint8_t> cavity;                // [n] inside the face model's open mouth
+  // Prior shading (field/prior_shading.h): the face model's normals [n, 3] (observed, canonical), the
+  // ratio s [n] (empty: not applied) and, in training, the colours before it [n, 3].
+  std::vector<float> normals_obs, normals_can, shade, rgb_unshaded;
+  std::vector<int64_t> shade_index;  // the samples dense enough to shade, and their gathered inputs/normals
+  std::vector<float> shade_positions, shade_betas, shade_obs, shade_can;
   CompositeOutputs<float> composite;
   // Gradients of the loss: w.r.t. ray colour [R, 3], opacity [R] and sample weights ([n], or empty
   // when no term has one), then w.r.t. sigma [n], rgb [n, 3] and canonical positions [n, 3].

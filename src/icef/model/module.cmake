@@ -1,1 +1,1 @@
-icef_module(model DEPS icef_field icef_render icef_face TEST_DEPS icef_testing)
+icef_module(model DEPS icef_field icef_render icef_face Ceres::ceres TEST_DEPS icef_testing icef_synth)

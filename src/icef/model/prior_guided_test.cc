@@ -38,6 +38,18 @@ class TestPrior final : public DeformationPrior {
       inside[i] = d.norm() < 0.1f * betas[i * dims_] ? 1 : 0;
     }
   }
+  // Normals: canonical (0.6, 0.8, 0) rotated about z by the sample's x, observed tilted further by
+  // beta_0 (so beta = 0 leaves the shading as it is).
+  bool Normals(const Executor&, int64_t n, const float* x, const float* betas, float* observed,
+               float* canonical) const override {
+    for (int64_t i = 0; i < n; ++i) {
+      const float a = x[3 * i], b0 = betas[i * dims_];
+      const Vec3f nc(0.6f * std::cos(a) - 0.8f * std::sin(a), 0.6f * std::sin(a) + 0.8f * std::cos(a), 0.f);
+      const Vec3f no = Vec3f(nc.x(), nc.y(), 0.9f * b0).normalized();
+      for (int k = 0; k < 3; ++k) observed[3 * i + k] = no[k], canonical[3 * i + k] = nc[k];
+    }
+    return true;
+  }
   int expression_dims() const override { return dims_; }
   std::string ToString() const override { return "TestPrior"; }
 
@@ -45,10 +57,16 @@ class TestPrior final : public DeformationPrior {
   int dims_;
 };
 
-std::unique_ptr<AvatarModel> MakePriorModel(const std::string& method, float deform_scale) {
+// A light along +z with strength 1.5: the prior shading scales the colour where beta_0 tilts the
+// observed normal towards it. With shading = false (model.prior_shading off) nothing is shaded.
+std::unique_ptr<AvatarModel> MakePriorModel(const std::string& method, float deform_scale, bool shading = true,
+                                            float density_bias = StaticFieldOptions{}.density_bias) {
   ModelConfig config = TinyModelConfig(method);
   config.deformation.output_init_scale = deform_scale;
-  const ModelSetup setup = TinySetup();
+  config.prior_shading = shading;
+  config.static_field.density_bias = density_bias;
+  ModelSetup setup = TinySetup();
+  setup.prior_light = Vec3f(0.f, 0.3f, 1.5f);
   auto model = AvatarModel::Create(config, setup, Executor(2), std::make_unique<TestPrior>(setup.expression_dim));
   ICEF_CHECK(model.ok(), model.status().message());
   (*model)->Initialize(7);
@@ -175,9 +193,46 @@ TEST(PriorGuidedTest, MouthCavityRendersDark) {
   EXPECT_GT(closed.color[0], 0.2f);  // no cavity at neutral: whatever the static field holds
 }
 
-// The training loss's gradient with a prior under the residual (and a cavity on some rays).
+// The prior shading: colour times s = (1 + max(0, n_obs . v)) / (1 + max(0, n_can . v)) at every
+// sample, from the prior's normals; at beta = 0 (equal normals) the render is the unshaded one, and
+// model.prior_shading = false or a setup without a light turns it off.
+TEST(PriorGuidedTest, PriorShadingScalesTheColourByTheLightOnTheTurnedSurface) {
+  // Dense enough that every sample is shaded (sparser ones are left as they are: avatar_model.cc).
+  auto shaded = MakePriorModel("icef-prior", 0.01f, true, -1.f);
+  auto plain = MakePriorModel("icef-prior", 0.01f, false, -1.f);
+  ASSERT_TRUE(shaded->prior_light().has_value());
+  EXPECT_FALSE(plain->prior_light().has_value());
+  const std::vector<Ray> rays = {Ray{Vec3f(0.1f, 0.05f, 2.f), Vec3f(0, 0, -1)}, Ray{Vec3f(-0.2f, 0.1f, 2.f), Vec3f(0, 0, -1)}};
+  for (float b0 : {0.f, 0.6f}) {
+    const std::vector<float> beta = {b0, 0.f, 0.f};
+    RenderOutput a, b;
+    shaded->Render(rays, beta, Vec3f::Zero(), Executor(1), &a);
+    plain->Render(rays, beta, Vec3f::Zero(), Executor(1), &b);
+    for (size_t r = 0; r < rays.size(); ++r) {
+      ASSERT_GT(b.opacity[r], 1e-3f);
+      EXPECT_FLOAT_EQ(a.opacity[r], b.opacity[r]);  // the density is not shaded
+      if (b0 == 0.f) {
+        for (int c = 0; c < 3; ++c) EXPECT_NEAR(a.color[3 * r + c], b.color[3 * r + c], 1e-6f);
+      } else {  // the observed normal turns towards +z: brighter, by at most the largest ratio
+        for (int c = 0; c < 3; ++c) {
+          EXPECT_GT(a.color[3 * r + c], 1.05f * b.color[3 * r + c]);
+          EXPECT_LT(a.color[3 * r + c], 2.5f * b.color[3 * r + c]);
+        }
+      }
+    }
+  }
+  // The ratio itself, in double precision.
+  const double up[3] = {0, 0, 1}, side[3] = {1, 0, 0}, none[3] = {0, 0, 0};
+  EXPECT_DOUBLE_EQ(PriorShadeRatio(up, side, Vec3f(0, 0, 2)), 3.0);
+  EXPECT_DOUBLE_EQ(PriorShadeRatio(side, up, Vec3f(0, 0, 2)), 1.0 / 3.0);
+  EXPECT_DOUBLE_EQ(PriorShadeRatio(up, up, Vec3f(0.3f, -1, 2)), 1.0);
+  EXPECT_DOUBLE_EQ(PriorShadeRatio(none, none, Vec3f(0, 0, 2)), 1.0);
+}
+
+// The training loss's gradient with a prior under the residual (and a cavity on some rays, and the
+// prior shading on every sample).
 TEST(PriorGuidedTest, TrainLossGradientMatchesFiniteDifferences) {
-  auto model = MakePriorModel("icef-prior", 0.05f);
+  auto model = MakePriorModel("icef-prior", 0.05f, true, -1.f);  // dense enough to be shaded
   const TrainRays batch = Batch(24, 5);
   LossWeights w;
   w.lambda_id_prior = 0.5;
@@ -204,6 +259,16 @@ TEST(PriorGuidedTest, TrainLossGradientMatchesFiniteDifferences) {
                     [&](int64_t a, int64_t b) { return std::abs(grads[a]) > std::abs(grads[b]); });
   ASSERT_GT(std::abs(grads[deform[0]]), 1e-7);
   check.insert(check.end(), deform.begin(), deform.begin() + 6);
+  // And the largest of the colour MLP's output layer (its last weights; no ReLU switches under a
+  // step there): their gradient passes through the prior shading's ratio.
+  const int color = store.FindBlock("static/color");
+  ASSERT_GE(color, 0);
+  const int64_t c1 = store.block(color).offset + store.block(color).size, c0 = c1 - 48;
+  std::vector<int64_t> colour(order.begin(), order.end());
+  std::erase_if(colour, [&](int64_t i) { return i < c0 || i >= c1; });
+  std::partial_sort(colour.begin(), colour.begin() + 6, colour.end(),
+                    [&](int64_t a, int64_t b) { return std::abs(grads[a]) > std::abs(grads[b]); });
+  check.insert(check.end(), colour.begin(), colour.begin() + 6);
   for (int64_t i : check) {
     const float saved = store.params()[i];
     const float h = std::max(3e-3f, 3e-3f * std::abs(saved));
@@ -299,6 +364,7 @@ TEST(FacePriorTest, SetupJsonKeepsTheFit) {
   fit.head_from_world.translation = Vec3d(0.1, 0.2, 0.3);
   fit.rms_iod = 0.01, fit.max_iod = 0.03, fit.landmarks_used = 300, fit.landmarks_total = 340, fit.iterations = 7;
   setup.face_fit = fit;
+  setup.prior_light = Vec3f(-0.5f, 0.75f, 1.25f);
   const Result<ModelSetup> parsed = ModelSetup::FromJson(setup.ToJson(), "test");
   ASSERT_TRUE(parsed.ok()) << parsed.status().message();
   const ModelSetup& back = *parsed;
@@ -307,6 +373,13 @@ TEST(FacePriorTest, SetupJsonKeepsTheFit) {
   EXPECT_NEAR(back.face_fit->head_from_world.scale, 1.5, 1e-12);
   EXPECT_NEAR((back.face_fit->head_from_world.rotation - fit.head_from_world.rotation).norm(), 0.0, 1e-12);
   EXPECT_EQ(back.face_fit->landmarks_used, 300);
+  ASSERT_TRUE(back.prior_light.has_value());
+  EXPECT_EQ(*back.prior_light, Vec3f(-0.5f, 0.75f, 1.25f));
+  Json no_light = setup.ToJson();
+  no_light.erase("prior_light");  // a model saved before the prior shading: no light, no shading
+  EXPECT_FALSE(ModelSetup::FromJson(no_light, "ckpt")->prior_light.has_value());
+  no_light["prior_light"] = {1.0, 2.0};
+  EXPECT_NE(ModelSetup::FromJson(no_light, "ckpt").status().message().find("prior_light"), std::string::npos);
   Json bad = setup.ToJson();
   bad["face_fit"]["head_from_world"]["rotation"][0][0] = 3.0;
   const auto err = ModelSetup::FromJson(bad, "ckpt");

@@ -8,6 +8,7 @@
 
 #include "icef/io/atomic_file.h"
 #include "icef/model/face_prior.h"
+#include "icef/model/prior_light.h"
 #include "icef/model/render_image.h"
 #include "icef/train/visual_hull.h"
 
@@ -86,6 +87,16 @@ Result<std::unique_ptr<Trainer>> Trainer::Create(const Dataset& dataset, const f
   if (UsesFacePrior(config.model.ParsedMethod())) {
     ICEF_ASSIGN_OR_RETURN(setup.face_fit, FitFaceModelToDataset(dataset));
   }
+  std::string shading_note;
+  if (config.model.prior_shading && setup.face_fit) {
+    // Without a light (tiny images) the model trains unshaded: the shading is a refinement, and the
+    // rest of the prior still applies.
+    if (Result<PriorLightFit> light = FitPriorLight(dataset, *setup.face_fit, executor); light.ok()) {
+      setup.prior_light = light->light;
+    } else {
+      shading_note = light.status().message();
+    }
+  }
   ICEF_ASSIGN_OR_RETURN(std::unique_ptr<AvatarModel> model, AvatarModel::Create(config.model, setup, executor));
   model->Initialize(static_cast<uint64_t>(config.train.seed));
   if (config.model.visual_hull.enabled && data.has_alpha()) {
@@ -103,7 +114,9 @@ Result<std::unique_ptr<Trainer>> Trainer::Create(const Dataset& dataset, const f
   fs::create_directories(model_dir, ec);
   if (!fs::is_directory(model_dir)) return Status::Error(model_dir.string() + ": cannot create the model directory");
   ICEF_RETURN_IF_ERROR(WriteFileAtomic(model_dir / "config.json", FormatJson(config.ToJson())));
-  return std::unique_ptr<Trainer>(new Trainer(dataset, model_dir, config, std::move(data), std::move(model)));
+  std::unique_ptr<Trainer> trainer(new Trainer(dataset, model_dir, config, std::move(data), std::move(model)));
+  trainer->prior_shading_note_ = std::move(shading_note);
+  return trainer;
 }
 
 Result<std::unique_ptr<Trainer>> Trainer::Resume(const Dataset& dataset, const fs::path& model_dir,

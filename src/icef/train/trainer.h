@@ -83,6 +83,9 @@ class Trainer {
   Status SaveCheckpoint() const;
 
   AvatarModel& model() { return *model_; }
+  // Why a model that would use the prior shading trains without it (its light could not be fitted:
+  // too few training pixels show the face model's skin); empty otherwise.
+  const std::string& prior_shading_note() const { return prior_shading_note_; }
   const RunConfig& config() const { return config_; }
   int64_t step() const { return state_.step; }
 
@@ -101,6 +104,7 @@ class Trainer {
   RunConfig config_;
   TrainingData data_;
   std::unique_ptr<AvatarModel> model_;
+  std::string prior_shading_note_;
   std::unique_ptr<nn::Adam> adam_;
   Executor executor_;  // a copy: a thread count
   TrainerState state_;

@@ -203,6 +203,49 @@ TEST(TrainerTest, EveryMethodTrainsAndWritesItsModelDirectory) {
   }
 }
 
+// icef-prior fits the prior shading's light to the training images and keeps it in the model; on
+// images too small to fit one it trains unshaded and says why.
+TEST(TrainerTest, PriorShadingFitsTheLightOrSaysWhyNot) {
+  RunConfig config = SmallConfig("icef-prior");
+  config.train.steps = 2;
+  const fs::path dir = testing::MakeTempDir("trainer_prior_light");
+  auto t = Trainer::Create(TinySubject(), dir, config);
+  ASSERT_TRUE(t.ok()) << t.status().message();
+  ASSERT_TRUE((*t)->model().prior_light().has_value());
+  EXPECT_TRUE((*t)->prior_shading_note().empty());
+  // The classic scene's key light: strength 0.72 / 0.38 towards (-0.35, 0.45, 0.82).
+  const Vec3f light = *(*t)->model().prior_light();
+  EXPECT_GT(light.normalized().dot(Vec3f(-0.35f, 0.45f, 0.82f).normalized()), 0.95f) << light.transpose();
+  ASSERT_TRUE((*t)->Run(nullptr, nullptr).ok());
+  auto loaded = LoadModel(dir, Executor(1));
+  ASSERT_TRUE(loaded.ok()) << loaded.status().message();
+  ASSERT_TRUE(loaded->model->prior_light().has_value());
+  EXPECT_EQ(*loaded->model->prior_light(), light);
+
+  config.model.prior_shading = false;
+  auto off = Trainer::Create(TinySubject(), testing::MakeTempDir("trainer_prior_light_off"), config);
+  ASSERT_TRUE(off.ok()) << off.status().message();
+  EXPECT_FALSE((*off)->model().prior_light().has_value());
+  EXPECT_TRUE((*off)->prior_shading_note().empty());
+
+  const fs::path tiny = testing::MakeTempDir("trainer_prior_light_tiny");
+  synth::SynthOptions o;
+  o.out_dir = tiny;
+  o.num_train = 3;
+  o.resolution = 12;
+  o.test_views = 1;
+  o.novel_per_tier = 1;
+  ASSERT_TRUE(synth::SynthesizeDataset(o, Executor(2)).ok());
+  auto dataset = LoadDataset(tiny);
+  ASSERT_TRUE(dataset.ok()) << dataset.status().message();
+  config.model.prior_shading = true;
+  auto small = Trainer::Create(*dataset, testing::MakeTempDir("trainer_prior_light_tiny_model"), config);
+  ASSERT_TRUE(small.ok()) << small.status().message();
+  EXPECT_FALSE((*small)->model().prior_light().has_value());
+  EXPECT_NE((*small)->prior_shading_note().find("too few"), std::string::npos) << (*small)->prior_shading_note();
+  EXPECT_TRUE((*small)->Run(nullptr, nullptr).ok());
+}
+
 TEST(RunConfigTest, ParentsOverridesAndStrictKeys) {
   const fs::path dir = testing::MakeTempDir("run_config");
   std::ofstream(dir / "base.json")
