@@ -23,7 +23,7 @@ CommandFn RegisterTrain(CLI::App& app) {
   auto threads = std::make_shared<int>(-1);
   app.add_option("dataset", o->dataset, "Dataset directory (transforms_train.json ...)")->required();
   app.add_option("--out", o->out, "Model directory to write")->required();
-  app.add_option("--method", *method, "icef-prior | warp-prior | icef | icef-no-id | icef-no-conf | icef-uniform | warp | nerface (default icef-prior: ICEF on the face model fitted to the training landmarks, docs/face_model.md; it needs the face model's expression names, other datasets train with icef)");
+  app.add_option("--method", *method, "icef-prior | warp-prior | icef | icef-no-id | icef-no-conf | icef-uniform | warp | nerface (default icef-prior: ICEF on the face model fitted to the training landmarks, docs/face_model.md; it needs the face model's expression names: re-express other datasets with icef track DATASET --keep-cameras, or train them with --method icef)");
   app.add_option("--steps", *steps, "Optimiser steps")->check(CLI::PositiveNumber);
   app.add_option("--time-budget", *budget, "Stop after this many seconds of training")->check(CLI::NonNegativeNumber);
   app.add_option("--config", *config, "Run config JSON ({\"parent\", \"model\": {...}, \"train\": {...}})");

@@ -24,8 +24,10 @@ class DeformationPrior {
   virtual void Cavity(const Executor& executor, int64_t n, const float* positions, const float* betas,
                       uint8_t* inside) const = 0;
 
-  // Surface normals of the face model, world frame: observed [n, 3] of the expressed surface at x_i
-  // (beta_i), canonical [n, 3] of the neutral surface at P(x_i, beta_i). False: the prior has none.
+  // Surface normals of the face model, world frame: canonical [n, 3] of the neutral surface at
+  // P(x_i, beta_i); observed [n, 3] that normal carried back through the warp (J^T n normalised,
+  // J = dP/dx at x_i): the normal at x_i of the surface P makes of the neutral one. The two are
+  // equal where P(., beta_i) is a translation. False: the prior has none.
   virtual bool Normals(const Executor& executor, int64_t n, const float* positions, const float* betas,
                        float* observed, float* canonical) const {
     (void)executor, (void)n, (void)positions, (void)betas, (void)observed, (void)canonical;

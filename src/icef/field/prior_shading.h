@@ -4,9 +4,10 @@
 // A canonical field's colours carry the light of the canonical (neutral) surface. Where an
 // expression turns the surface (an opened jaw, puffed cheeks, raised brows) the light on it changes:
 // on validation identity 101 that is most of the moderate tier's change at the scale of the features
-// (docs/results/expr_gain_probe). The face-model prior knows both orientations: n_obs, the normal of
-// the expressed face model at an observation point x, and n_can, the neutral face model's normal at
-// its canonical point P(x, beta). With the subject's light v (world frame: ambient 1 plus a
+// (docs/results/expr_gain_probe). The face-model prior knows both orientations: n_can, the neutral
+// face model's normal at the canonical point P(x, beta) of an observation point x, and n_obs, that
+// normal carried back through the warp (the normal at x of the surface P makes of the neutral face;
+// DeformationPrior::Normals). With the subject's light v (world frame: ambient 1 plus a
 // Lambertian key light of strength |v| along v / |v|; fitted to the training images before training,
 // model/prior_light.h), each sample's colour is scaled by
 //

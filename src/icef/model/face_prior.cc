@@ -9,6 +9,8 @@ namespace icef {
 
 namespace {
 
+constexpr float kJacobianStep = 1e-3f;  // head units (the head is 0.73 tall; the warp's windows span 0.03+)
+
 class FacePrior final : public DeformationPrior {
  public:
   explicit FacePrior(const face::FaceFit& fit) : fit_(fit), model_(fit.shape) {
@@ -57,8 +59,24 @@ class FacePrior final : public DeformationPrior {
         const Vec3f x(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]);
         const face::ExpressionState& state = cache.Get(model_, betas + i * face::kNumExpressions);
         const Vec3f x_h = head_from_world_ * x + translation_;
-        const Vec3f n_obs = rotation_t_ * model_.Normal(x_h, state);
-        const Vec3f n_can = rotation_t_ * model_.Normal(model_.PriorWarp(x_h, state), neutral_);
+        // The neutral surface's normal g at the canonical point P(x), and g carried back through the
+        // prior warp: the surface the warp makes of the neutral one is d(x) = d_neutral(P(x)), whose
+        // gradient is J^T g with J = dP/dx (central differences). Where the warp is a translation the
+        // two agree (s = 1) whatever the expression. Six warps cost a fraction of the four signed
+        // distances of the expressed model's own normal.
+        const Vec3f g = model_.Normal(model_.PriorWarp(x_h, state), neutral_);
+        Vec3f carried = g;
+        if (!state.neutral) {
+          Mat3f jacobian;
+          for (int a = 0; a < 3; ++a) {
+            const Vec3f e = Vec3f::Unit(a) * kJacobianStep;
+            jacobian.col(a) = (model_.PriorWarp(x_h + e, state) - model_.PriorWarp(x_h - e, state)) / (2.f * kJacobianStep);
+          }
+          const Vec3f m = jacobian.transpose() * g;
+          if (m.norm() > 0.f) carried = m.normalized();
+        }
+        const Vec3f n_obs = rotation_t_ * carried;
+        const Vec3f n_can = rotation_t_ * g;
         for (int a = 0; a < 3; ++a) {
           observed[3 * i + a] = n_obs[a];
           canonical[3 * i + a] = n_can[a];
@@ -109,7 +127,8 @@ Status CheckFaceModelExpressions(const std::vector<std::string>& expression_name
   return Status::Error(origin + ": the face-model prior needs the face model's " + std::to_string(want.size()) +
                        " expressions (jaw_open, smile_left, ...; docs/face_model.md), but expression_names are [" +
                        (got.empty() ? std::string("none") : got) +
-                       "]: train this dataset with a method without the prior (icef, warp, nerface)");
+                       "]: re-express the dataset in them with `icef track DATASET --keep-cameras --out NEW`, or "
+                       "train it with a method without the prior (icef, warp, nerface)");
 }
 
 Result<face::FaceFit> FitFaceModelToDataset(const Dataset& dataset, const face::FaceFitOptions& options) {

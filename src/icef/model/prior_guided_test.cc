@@ -3,6 +3,7 @@
 // and the training gradient still matches finite differences with a prior under the residual.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "icef/core/rng.h"
@@ -353,6 +354,88 @@ TEST(FacePriorTest, FittedPriorMatchesTheGeneratingHeadsWarp) {
     EXPECT_LT(worst, 0.02) << "largest warp " << motion << " IOD";  // measured: 0.0013, 0.0016, 0.0096
     EXPECT_GT(motion, 0.05);  // the expressions do move the face
   }
+}
+
+// The shading normals (FacePrior::Normals): the neutral normal at P(x), and that normal carried
+// back through the warp. On the expressed surface away from the lids (which the prior slides rather
+// than warps) and the mouth's cavity, the carried normal is the expressed face model's own normal;
+// where an expression leaves the surface alone, and at neutral, the two normals agree.
+TEST(FacePriorTest, ShadingNormalsAreTheNeutralNormalCarriedThroughTheWarp) {
+  face::ShapeParams shape;
+  shape.jaw_width = 1.1f, shape.cheek_fullness = 1.1f;
+  const face::FaceModel truth(shape);
+  ModelSetup setup;
+  setup.expression_dim = face::kNumExpressions;
+  setup.expression_names = face::ExpressionNames();
+  face::FaceFit fit;
+  fit.shape = shape;
+  fit.head_from_world.scale = 1.3;
+  fit.head_from_world.rotation = Eigen::AngleAxisd(0.5, Vec3d(0.2, 1.0, -0.3).normalized()).toRotationMatrix();
+  fit.head_from_world.translation = Vec3d(0.05, -0.1, 0.2);
+  setup.face_fit = fit;
+  Result<std::unique_ptr<DeformationPrior>> made = MakeFacePrior(setup);
+  ASSERT_TRUE(made.ok()) << made.status().message();
+  const std::unique_ptr<DeformationPrior> prior = std::move(made).value();
+  const Mat3f to_world = fit.head_from_world.rotation.transpose().cast<float>();
+  auto normals = [&](const std::vector<Vec3f>& head_points, const std::vector<float>& beta,
+                     std::vector<Vec3f>* observed, std::vector<Vec3f>* canonical) {
+    std::vector<float> x, rows, obs(3 * head_points.size()), can(3 * head_points.size());
+    for (const Vec3f& p : head_points) {
+      const Vec3d w = fit.head_from_world.ApplyInverse(p.cast<double>());
+      for (int a = 0; a < 3; ++a) x.push_back(static_cast<float>(w[a]));
+    }
+    const int64_t n = static_cast<int64_t>(head_points.size());
+    BroadcastExpression(beta, n, &rows);
+    ASSERT_TRUE(prior->Normals(Executor(2), n, x.data(), rows.data(), obs.data(), can.data()));
+    observed->clear(), canonical->clear();
+    for (int64_t i = 0; i < n; ++i) {
+      observed->emplace_back(obs[3 * i], obs[3 * i + 1], obs[3 * i + 2]);
+      canonical->emplace_back(can[3 * i], can[3 * i + 1], can[3 * i + 2]);
+    }
+  };
+  auto angle_deg = [](const Vec3f& a, const Vec3f& b) {
+    return std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.f, 1.f)) * 57.29578f;
+  };
+
+  // On the expressed surface: the landmarks of the jaw line, nose and brows.
+  std::vector<float> beta(face::kNumExpressions, 0.f);
+  beta[face::kJawOpen] = 0.9f, beta[face::kSmileLeft] = 0.8f, beta[face::kCheekPuff] = 0.9f;
+  beta[face::kBrowRaiseRight] = 1.2f;
+  const face::ExpressionState state = truth.Prepare(beta);
+  const auto landmarks = truth.Landmarks(state);
+  std::vector<Vec3f> points;
+  for (int i = 0; i < 36; ++i) points.push_back(landmarks[i]);
+  std::vector<Vec3f> observed, canonical;
+  normals(points, beta, &observed, &canonical);
+  double worst = 0, turned = 0;
+  for (size_t i = 0; i < points.size(); ++i) {
+    EXPECT_NEAR(observed[i].norm(), 1.f, 1e-5f);
+    worst = std::max<double>(worst, angle_deg(observed[i], to_world * truth.Normal(points[i], state)));
+    turned = std::max<double>(turned, angle_deg(observed[i], canonical[i]));
+  }
+  EXPECT_LT(worst, 2.0);   // the expressed model's own normal (measured 0.6 degrees; 21 with J for J^T)
+  EXPECT_GT(turned, 5.0);   // and the expression does turn the surface (10 degrees)
+
+  // Where the expression moves nothing (the crown, the back of the head: jaw and mouth only), and at
+  // neutral everywhere, the two normals agree.
+  std::vector<float> mouth_only(face::kNumExpressions, 0.f);
+  mouth_only[face::kJawOpen] = 1.f, mouth_only[face::kLipPucker] = 0.8f;
+  const std::vector<Vec3f> far_away = {Vec3f(0.f, 0.388f, 0.f), Vec3f(0.1f, 0.3f, -0.2f), Vec3f(-0.2f, 0.2f, -0.25f)};
+  normals(far_away, mouth_only, &observed, &canonical);
+  for (size_t i = 0; i < far_away.size(); ++i) EXPECT_LT(angle_deg(observed[i], canonical[i]), 0.05) << i;
+  normals(points, std::vector<float>(face::kNumExpressions, 0.f), &observed, &canonical);
+  for (size_t i = 0; i < points.size(); ++i) EXPECT_EQ(observed[i], canonical[i]) << i;
+}
+
+// Another expression space (NerFace's 76-D vectors, say): one line that names the dataset and the
+// names it has, and points to the tracker that re-expresses it.
+TEST(FacePriorTest, AnotherExpressionSpacePointsToTheTracker) {
+  EXPECT_TRUE(CheckFaceModelExpressions(face::ExpressionNames(), "d").ok());
+  const Status s = CheckFaceModelExpressions({"e0", "e1"}, "data/nerface");
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.message().find('\n'), std::string::npos);
+  for (const char* want : {"data/nerface", "[e0, e1]", "icef track DATASET --keep-cameras --out NEW", "icef, warp"})
+    EXPECT_NE(s.message().find(want), std::string::npos) << want << " in " << s.message();
 }
 
 TEST(FacePriorTest, SetupJsonKeepsTheFit) {
