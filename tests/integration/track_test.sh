@@ -23,6 +23,8 @@ fail() { echo "FAIL: $*" >&2; exit 1; }
   --res 128 --check 4,0.08,0.3,0.9 || fail "track_eval bounds"
 "$ICEF" info "$TMP/eval/track_2" >/dev/null || fail "the tracked dataset does not validate"
 ls "$TMP/eval/track_2/track/overlay_000.png" >/dev/null || fail "no overlay"
+# The photometric refit ran on the synthetic photos (one consistently lit face).
+grep -q '"photometric_refit": "used"' "$TMP/eval/track_2/track/report.json" || fail "the photometric refit was not used"
 
 # Bad input: one line naming the file, exit 1, nothing written.
 PHOTOS="$TMP/eval/photos_2/photos"
@@ -47,6 +49,10 @@ expect_error "already exists" "$PHOTOS/photo_000.png" --out "$TMP/eval/track_2"
 cat "$TMP/woman.log"
 rms=$(grep -o '"landmark_rms_iod": [0-9.e-]*' "$TMP/woman/track/report.json" | tail -1 | awk '{print $2}')
 awk -v r="$rms" 'BEGIN { exit !(r <= 0.08) }' || fail "landmark RMS $rms IOD on the webcam frames"
+# Lit differently and drawn on (coloured circles): the photometric refit's agreement check keeps
+# the landmark fit, and the log says why.
+grep -q "photometric refit not used: the images' colours disagree" "$TMP/woman.log" \
+  || fail "the webcam frames' photometric refit was not refused: $(grep 'track fit' "$TMP/woman.log")"
 "$ICEF" train "$TMP/woman" --out "$TMP/woman_model" --steps 30 --time-budget 0 >/dev/null || fail "train on the tracked dataset"
 "$ICEF" render "$TMP/woman_model" --out "$TMP/woman_render" --sweep jaw_open=0.8 --sweep-frames 2 >/dev/null \
   || fail "render of the tracked model"

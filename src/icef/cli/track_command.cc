@@ -21,7 +21,9 @@ CommandFn RegisterTrack(CLI::App& app) {
       "Turn photos of one person into a dataset: detects the face and its 68 landmarks in each photo (exactly one "
       "face per photo), fits the face model to all photos at once (shared identity; per photo a head pose and "
       "expression weights), crops a square around the head, masks the person (GrabCut seeded by the fitted head), "
-      "refits the face model to the landmarks and each mask's outline, crops and masks again, and writes the dataset in the fitted head's frame, with track/overlay_NNN.png to check the fit and "
+      "refits the face model to the landmarks and each mask's outline, refines each photo's expression and pose on "
+      "the photos' colours (the photometric refit), crops and masks again, and writes the dataset in the fitted "
+      "head's frame, with track/overlay_NNN.png to check the fit and "
       "track/report.json. Then: icef train DATASET, icef render --sweep.\n"
       "With --keep-cameras, re-express an existing dataset (NerFace, instant-ngp, any expression space) in the face "
       "model's expressions: same cameras and images, the face model fitted to every frame's landmarks.");
@@ -44,6 +46,11 @@ CommandFn RegisterTrack(CLI::App& app) {
   app.add_option("--silhouette-points", options->track.silhouette_points,
                  "Refit each photo's pose, expression and the shape with this many points of its mask's edge "
                  "beside the landmarks (0 = landmarks only; default 200)");
+  app.add_option("--photometric-weight", options->track.fit.photometric_weight,
+                 "Refine each photo's expression and pose on the photos themselves: points of the neutral face, "
+                 "carried into every photo by the fitted warp and pose, must find the same colour there; their "
+                 "weight against the landmarks (0 = landmarks and outline only; default 16)")
+      ->check(CLI::NonNegativeNumber);
   auto region = std::make_shared<std::string>("face");
   app.add_option("--silhouette-region", *region,
                  "Which part of the mask's edge the refit uses: face (where it touches the head between the chin and "

@@ -96,6 +96,25 @@ Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions
       result.frame_names.push_back(FrameName(split, static_cast<int>(i), f));
     }
   }
+  // The images, for the photometric refit (track_fit.h), composited over the dataset's background.
+  std::vector<Image> photos;
+  if (options.fit.photometric_weight > 0 && order.size() <= static_cast<size_t>(kMaxPhotometricFrames)) {
+    photos.reserve(order.size());  // track_frames point into it
+    for (size_t k = 0; k < order.size(); ++k) {
+      ICEF_ASSIGN_OR_RETURN(Image rgba, LoadFrameImage(d, *order[k]));
+      Image rgb(rgba.width, rgba.height, 3);
+      for (int y = 0; y < rgba.height; ++y)
+        for (int x = 0; x < rgba.width; ++x) {
+          const float a = rgba.HasAlpha() ? rgba.At(x, y, 3) : 1.f;
+          for (int c = 0; c < 3; ++c) rgb.At(x, y, c) = a * rgba.At(x, y, c) + (1 - a) * d.background[c];
+        }
+      photos.push_back(std::move(rgb));
+      track_frames[k].photo = &photos.back();
+    }
+  } else if (options.fit.photometric_weight > 0 && log) {
+    log("photometric refit skipped: " + std::to_string(order.size()) + " frames (at most " +
+        std::to_string(kMaxPhotometricFrames) + "); the landmarks alone give the expressions");
+  }
   TrackFitOptions fit_options = options.fit;
   if (options.landmarks == RetrackLandmarks::kDatasetModel) {
     // The face model's own landmarks, as exact as the data that carries them: the priors of a
@@ -104,6 +123,7 @@ Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions
     fit_options.landmark_sigma_iod = 0.02;
     fit_options.shape_prior_sigma = 0.15;
     fit_options.expression_prior_sigma = 0.6;
+    fit_options.photometric_expression_prior_sigma = 0.6;
   }
   ICEF_ASSIGN_OR_RETURN(result.fit, FitTrack(track_frames, fit_options));
   if (log) log(result.fit.BriefReport());
@@ -132,6 +152,8 @@ Json RetrackReportJson(const RetrackResult& result) {
                           {"landmark_rms_iod", f.rms_iod},
                           {"landmark_max_iod", f.max_iod},
                           {"landmarks_used", f.landmarks_used},
+                          {"photometric_rms", f.photometric_rms},
+                          {"photometric_points_used", f.photometric_used},
                           {"expression", expression}});
   }
   Json shape = Json::object();
@@ -143,6 +165,7 @@ Json RetrackReportJson(const RetrackResult& result) {
   return Json{{"frames", frames},
               {"skipped", result.skipped},
               {"landmark_rms_iod", result.fit.rms_iod},
+              {"photometric_refit", result.fit.photometric},
               {"landmark_max_iod", result.fit.max_iod},
               {"iterations", result.fit.iterations},
               {"head_from_world", {{"scale", s.scale},

@@ -30,6 +30,10 @@ enum class RetrackLandmarks {
 const char* RetrackLandmarksName(RetrackLandmarks landmarks);
 std::optional<RetrackLandmarks> ParseRetrackLandmarks(const std::string& name);  // "detect", "dlib", "model"
 
+// Datasets with more frames than this are fitted on their landmarks only: the photometric refit
+// (track_fit.h) solves all frames at once, with every image in memory.
+inline constexpr int kMaxPhotometricFrames = 64;
+
 struct RetrackOptions {
   RetrackLandmarks landmarks = RetrackLandmarks::kDetect;
   bool skip_bad = false;  // drop frames without landmarks (no face found) instead of stopping

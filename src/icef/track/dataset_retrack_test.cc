@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 
 #include "icef/face/expression.h"
@@ -51,7 +52,12 @@ TEST(DatasetRetrackTest, SyntheticDatasetKeepsItsCamerasAndGetsItsExpressionsBac
     for (int e = 0; e < face::kNumExpressions; ++e)
       if (e != face::kCheekPuff) sum2 += std::pow(d.train[i].expression[e] - source->train[i].expression[e], 2), ++n;
   }
+  std::printf("train expression RMS %.3f (dlib landmarks and the photometric refit)\n", std::sqrt(sum2 / n));
   EXPECT_LT(std::sqrt(sum2 / n), 0.25);
+  for (const TrackedFrame& f : r->fit.frames) {  // the photometric refit saw the face in every image
+    EXPECT_GT(f.photometric_used, 50) << f.ToString();
+    EXPECT_LT(f.photometric_rms, 0.1) << f.ToString();
+  }
   EXPECT_EQ(d.test[0].tier, source->test[0].tier);
 
   // The dataset's own landmarks, in the face model's convention (icef synth's): close to exact.

@@ -213,7 +213,11 @@ Result<TrackResult> TrackPhotos(const std::vector<fs::path>& photos, const Track
                          std::to_string(options.num_test));
 
   std::vector<TrackFrame> frames;
-  for (const TrackedPhoto& p : result.photos) frames.push_back(TrackFrame{p.detection.landmarks, p.photo_intrinsics, {}, {}});
+  for (const TrackedPhoto& p : result.photos)
+    frames.push_back(TrackFrame{p.detection.landmarks, p.photo_intrinsics, {}, {}, &p.photo});
+  // The images join in the last fit only (the photometric refit starts from the landmarks').
+  if (options.silhouette_points > 0)
+    for (TrackFrame& f : frames) f.photo = nullptr;
   ICEF_ASSIGN_OR_RETURN(result.fit, FitTrack(frames, options.fit));
   if (log) log(result.fit.BriefReport());
   if (options.silhouette_points > 0) {
@@ -223,6 +227,7 @@ Result<TrackResult> TrackPhotos(const std::vector<fs::path>& photos, const Track
       const HeadCrop c = CropHead(first, result.fit.frames[i], result.photos[i], options, executor);
       frames[i].silhouette = SilhouettePoints(c, result.photos[i], options.resolution, options.silhouette_points,
                                               options.fit.silhouette_face_only);
+      frames[i].photo = &result.photos[i].photo;
     }
     ICEF_ASSIGN_OR_RETURN(result.fit, FitTrack(frames, options.fit));
     if (log) log(result.fit.BriefReport() + " (with silhouettes)");
@@ -275,6 +280,8 @@ Json TrackReportJson(const TrackResult& result) {
                           {"landmarks_used", f.landmarks_used},
                           {"silhouette_rms_iod", f.silhouette_rms_iod},
                           {"silhouette_points_used", f.silhouette_used},
+                          {"photometric_rms", f.photometric_rms},
+                          {"photometric_points_used", f.photometric_used},
                           {"yaw_pitch_roll_deg", {ypr.x(), ypr.y(), ypr.z()}},
                           {"head_in_camera", {t.x(), t.y(), t.z()}},
                           {"expression", expression}});
@@ -285,6 +292,7 @@ Json TrackReportJson(const TrackResult& result) {
   return Json{{"photos", photos},
               {"skipped", result.skipped},
               {"landmark_rms_iod", result.fit.rms_iod},
+              {"photometric_refit", result.fit.photometric},
               {"landmark_max_iod", result.fit.max_iod},
               {"iterations", result.fit.iterations},
               {"shape", shape}};

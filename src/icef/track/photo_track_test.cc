@@ -111,6 +111,9 @@ TEST_F(PhotoTrackTest, SyntheticPhotosBecomeADatasetInTheHeadFrame) {
     EXPECT_GT(r.fit.frames[i].silhouette_used, 10) << "photo " << i;
     EXPECT_LT(r.fit.frames[i].silhouette_rms_iod, 0.1) << "photo " << i;
     EXPECT_EQ(static_cast<int>(r.fit.frames[i].silhouette_points.size()), r.fit.frames[i].silhouette_used);
+    // The photometric refit saw the face in every photo and its colours agree.
+    EXPECT_GT(r.fit.frames[i].photometric_used, 100) << "photo " << i;
+    EXPECT_LT(r.fit.frames[i].photometric_rms, 0.1) << "photo " << i;
     // The mask against the true coverage, cropped the same way.
     ASSERT_EQ(p.image.channels, 4);
     Image mask(128, 128, 1);

@@ -20,6 +20,7 @@
 #include "icef/core/status.h"
 #include "icef/face/face_fit.h"
 #include "icef/face/shape_params.h"
+#include "icef/io/image.h"
 #include "icef/math/camera.h"
 #include "icef/math/types.h"
 
@@ -34,6 +35,10 @@ struct TrackFrame {
   // GrabCut mask). Each adds a silhouette residual: the fitted surface's closest approach to the
   // point's ray, which is 0 where the ray grazes the head.
   std::vector<Vec2f> silhouette;
+  // Optional: the image itself (RGB or RGBA, the pixels the landmarks and intrinsics refer to; not
+  // owned, it must outlive FitTrack). When every frame has one, a photometric refit follows the
+  // landmark fit (TrackFitOptions::photometric_weight; track/photometric.h).
+  const Image* photo = nullptr;
 };
 
 // The defaults were chosen on synthetic photos of validation identities 101-106 (scripts/track_eval.py).
@@ -55,6 +60,22 @@ struct TrackFitOptions {
   // its surface (IOD), or, with silhouette_face_only, touching it above the brows or below the chin.
   double silhouette_max_gap_iod = 0.15;
   bool silhouette_face_only = true;
+  // The photometric refit (TrackFrame::photo): points of the neutral face carried into every image
+  // by the fitted warp and pose must find the same colour there. A frame's colour residuals weigh
+  // together this many times as much as its 68 landmarks (0: no refit).
+  double photometric_weight = 16;
+  double photometric_sigma = 0.05;     // colour noise (colours in [0, 1]); also where the Cauchy loss discounts a point
+  double photometric_expression_prior_sigma = 0.2;  // the refit's expression_prior_sigma
+  int photometric_points = 400;        // points on the neutral face (track/photometric.h)
+  // The images are blurred by a Gaussian of this standard deviation (IOD), coarse then fine: each
+  // blur is one Levenberg-Marquardt solve started from the last.
+  double photometric_blur_coarse_iod = 0.1;
+  double photometric_blur_fine_iod = 0.04;
+  // After the refit, if the images' colours still disagree by more than this RMS (the upper median
+  // over the images, after each one's exposure gain), the refit is dropped and the landmark fit
+  // stands: the photos then do not show one consistently lit face (synthetic photos: medians
+  // 0.01-0.02; the two webcam frames of opencv-doc, lit differently and drawn on: 0.09).
+  double photometric_max_rms = 0.06;
 
   Status Validate() const;
   std::string ToString() const;
@@ -70,6 +91,8 @@ struct TrackedFrame {
   double rms_iod = 0;                       // landmark residual of this frame (inliers)
   double max_iod = 0;                       // its largest landmark residual (all landmarks)
   int landmarks_used = 0;                   // inliers
+  double photometric_rms = 0;               // colour residual of this frame's visible face points (0: no refit)
+  int photometric_used = 0;                 // those points
   double silhouette_rms_iod = 0;            // silhouette gap of the inlier silhouette points (0: none given)
   int silhouette_used = 0;                  // inlier silhouette points
   std::vector<Vec2f> silhouette_points;     // those points (pixels), for overlays
@@ -88,6 +111,10 @@ struct TrackFit {
   double rms_iod = 0;  // over all frames' inliers
   double max_iod = 0;
   int iterations = 0;
+  // The photometric refit: "off" (no images, one image or weight 0), "used", or "not used: ..." with
+  // the reason (TrackFitOptions::photometric_max_rms); each frame's photometric_rms says how far
+  // its colours agreed either way.
+  std::string photometric = "off";
   std::string BriefReport() const;
   std::string ToString() const { return BriefReport(); }
 };
