@@ -46,10 +46,12 @@ CommandFn RegisterTrack(CLI::App& app) {
   app.add_option("--silhouette-points", options->track.silhouette_points,
                  "Refit each photo's pose, expression and the shape with this many points of its mask's edge "
                  "beside the landmarks (0 = landmarks only; default 200)");
-  app.add_option("--photometric-weight", options->track.fit.photometric_weight,
+  auto photometric = std::make_shared<double>(-1);  // -1: the mode's default
+  app.add_option("--photometric-weight", *photometric,
                  "Refine each photo's expression and pose on the photos themselves: points of the neutral face, "
                  "carried into every photo by the fitted warp and pose, must find the same colour there; their "
-                 "weight against the landmarks (0 = landmarks and outline only; default 16)")
+                 "weight against the landmarks (0 = landmarks and outline only; default 16 for photos, 0 with "
+                 "--keep-cameras, where it measured worse: docs/tracking.md)")
       ->check(CLI::NonNegativeNumber);
   auto region = std::make_shared<std::string>("face");
   app.add_option("--silhouette-region", *region,
@@ -64,8 +66,13 @@ CommandFn RegisterTrack(CLI::App& app) {
   app.add_flag("--calibrate-detector", *calibrate,
                "Developer: measure where dlib puts its landmarks on the face model (renders of validation "
                "identities) and print the table of src/icef/track/detector_landmarks.inc");
-  return [options, focal, calibrate, landmarks, region, &app]() -> Status {
+  return [options, focal, calibrate, landmarks, region, photometric, &app]() -> Status {
     options->track.fit.silhouette_face_only = *region == "face";
+    if (*photometric >= 0) {
+      options->track.fit.photometric_weight = *photometric;
+    } else if (options->keep_cameras) {
+      options->track.fit.photometric_weight = track::RetrackOptions().fit.photometric_weight;
+    }
     const auto parsed = track::ParseRetrackLandmarks(*landmarks);
     if (!parsed) return Status::Error("--landmarks: expected detect, dlib or model, got \"" + *landmarks + "\"");
     options->landmarks = *parsed;

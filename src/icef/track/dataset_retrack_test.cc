@@ -4,7 +4,6 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 
 #include "icef/face/expression.h"
@@ -52,9 +51,16 @@ TEST(DatasetRetrackTest, SyntheticDatasetKeepsItsCamerasAndGetsItsExpressionsBac
     for (int e = 0; e < face::kNumExpressions; ++e)
       if (e != face::kCheekPuff) sum2 += std::pow(d.train[i].expression[e] - source->train[i].expression[e], 2), ++n;
   }
-  std::printf("train expression RMS %.3f (dlib landmarks and the photometric refit)\n", std::sqrt(sum2 / n));
   EXPECT_LT(std::sqrt(sum2 / n), 0.25);
-  for (const TrackedFrame& f : r->fit.frames) {  // the photometric refit saw the face in every image
+  EXPECT_EQ(r->fit.photometric, "off");  // off by default with known cameras
+
+  // Asked for, the photometric refit runs on the dataset's images and sees the face in every one.
+  RetrackOptions photometric;
+  photometric.fit.photometric_weight = 16;
+  const Result<RetrackResult> p = RetrackDataset(*source, photometric, Executor(2));
+  ASSERT_TRUE(p.ok()) << p.status().message();
+  EXPECT_NE(p->fit.photometric, "off");
+  for (const TrackedFrame& f : p->fit.frames) {
     EXPECT_GT(f.photometric_used, 50) << f.ToString();
     EXPECT_LT(f.photometric_rms, 0.1) << f.ToString();
   }
