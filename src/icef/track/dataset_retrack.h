@@ -39,8 +39,8 @@ struct RetrackOptions {
   bool skip_bad = false;  // drop frames without landmarks (no face found) instead of stopping
   std::filesystem::path predictor_path;  // dlib's shape predictor; empty: the Debian default
   // The photometric refit is off by default here: on a synthetic dataset (test identity 1, dlib's
-  // landmarks) it turned the shared similarity by 5.7 degrees and cost the trained model 3 dB
-  // (docs/tracking.md), though it read the expressions a little better.
+  // landmarks) it turned the shared similarity by 5.7 degrees and cost the model trained on the
+  // result 3 dB (docs/tracking.md), though it read the expressions a little better.
   TrackFitOptions fit = [] {
     TrackFitOptions o;
     o.photometric_weight = 0;
