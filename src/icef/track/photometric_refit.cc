@@ -180,6 +180,7 @@ Status PhotometricRefit(std::vector<FrameProblem>& problems, Shared& shared, con
   for (int k = 0; k < n; ++k) all[k] = k;
   TrackFitOptions refit_options = options;
   refit_options.expression_prior_sigma = options.photometric_expression_prior_sigma;
+  refit_options.expression_prior_laplace = options.photometric_expression_prior_laplace;
   for (const double blur_iod : {options.photometric_blur_coarse_iod, options.photometric_blur_fine_iod}) {
     std::vector<BlurredImage> images;
     std::vector<std::vector<char>> visible;

@@ -277,6 +277,19 @@ struct GaussianPrior {
   }
 };
 
+// A Laplace prior on weights >= 0: cost sum(x) / scale, up to a constant, as the residuals
+// sqrt(2 (x + kLaplaceOffset) / scale); the offset keeps their Jacobian finite at 0.
+template <int N>
+struct LaplacePrior {
+  static constexpr double kLaplaceOffset = 0.02;
+  double scale;
+  template <typename T>
+  bool operator()(const T* x, T* residuals) const {
+    for (int i = 0; i < N; ++i) residuals[i] = sqrt(T(2.0) * (x[i] + T(kLaplaceOffset)) / T(scale));
+    return true;
+  }
+};
+
 Status CheckFrames(std::span<const TrackFrame> frames) {
   if (frames.empty()) return Status::Error("track fit: no frames");
   const bool known = frames[0].world_from_cam.has_value();
@@ -327,6 +340,10 @@ void AddLandmarkBlocks(ceres::Problem& cp, std::vector<FrameProblem>& problems, 
     cp.AddResidualBlock(new ceres::AutoDiffCostFunction<GaussianPrior<kExpr>, kExpr, kExpr>(
                             new GaussianPrior<kExpr>{0.0, 1.0 / options.expression_prior_sigma}),
                         nullptr, s->expression[k].data());
+    if (options.expression_prior_laplace > 0)
+      cp.AddResidualBlock(new ceres::AutoDiffCostFunction<LaplacePrior<kExpr>, kExpr, kExpr>(
+                              new LaplacePrior<kExpr>{options.expression_prior_laplace}),
+                          nullptr, s->expression[k].data());
     for (int i = 0; i < kExpr; ++i) {
       cp.SetParameterLowerBound(s->expression[k].data(), i, 0.0);
       cp.SetParameterUpperBound(s->expression[k].data(), i, options.max_expression);
@@ -468,6 +485,9 @@ Status TrackFitOptions::Validate() const {
     return Status::Error("shape_prior_sigma must be a finite number > 0");
   if (!(expression_prior_sigma > 0) || !std::isfinite(expression_prior_sigma))
     return Status::Error("expression_prior_sigma must be a finite number > 0");
+  if (!(expression_prior_laplace >= 0) || !std::isfinite(expression_prior_laplace) ||
+      !(photometric_expression_prior_laplace >= 0) || !std::isfinite(photometric_expression_prior_laplace))
+    return Status::Error("expression_prior_laplace and photometric_expression_prior_laplace must be finite numbers >= 0");
   if (!(max_expression > 0) || !std::isfinite(max_expression)) return Status::Error("max_expression must be > 0");
   if (!(jaw_line_weight >= 0) || jaw_line_weight > 1) return Status::Error("jaw_line_weight must be in [0, 1]");
   if (max_iterations < 1) return Status::Error("max_iterations must be >= 1");
@@ -500,7 +520,9 @@ std::string TrackFitOptions::ToString() const {
      << ", silhouette_sigma_iod=" << silhouette_sigma_iod << ", silhouette_max_gap_iod=" << silhouette_max_gap_iod
      << ", silhouette_face_only=" << silhouette_face_only << ", photometric_weight=" << photometric_weight
      << ", photometric_sigma=" << photometric_sigma
+     << ", expression_prior_laplace=" << expression_prior_laplace
      << ", photometric_expression_prior_sigma=" << photometric_expression_prior_sigma
+     << ", photometric_expression_prior_laplace=" << photometric_expression_prior_laplace
      << ", photometric_points=" << photometric_points << ", photometric_max_rms=" << photometric_max_rms
      << ", photometric_blur_iod=[" << photometric_blur_coarse_iod << ", " << photometric_blur_fine_iod << "])";
   return os.str();

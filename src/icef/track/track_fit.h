@@ -48,6 +48,9 @@ struct TrackFitOptions {
   double landmark_sigma_iod = 0.05;
   double shape_prior_sigma = 0.1;       // std of each shape scale around 1
   double expression_prior_sigma = 0.3;  // std of each expression weight around 0 (neutral)
+  // A Laplace (L1) prior on the weights besides the Gaussian one, cost sum(weights) / this scale
+  // (0: none): a photo shows few expressions at once, and this prior leaves the others at exactly 0.
+  double expression_prior_laplace = 0;
   double max_expression = 1.5;          // upper bound of the weights (lower bound 0)
   double jaw_line_weight = 0.5;         // weight of landmarks 0-16: the detector follows the silhouette there
   int max_iterations = 80;              // Levenberg-Marquardt iterations per pass
@@ -66,6 +69,7 @@ struct TrackFitOptions {
   double photometric_weight = 16;
   double photometric_sigma = 0.05;     // colour noise (colours in [0, 1]); also where the Cauchy loss discounts a point
   double photometric_expression_prior_sigma = 0.2;  // the refit's expression_prior_sigma
+  double photometric_expression_prior_laplace = 0.3;  // the refit's expression_prior_laplace
   int photometric_points = 400;        // points on the neutral face (track/photometric.h)
   // The images are blurred by a Gaussian of this standard deviation (IOD), coarse then fine: each
   // blur is one Levenberg-Marquardt solve started from the last.
