@@ -90,7 +90,10 @@ fi
 "$ICEF" info "$TMP/syn_tracked" >/dev/null || fail "the re-expressed dataset does not validate"
 grep -q '"expression_names": \[' "$TMP/syn_tracked/transforms_train.json" || fail "no expression_names"
 grep -q "jaw_open" "$TMP/syn_tracked/transforms_train.json" || fail "not the face model's expressions"
+# dlib's landmarks: the photometric refit runs by default; the face model's exact ones: it does not.
+grep -q '"photometric_refit": "used"' "$TMP/syn_tracked/track/report.json" || fail "--keep-cameras: the photometric refit was not used"
 "$ICEF" track "$TMP/syn" --keep-cameras --landmarks model --out "$TMP/syn_model" >/dev/null || fail "--landmarks model"
+grep -q '"photometric_refit": "off"' "$TMP/syn_model/track/report.json" || fail "--landmarks model: the photometric refit ran"
 "$ICEF" info "$TMP/syn_model" >/dev/null || fail "the dataset re-expressed from its own landmarks does not validate"
 expect_error "--landmarks: expected detect, dlib or model" "$TMP/syn" --keep-cameras --landmarks mediapipe --out "$TMP/bad5"
 echo "track_test: OK"

@@ -39,6 +39,16 @@ std::optional<RetrackLandmarks> ParseRetrackLandmarks(const std::string& name) {
   return std::nullopt;
 }
 
+double RetrackPhotometricWeight(RetrackLandmarks landmarks) {
+  return landmarks == RetrackLandmarks::kDatasetModel ? 0.0 : TrackFitOptions().photometric_weight;
+}
+
+Status RetrackOptions::Validate() const {
+  TrackFitOptions resolved = fit;
+  if (resolved.photometric_weight < 0) resolved.photometric_weight = RetrackPhotometricWeight(landmarks);
+  return resolved.Validate();
+}
+
 std::string RetrackOptions::ToString() const {
   return "RetrackOptions(landmarks=" + std::string(RetrackLandmarksName(landmarks)) + ", skip_bad=" + std::to_string(skip_bad) + ", predictor=" +
          (predictor_path.empty() ? std::string("default") : predictor_path.string()) + ", " + fit.ToString() + ")";
@@ -96,9 +106,11 @@ Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions
       result.frame_names.push_back(FrameName(split, static_cast<int>(i), f));
     }
   }
+  TrackFitOptions fit_options = options.fit;
+  if (fit_options.photometric_weight < 0) fit_options.photometric_weight = RetrackPhotometricWeight(options.landmarks);
   // The images, for the photometric refit (track_fit.h), composited over the dataset's background.
   std::vector<Image> photos;
-  if (options.fit.photometric_weight > 0 && order.size() <= static_cast<size_t>(kMaxPhotometricFrames)) {
+  if (fit_options.photometric_weight > 0 && order.size() <= static_cast<size_t>(kMaxPhotometricFrames)) {
     photos.reserve(order.size());  // track_frames point into it
     for (size_t k = 0; k < order.size(); ++k) {
       ICEF_ASSIGN_OR_RETURN(Image rgba, LoadFrameImage(d, *order[k]));
@@ -111,11 +123,10 @@ Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions
       photos.push_back(std::move(rgb));
       track_frames[k].photo = &photos.back();
     }
-  } else if (options.fit.photometric_weight > 0 && log) {
+  } else if (fit_options.photometric_weight > 0 && log) {
     log("photometric refit skipped: " + std::to_string(order.size()) + " frames (at most " +
         std::to_string(kMaxPhotometricFrames) + "); the landmarks alone give the expressions");
   }
-  TrackFitOptions fit_options = options.fit;
   if (options.landmarks == RetrackLandmarks::kDatasetModel) {
     // The face model's own landmarks, as exact as the data that carries them: the priors of a
     // sub-pixel source (track_fit_test's), not those balanced against dlib's scatter.

@@ -34,19 +34,23 @@ std::optional<RetrackLandmarks> ParseRetrackLandmarks(const std::string& name); 
 // (track_fit.h) solves all frames at once, with every image in memory.
 inline constexpr int kMaxPhotometricFrames = 64;
 
+// The photometric refit's default weight for a landmark source: on (TrackFitOptions' 16) for dlib's
+// landmarks, whose scatter it reads past; off for the face model's own, which are exact and which it
+// only pulls away from (docs/tracking.md: the round trips of validation identities 101-103).
+double RetrackPhotometricWeight(RetrackLandmarks landmarks);
+
 struct RetrackOptions {
   RetrackLandmarks landmarks = RetrackLandmarks::kDetect;
   bool skip_bad = false;  // drop frames without landmarks (no face found) instead of stopping
   std::filesystem::path predictor_path;  // dlib's shape predictor; empty: the Debian default
-  // The photometric refit is off by default here: on a synthetic dataset (test identity 1, dlib's
-  // landmarks) it turned the shared similarity by 5.7 degrees and cost the model trained on the
-  // result 3 dB (docs/tracking.md), though it read the expressions a little better.
+  // fit.photometric_weight < 0 (the default): the landmark source's default,
+  // RetrackPhotometricWeight(landmarks).
   TrackFitOptions fit = [] {
     TrackFitOptions o;
-    o.photometric_weight = 0;
+    o.photometric_weight = -1;
     return o;
   }();
-  Status Validate() const { return fit.Validate(); }
+  Status Validate() const;
   std::string ToString() const;
 };
 

@@ -52,18 +52,22 @@ TEST(DatasetRetrackTest, SyntheticDatasetKeepsItsCamerasAndGetsItsExpressionsBac
       if (e != face::kCheekPuff) sum2 += std::pow(d.train[i].expression[e] - source->train[i].expression[e], 2), ++n;
   }
   EXPECT_LT(std::sqrt(sum2 / n), 0.25);
-  EXPECT_EQ(r->fit.photometric, "off");  // off by default with known cameras
-
-  // Asked for, the photometric refit runs on the dataset's images and sees the face in every one.
-  RetrackOptions photometric;
-  photometric.fit.photometric_weight = 16;
-  const Result<RetrackResult> p = RetrackDataset(*source, photometric, Executor(2));
-  ASSERT_TRUE(p.ok()) << p.status().message();
-  EXPECT_NE(p->fit.photometric, "off");
-  for (const TrackedFrame& f : p->fit.frames) {
+  // dlib's landmarks: the photometric refit runs by default on the dataset's images and sees the
+  // face in every one.
+  EXPECT_NE(r->fit.photometric, "off");
+  for (const TrackedFrame& f : r->fit.frames) {
     EXPECT_GT(f.photometric_used, 50) << f.ToString();
     EXPECT_LT(f.photometric_rms, 0.1) << f.ToString();
   }
+  EXPECT_EQ(RetrackPhotometricWeight(RetrackLandmarks::kDetect), TrackFitOptions().photometric_weight);
+  EXPECT_EQ(RetrackPhotometricWeight(RetrackLandmarks::kDatasetDlib), TrackFitOptions().photometric_weight);
+  EXPECT_EQ(RetrackPhotometricWeight(RetrackLandmarks::kDatasetModel), 0.0);
+  // Turned off: the landmarks alone.
+  RetrackOptions landmarks_only;
+  landmarks_only.fit.photometric_weight = 0;
+  const Result<RetrackResult> p = RetrackDataset(*source, landmarks_only, Executor(2));
+  ASSERT_TRUE(p.ok()) << p.status().message();
+  EXPECT_EQ(p->fit.photometric, "off");
   EXPECT_EQ(d.test[0].tier, source->test[0].tier);
 
   // The dataset's own landmarks, in the face model's convention (icef synth's): close to exact.
@@ -71,6 +75,7 @@ TEST(DatasetRetrackTest, SyntheticDatasetKeepsItsCamerasAndGetsItsExpressionsBac
   own.landmarks = RetrackLandmarks::kDatasetModel;
   const Result<RetrackResult> exact = RetrackDataset(*source, own, Executor(2));
   ASSERT_TRUE(exact.ok()) << exact.status().message();
+  EXPECT_EQ(exact->fit.photometric, "off");  // exact landmarks: no refit by default
   EXPECT_LT(Eigen::AngleAxisd(exact->fit.head_from_world->rotation).angle() * 180 / M_PI, 1.0);
   double exact2 = 0;
   for (size_t i = 0; i < d.train.size(); ++i)
