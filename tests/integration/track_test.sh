@@ -90,6 +90,12 @@ fi
 "$ICEF" info "$TMP/syn_tracked" >/dev/null || fail "the re-expressed dataset does not validate"
 grep -q '"expression_names": \[' "$TMP/syn_tracked/transforms_train.json" || fail "no expression_names"
 grep -q "jaw_open" "$TMP/syn_tracked/transforms_train.json" || fail "not the face model's expressions"
+# An overlay per frame (3 training, 1 view x (3 observed + 3 novel) test frames), as the log says.
+for f in overlay_train_000.png overlay_train_002.png overlay_test_000.png overlay_test_005.png; do
+  [ -s "$TMP/syn_tracked/track/$f" ] || fail "--keep-cameras: no track/$f"
+done
+[ "$(ls "$TMP/syn_tracked/track" | grep -c '^overlay_')" = 9 ] || fail "--keep-cameras: not one overlay per frame"
+grep -q "9 overlays" "$TMP/keep.log" || fail "--keep-cameras: the log does not count the overlays"
 # dlib's landmarks: the photometric refit runs by default; the face model's exact ones: it does not.
 grep -q '"photometric_refit": "used"' "$TMP/syn_tracked/track/report.json" || fail "--keep-cameras: the photometric refit was not used"
 "$ICEF" track "$TMP/syn" --keep-cameras --landmarks model --out "$TMP/syn_model" >/dev/null || fail "--landmarks model"

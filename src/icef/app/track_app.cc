@@ -79,7 +79,54 @@ Image TrackOverlay(const track::TrackResult& result, int photo_index) {
   return out;
 }
 
+Image RetrackOverlay(const Image& frame, const Vec3f& background, std::span<const Vec2f> landmarks,
+                     std::span<const Vec2f> fitted) {
+  ICEF_CHECK(frame.channels == 3 || frame.channels == 4, "RetrackOverlay: 3 or 4 channels");
+  Image rgb(frame.width, frame.height, 3);
+  for (int y = 0; y < frame.height; ++y)
+    for (int x = 0; x < frame.width; ++x) {
+      const float a = frame.HasAlpha() ? frame.At(x, y, 3) : 1.f;
+      for (int c = 0; c < 3; ++c) rgb.At(x, y, c) = a * frame.At(x, y, c) + (1 - a) * background[c];
+    }
+  const int w = std::max(1, static_cast<int>(std::lround(double(frame.width) * kOverlayHeight / frame.height)));
+  Image out = track::ResizeImage(rgb, w, kOverlayHeight);
+  const double s = double(kOverlayHeight) / frame.height;
+  std::vector<std::optional<Vec2d>> uv;
+  for (const Vec2f& q : fitted) uv.push_back(q.allFinite() ? std::optional<Vec2d>(q.cast<double>() * s) : std::nullopt);
+  DrawFaceOutline2d(&out, uv, Vec3f(1.f, 0.15f, 0.1f));
+  for (const Vec2f& l : landmarks)
+    if (l.allFinite()) Dot(&out, (l.cast<double>() * s).cast<float>(), Vec3f(0.1f, 0.95f, 0.2f));
+  return out;
+}
+
+std::vector<int> RetrackOverlayFrames(int n) {
+  std::vector<int> frames;
+  if (n <= kMaxRetrackOverlays) {
+    for (int i = 0; i < n; ++i) frames.push_back(i);
+    return frames;
+  }
+  for (int i = 0; i < kMaxRetrackOverlays; ++i)
+    frames.push_back(static_cast<int>(std::lround(double(i) * (n - 1) / (kMaxRetrackOverlays - 1))));
+  return frames;
+}
+
 namespace {
+
+// Every fitted frame of a --keep-cameras fit, in the fit's order (train, test, val, as
+// RetrackResult::frame_names), with its overlay's name track/overlay_<split>_NNN.png.
+std::vector<std::pair<std::string, const Frame*>> RetrackFrames(const track::RetrackResult& result) {
+  const Dataset& d = result.dataset;
+  std::vector<std::pair<std::string, const Frame*>> frames;
+  for (const auto& [split, list] : {std::pair<const char*, const std::vector<Frame>*>{"train", &d.train},
+                                    {"test", &d.test}, {"val", &d.val}})
+    for (size_t i = 0; i < list->size(); ++i) {
+      char name[64];
+      std::snprintf(name, sizeof(name), "track/overlay_%s_%03zu.png", split, i);
+      frames.emplace_back(name, &(*list)[i]);
+    }
+  ICEF_CHECK(frames.size() == result.fit.frames.size(), "RetrackFrames: one fitted frame per dataset frame");
+  return frames;
+}
 
 Status RunRetrack(const TrackAppOptions& options, std::ostream& out) {
   if (options.photos.size() != 1) return Status::Error("icef track --keep-cameras takes one dataset directory");
@@ -94,15 +141,31 @@ Status RunRetrack(const TrackAppOptions& options, std::ostream& out) {
   ICEF_ASSIGN_OR_RETURN(const track::RetrackResult result,
                         track::RetrackDataset(source, ro, Executor(options.threads),
                                               [&](const std::string& line) { out << line << "\n"; }));
-  for (size_t k = 0; k < result.fit.frames.size(); ++k)
-    if (result.fit.frames[k].rms_iod > 0.05)
-      out << "warning: " << result.frame_names[k] << ": the face model fits its landmarks poorly (RMS "
-          << result.fit.frames[k].rms_iod << " IOD > 0.05)\n";
+  // The overlays (RetrackOverlay) of RetrackOverlayFrames' frames.
+  const auto frames = RetrackFrames(result);
+  const std::vector<int> chosen = RetrackOverlayFrames(static_cast<int>(frames.size()));
+  std::vector<std::pair<std::string, Image>> overlays;
+  for (const int k : chosen) {
+    const Frame& f = *frames[k].second;
+    ICEF_ASSIGN_OR_RETURN(const Image image, LoadFrameImage(result.dataset, f));
+    overlays.emplace_back(frames[k].first, RetrackOverlay(image, result.dataset.background,
+                                                          f.landmarks_2d ? std::span<const Vec2f>(*f.landmarks_2d)
+                                                                         : std::span<const Vec2f>(),
+                                                          result.fit.frames[k].projected));
+  }
+  for (size_t k = 0; k < result.fit.frames.size(); ++k) {
+    if (result.fit.frames[k].rms_iod <= 0.05) continue;
+    out << "warning: " << result.frame_names[k] << ": the face model fits its landmarks poorly (RMS "
+        << result.fit.frames[k].rms_iod << " IOD > 0.05)";
+    if (std::find(chosen.begin(), chosen.end(), static_cast<int>(k)) != chosen.end()) out << "; check " << frames[k].first;
+    out << "\n";
+  }
   out << "head_from_world: " << result.fit.head_from_world->ToString() << "\n";
-  ICEF_RETURN_IF_ERROR(track::WriteRetrackedDataset(result, options.out));
+  ICEF_RETURN_IF_ERROR(track::WriteRetrackedDataset(result, options.out, overlays));
   out << "wrote " << options.out.string() << ": the same cameras and images, expressions in the face model's "
       << face::kNumExpressions << " weights; per-frame fit in " << (options.out / "track" / "report.json").string()
-      << "\n";
+      << ", " << overlays.size() << " overlay" << (overlays.size() == 1 ? "" : "s") << " (track/overlay_<split>_NNN.png"
+      << (overlays.size() < result.fit.frames.size() ? ", frames spread over the sequence" : "") << ")\n";
   return Status::Ok();
 }
 

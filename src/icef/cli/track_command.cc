@@ -26,7 +26,8 @@ CommandFn RegisterTrack(CLI::App& app) {
       "head's frame, with track/overlay_NNN.png to check the fit and "
       "track/report.json. Then: icef train DATASET, icef render --sweep.\n"
       "With --keep-cameras, re-express an existing dataset (NerFace, instant-ngp, any expression space) in the face "
-      "model's expressions: same cameras and images, the face model fitted to every frame's landmarks.");
+      "model's expressions: same cameras and images, the face model fitted to every frame's landmarks, with "
+      "track/overlay_<split>_NNN.png to check the fit (every frame; at most 100, spread over a longer sequence).");
   app.add_option("photos", options->photos, "Photos (PNG/JPEG) or directories of photos");
   app.add_option("--out", options->out, "Dataset directory to create (must not exist, or be empty)");
   app.add_option("--res", options->track.resolution, "Side of the square dataset images in pixels (default 256)");

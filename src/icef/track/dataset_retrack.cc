@@ -6,6 +6,7 @@
 #include "icef/face/expression.h"
 #include "icef/face/shape_params.h"
 #include "icef/io/atomic_file.h"
+#include "icef/io/image.h"
 #include "icef/landmarks/landmark_detection.h"
 
 namespace icef::track {
@@ -185,7 +186,8 @@ Json RetrackReportJson(const RetrackResult& result) {
               {"shape", shape}};
 }
 
-Status WriteRetrackedDataset(const RetrackResult& result, const fs::path& out_dir) {
+Status WriteRetrackedDataset(const RetrackResult& result, const fs::path& out_dir,
+                             const std::vector<std::pair<std::string, Image>>& extra_images) {
   return CreateDirectoryAtomic(out_dir, [&](const fs::path& tmp) -> Status {
     const Dataset& src = result.dataset;
     std::set<std::string> files;
@@ -205,6 +207,10 @@ Status WriteRetrackedDataset(const RetrackResult& result, const fs::path& out_di
     d.root = tmp;
     ICEF_RETURN_IF_ERROR(SaveDataset(d));
     fs::create_directories(tmp / "track", ec);
+    for (const auto& [name, image] : extra_images) {
+      fs::create_directories((tmp / name).parent_path(), ec);
+      ICEF_RETURN_IF_ERROR(WritePng(tmp / name, image));
+    }
     return WriteFileAtomic(tmp / "track" / "report.json", FormatJson(RetrackReportJson(result)) + "\n");
   });
 }

@@ -11,11 +11,13 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "icef/core/parallel.h"
 #include "icef/core/status.h"
 #include "icef/data/dataset.h"
+#include "icef/io/image.h"
 #include "icef/io/json_util.h"
 #include "icef/track/track_fit.h"
 
@@ -69,8 +71,9 @@ Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions
 Json RetrackReportJson(const RetrackResult& result);
 
 // Writes the re-expressed dataset into out_dir (which must not exist or be empty): the transforms
-// files, a copy of every image they reference, track/report.json. Built in a temporary sibling
-// directory and renamed into place.
-Status WriteRetrackedDataset(const RetrackResult& result, const std::filesystem::path& out_dir);
+// files, a copy of every image they reference, track/report.json and `extra_images` (paths relative
+// to out_dir, e.g. overlays). Built in a temporary sibling directory and renamed into place.
+Status WriteRetrackedDataset(const RetrackResult& result, const std::filesystem::path& out_dir,
+                             const std::vector<std::pair<std::string, Image>>& extra_images = {});
 
 }  // namespace icef::track
