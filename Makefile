@@ -4,7 +4,7 @@ BUILD_DIR ?= build
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
-.PHONY: all build deps demo test bench clean sanitize fuzz fuzz-deps
+.PHONY: all build tool deps demo test bench clean sanitize fuzz fuzz-deps
 
 all: build
 
@@ -17,8 +17,12 @@ $(BUILD_DIR)/CMakeCache.txt:
 build: $(BUILD_DIR)/CMakeCache.txt
 	cmake --build $(BUILD_DIR) -j $(JOBS)
 
+# The command-line tool alone (no tests, benchmarks or fuzzers): what `make demo` needs.
+tool: $(BUILD_DIR)/CMakeCache.txt
+	cmake --build $(BUILD_DIR) -j $(JOBS) --target icef
+
 demo: deps
-	@$(MAKE) --no-print-directory build
+	@$(MAKE) --no-print-directory tool
 	./$(BUILD_DIR)/icef demo
 
 test: deps
