@@ -100,6 +100,10 @@ grep -q "9 overlays" "$TMP/keep.log" || fail "--keep-cameras: the log does not c
 grep -q '"photometric_refit": "used"' "$TMP/syn_tracked/track/report.json" || fail "--keep-cameras: the photometric refit was not used"
 "$ICEF" track "$TMP/syn" --keep-cameras --landmarks model --out "$TMP/syn_model" >/dev/null || fail "--landmarks model"
 grep -q '"photometric_refit": "off"' "$TMP/syn_model/track/report.json" || fail "--landmarks model: the photometric refit ran"
+# The alpha masks' outlines join the fit by default with dlib's landmarks, not with the exact ones.
+grep -q '"silhouette_points_used": [1-9]' "$TMP/syn_tracked/track/report.json" || fail "--keep-cameras: no silhouette point used"
+grep -q "silhouettes: the alpha masks' outlines of 9 of 9 frames" "$TMP/keep.log" || fail "--keep-cameras: the log does not report the silhouettes"
+grep -q '"silhouette_points_used": [1-9]' "$TMP/syn_model/track/report.json" && fail "--landmarks model: silhouettes used by default"
 "$ICEF" info "$TMP/syn_model" >/dev/null || fail "the dataset re-expressed from its own landmarks does not validate"
 expect_error "--landmarks: expected detect, dlib or model" "$TMP/syn" --keep-cameras --landmarks mediapipe --out "$TMP/bad5"
 echo "track_test: OK"

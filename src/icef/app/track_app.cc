@@ -80,7 +80,7 @@ Image TrackOverlay(const track::TrackResult& result, int photo_index) {
 }
 
 Image RetrackOverlay(const Image& frame, const Vec3f& background, std::span<const Vec2f> landmarks,
-                     std::span<const Vec2f> fitted) {
+                     std::span<const Vec2f> fitted, std::span<const Vec2f> silhouette) {
   ICEF_CHECK(frame.channels == 3 || frame.channels == 4, "RetrackOverlay: 3 or 4 channels");
   Image rgb(frame.width, frame.height, 3);
   for (int y = 0; y < frame.height; ++y)
@@ -94,6 +94,7 @@ Image RetrackOverlay(const Image& frame, const Vec3f& background, std::span<cons
   std::vector<std::optional<Vec2d>> uv;
   for (const Vec2f& q : fitted) uv.push_back(q.allFinite() ? std::optional<Vec2d>(q.cast<double>() * s) : std::nullopt);
   DrawFaceOutline2d(&out, uv, Vec3f(1.f, 0.15f, 0.1f));
+  for (const Vec2f& q : silhouette) Dot(&out, (q.cast<double>() * s).cast<float>(), Vec3f(0.1f, 0.85f, 1.f));
   for (const Vec2f& l : landmarks)
     if (l.allFinite()) Dot(&out, (l.cast<double>() * s).cast<float>(), Vec3f(0.1f, 0.95f, 0.2f));
   return out;
@@ -136,6 +137,7 @@ Status RunRetrack(const TrackAppOptions& options, std::ostream& out) {
   ro.landmarks = options.landmarks;
   ro.predictor_path = options.predictor;
   ro.fit = options.track.fit;
+  ro.silhouette_points = options.track.silhouette_points;
   out << "icef track --keep-cameras: " << options.photos[0].string() << " (" << source.train.size() << " training, "
       << source.test.size() << " test frames, expression_dim " << source.expression_dim << ")\n";
   ICEF_ASSIGN_OR_RETURN(const track::RetrackResult result,
@@ -151,7 +153,8 @@ Status RunRetrack(const TrackAppOptions& options, std::ostream& out) {
     overlays.emplace_back(frames[k].first, RetrackOverlay(image, result.dataset.background,
                                                           f.landmarks_2d ? std::span<const Vec2f>(*f.landmarks_2d)
                                                                          : std::span<const Vec2f>(),
-                                                          result.fit.frames[k].projected));
+                                                          result.fit.frames[k].projected,
+                                                          result.fit.frames[k].silhouette_points));
   }
   for (size_t k = 0; k < result.fit.frames.size(); ++k) {
     if (result.fit.frames[k].rms_iod <= 0.05) continue;

@@ -33,10 +33,10 @@ Image TrackOverlay(const track::TrackResult& result, int photo_index);
 
 // With --keep-cameras, the overlay of one dataset frame (track/overlay_<split>_NNN.png): the frame
 // (RGB, or RGBA over `background`) scaled to 384 pixels high, the landmarks the fit used as green
-// dots and the fitted face model's landmarks (where the fit put them, in the same convention) as a
-// red outline. Points in the frame's pixels.
+// dots, the fitted face model's landmarks (where the fit put them, in the same convention) as a
+// red outline and the mask-edge points the fit used as cyan dots. Points in the frame's pixels.
 Image RetrackOverlay(const Image& frame, const Vec3f& background, std::span<const Vec2f> landmarks,
-                     std::span<const Vec2f> fitted);
+                     std::span<const Vec2f> fitted, std::span<const Vec2f> silhouette = {});
 
 // Which of n frames get a --keep-cameras overlay: all of them up to kMaxRetrackOverlays, else that
 // many spread evenly from the first to the last (a NerFace sequence has thousands).

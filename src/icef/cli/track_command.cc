@@ -44,9 +44,13 @@ CommandFn RegisterTrack(CLI::App& app) {
                  "With --keep-cameras: whose 2D landmarks to fit: detect (dlib, in every frame; default), dlib (the "
                  "dataset's own landmarks_2d, from icef landmarks or icef track), model (the dataset's own, in the face "
                  "model's convention, as icef synth writes them)");
-  app.add_option("--silhouette-points", options->track.silhouette_points,
+  auto silhouette_points = std::make_shared<int>(-1);  // -1: the mode's default
+  app.add_option("--silhouette-points", *silhouette_points,
                  "Refit each photo's pose, expression and the shape with this many points of its mask's edge "
-                 "beside the landmarks (0 = landmarks only; default 200)");
+                 "beside the landmarks (0 = landmarks only; default 200); with --keep-cameras, the edge of each "
+                 "frame's alpha mask, in the frames that have one (default 200 for dlib's landmarks and 0 for "
+                 "--landmarks model, which place the head already)")
+      ->check(CLI::NonNegativeNumber);
   auto photometric = std::make_shared<double>(-1);  // -1: the mode's default
   app.add_option("--photometric-weight", *photometric,
                  "Refine each photo's expression and pose on the photos themselves: points of the neutral face, "
@@ -58,7 +62,8 @@ CommandFn RegisterTrack(CLI::App& app) {
   app.add_option("--silhouette-region", *region,
                  "Which part of the mask's edge the refit uses: face (where it touches the head between the chin and "
                  "the brows with skin just inside it; default: a real head's crown and often its cheeks are hair, its "
-                 "neck runs into clothes) or head (the whole outline: heads without hair, such as icef synth --photos)")
+                 "neck runs into clothes) or head (the whole outline: heads without hair, such as icef synth's, whose hair "
+                 "is painted on)")
       ->check(CLI::IsMember({"face", "head"}));
   app.add_option("--threads", options->threads, "Worker threads (0 = all cores)");
   app.add_option("--predictor", options->predictor,
@@ -67,12 +72,17 @@ CommandFn RegisterTrack(CLI::App& app) {
   app.add_flag("--calibrate-detector", *calibrate,
                "Developer: measure where dlib puts its landmarks on the face model (renders of validation "
                "identities) and print the table of src/icef/track/detector_landmarks.inc");
-  return [options, focal, calibrate, landmarks, region, photometric, &app]() -> Status {
+  return [options, focal, calibrate, landmarks, region, photometric, silhouette_points, &app]() -> Status {
     options->track.fit.silhouette_face_only = *region == "face";
     if (*photometric >= 0) {
       options->track.fit.photometric_weight = *photometric;
     } else if (options->keep_cameras) {
       options->track.fit.photometric_weight = track::RetrackOptions().fit.photometric_weight;
+    }
+    if (*silhouette_points >= 0) {
+      options->track.silhouette_points = *silhouette_points;
+    } else if (options->keep_cameras) {
+      options->track.silhouette_points = track::RetrackOptions().silhouette_points;  // the source's default
     }
     const auto parsed = track::ParseRetrackLandmarks(*landmarks);
     if (!parsed) return Status::Error("--landmarks: expected detect, dlib or model, got \"" + *landmarks + "\"");

@@ -7,6 +7,7 @@
 #include "icef/face/shape_params.h"
 #include "icef/io/atomic_file.h"
 #include "icef/io/image.h"
+#include "icef/track/head_mask.h"
 #include "icef/landmarks/landmark_detection.h"
 
 namespace icef::track {
@@ -44,6 +45,8 @@ double RetrackPhotometricWeight(RetrackLandmarks landmarks) {
   return landmarks == RetrackLandmarks::kDatasetModel ? 0.0 : TrackFitOptions().photometric_weight;
 }
 
+int RetrackSilhouettePoints(RetrackLandmarks landmarks) { return landmarks == RetrackLandmarks::kDatasetModel ? 0 : 200; }
+
 Status RetrackOptions::Validate() const {
   TrackFitOptions resolved = fit;
   if (resolved.photometric_weight < 0) resolved.photometric_weight = RetrackPhotometricWeight(landmarks);
@@ -51,7 +54,8 @@ Status RetrackOptions::Validate() const {
 }
 
 std::string RetrackOptions::ToString() const {
-  return "RetrackOptions(landmarks=" + std::string(RetrackLandmarksName(landmarks)) + ", skip_bad=" + std::to_string(skip_bad) + ", predictor=" +
+  return "RetrackOptions(landmarks=" + std::string(RetrackLandmarksName(landmarks)) + ", skip_bad=" + std::to_string(skip_bad) +
+         ", silhouette_points=" + std::to_string(silhouette_points) + ", predictor=" +
          (predictor_path.empty() ? std::string("default") : predictor_path.string()) + ", " + fit.ToString() + ")";
 }
 
@@ -109,12 +113,38 @@ Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions
   }
   TrackFitOptions fit_options = options.fit;
   if (fit_options.photometric_weight < 0) fit_options.photometric_weight = RetrackPhotometricWeight(options.landmarks);
-  // The images, for the photometric refit (track_fit.h), composited over the dataset's background.
+  const int silhouette_points =
+      options.silhouette_points < 0 ? RetrackSilhouettePoints(options.landmarks) : options.silhouette_points;
+  // The images: for the photometric refit (track_fit.h), composited over the dataset's background;
+  // their alpha masks' edges for the silhouette term. Loaded one at a time unless the refit keeps them.
+  const bool photometric = fit_options.photometric_weight > 0 && order.size() <= static_cast<size_t>(kMaxPhotometricFrames);
+  if (fit_options.photometric_weight > 0 && !photometric && log)
+    log("photometric refit skipped: " + std::to_string(order.size()) + " frames (at most " +
+        std::to_string(kMaxPhotometricFrames) + "); the landmarks alone give the expressions");
   std::vector<Image> photos;
-  if (fit_options.photometric_weight > 0 && order.size() <= static_cast<size_t>(kMaxPhotometricFrames)) {
-    photos.reserve(order.size());  // track_frames point into it
+  photos.reserve(order.size());  // track_frames point into it
+  int masked = 0;
+  if (photometric || silhouette_points > 0) {
     for (size_t k = 0; k < order.size(); ++k) {
       ICEF_ASSIGN_OR_RETURN(Image rgba, LoadFrameImage(d, *order[k]));
+      if (silhouette_points > 0 && rgba.HasAlpha()) {
+        Image mask(rgba.width, rgba.height, 1);
+        for (int y = 0; y < rgba.height; ++y)
+          for (int x = 0; x < rgba.width; ++x) mask.At(x, y, 0) = rgba.At(x, y, 3);
+        std::vector<Vec2f> points = MaskEdgePoints(mask, Image(), silhouette_points);
+        if (fit_options.silhouette_face_only) {  // as photo tracking: where skin lies just inside the edge
+          const std::vector<Vec2f>& lm = track_frames[k].landmarks_2d;
+          const float iod = ((lm[36] + lm[39]) * 0.5f - (lm[42] + lm[45]) * 0.5f).norm();
+          const std::vector<bool> keep = SkinEdges(rgba, mask, points, FitSkinModel(rgba, lm), 0.08 * iod);
+          std::vector<Vec2f> skin;
+          for (size_t i = 0; i < points.size(); ++i)
+            if (keep[i]) skin.push_back(points[i]);
+          points = std::move(skin);
+        }
+        track_frames[k].silhouette = std::move(points);
+        masked += !track_frames[k].silhouette.empty();
+      }
+      if (!photometric) continue;
       Image rgb(rgba.width, rgba.height, 3);
       for (int y = 0; y < rgba.height; ++y)
         for (int x = 0; x < rgba.width; ++x) {
@@ -124,10 +154,12 @@ Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions
       photos.push_back(std::move(rgb));
       track_frames[k].photo = &photos.back();
     }
-  } else if (fit_options.photometric_weight > 0 && log) {
-    log("photometric refit skipped: " + std::to_string(order.size()) + " frames (at most " +
-        std::to_string(kMaxPhotometricFrames) + "); the landmarks alone give the expressions");
   }
+  if (silhouette_points > 0 && log)
+    log(masked > 0 ? "silhouettes: the alpha masks' outlines of " + std::to_string(masked) + " of " +
+                         std::to_string(order.size()) + " frames (" +
+                         (fit_options.silhouette_face_only ? "the face's part" : "the whole head") + ")"
+                   : std::string("silhouettes: no frame has an alpha mask; landmarks only"));
   if (options.landmarks == RetrackLandmarks::kDatasetModel) {
     // The face model's own landmarks, as exact as the data that carries them: the priors of a
     // sub-pixel source (track_fit_test's), not those balanced against dlib's scatter.
@@ -164,6 +196,8 @@ Json RetrackReportJson(const RetrackResult& result) {
                           {"landmark_rms_iod", f.rms_iod},
                           {"landmark_max_iod", f.max_iod},
                           {"landmarks_used", f.landmarks_used},
+                          {"silhouette_rms_iod", f.silhouette_rms_iod},
+                          {"silhouette_points_used", f.silhouette_used},
                           {"photometric_rms", f.photometric_rms},
                           {"photometric_points_used", f.photometric_used},
                           {"expression", expression}});

@@ -3,7 +3,8 @@
 // expression space, so the prior-guided methods apply to it. Its cameras, images, aabb, background
 // and test tiers stay; the face model is fitted to the 2D landmarks of every frame (dlib's,
 // detected anew, by default; or the dataset's own, in a convention the caller names) with one
-// head_from_world similarity shared by all frames (track_fit.h); each frame gets the fitted
+// head_from_world similarity shared by all frames (track_fit.h), and to the outlines of the frames'
+// alpha masks where they have them; each frame gets the fitted
 // expression weights, the landmarks the fit used and the fitted model's 3D landmarks (world frame).
 #pragma once
 
@@ -41,9 +42,19 @@ inline constexpr int kMaxPhotometricFrames = 64;
 // only pulls away from (docs/tracking.md: the round trips of validation identities 101-103).
 double RetrackPhotometricWeight(RetrackLandmarks landmarks);
 
+// The silhouette term's default for a landmark source, as the refit's: 200 mask-edge points per frame
+// for dlib's landmarks, none with the face model's own (exact: they place the head already).
+int RetrackSilhouettePoints(RetrackLandmarks landmarks);
+
 struct RetrackOptions {
   RetrackLandmarks landmarks = RetrackLandmarks::kDetect;
   bool skip_bad = false;  // drop frames without landmarks (no face found) instead of stopping
+  // Frames whose image has an alpha channel (a foreground mask: icef synth, icef track) add this many
+  // points of its edge (alpha 0.5) to the fit (TrackFrame::silhouette; which part of the outline:
+  // fit.silhouette_face_only); 0: landmarks only; < 0 (the default): the landmark source's default,
+  // RetrackSilhouettePoints(landmarks). With every camera known, the outlines place the head where
+  // dlib's landmarks, biased differently in each view, leave it a few degrees off.
+  int silhouette_points = -1;
   std::filesystem::path predictor_path;  // dlib's shape predictor; empty: the Debian default
   // fit.photometric_weight < 0 (the default): the landmark source's default,
   // RetrackPhotometricWeight(landmarks).
