@@ -48,8 +48,9 @@ CommandFn RegisterTrack(CLI::App& app) {
   app.add_option("--silhouette-points", *silhouette_points,
                  "Refit each photo's pose, expression and the shape with this many points of its mask's edge "
                  "beside the landmarks (0 = landmarks only; default 200); with --keep-cameras, the edge of each "
-                 "frame's alpha mask, in the frames that have one (default 200 for dlib's landmarks and 0 for "
-                 "--landmarks model, which place the head already)")
+                 "frame's alpha mask, or of its difference to the dataset's background image (NerFace's bg/), in "
+                 "the frames that have one (default 200 for dlib's landmarks and 0 for --landmarks model, which "
+                 "place the head already)")
       ->check(CLI::NonNegativeNumber);
   auto photometric = std::make_shared<double>(-1);  // -1: the mode's default
   app.add_option("--photometric-weight", *photometric,

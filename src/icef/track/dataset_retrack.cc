@@ -123,14 +123,28 @@ Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions
         std::to_string(kMaxPhotometricFrames) + "); the landmarks alone give the expressions");
   std::vector<Image> photos;
   photos.reserve(order.size());  // track_frames point into it
-  int masked = 0;
+  // Frames without alpha in a dataset with a background image (NerFace: a static camera's empty
+  // scene): the mask is where they differ from it.
+  std::optional<Image> background_image;
+  if (silhouette_points > 0 && d.background_file_path) {
+    Result<Image> bg = ReadImage(d.root / *d.background_file_path);
+    if (!bg.ok()) return bg.status().WithContext((d.root / *d.background_file_path).string() + ": background_file_path");
+    background_image = std::move(*bg);
+  }
+  int masked = 0, differenced = 0;
   if (photometric || silhouette_points > 0) {
     for (size_t k = 0; k < order.size(); ++k) {
       ICEF_ASSIGN_OR_RETURN(Image rgba, LoadFrameImage(d, *order[k]));
-      if (silhouette_points > 0 && rgba.HasAlpha()) {
+      const bool by_background = !rgba.HasAlpha() && background_image && background_image->width == rgba.width &&
+                                 background_image->height == rgba.height;
+      if (silhouette_points > 0 && (rgba.HasAlpha() || by_background)) {
         Image mask(rgba.width, rgba.height, 1);
-        for (int y = 0; y < rgba.height; ++y)
-          for (int x = 0; x < rgba.width; ++x) mask.At(x, y, 0) = rgba.At(x, y, 3);
+        if (by_background) {
+          mask = BackgroundDifferenceMask(rgba, *background_image);
+        } else {
+          for (int y = 0; y < rgba.height; ++y)
+            for (int x = 0; x < rgba.width; ++x) mask.At(x, y, 0) = rgba.At(x, y, 3);
+        }
         std::vector<Vec2f> points = MaskEdgePoints(mask, Image(), silhouette_points);
         if (fit_options.silhouette_face_only) {  // as photo tracking: where skin lies just inside the edge
           const std::vector<Vec2f>& lm = track_frames[k].landmarks_2d;
@@ -142,7 +156,7 @@ Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions
           points = std::move(skin);
         }
         track_frames[k].silhouette = std::move(points);
-        masked += !track_frames[k].silhouette.empty();
+        (by_background ? differenced : masked) += !track_frames[k].silhouette.empty();
       }
       if (!photometric) continue;
       Image rgb(rgba.width, rgba.height, 3);
@@ -155,11 +169,17 @@ Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions
       track_frames[k].photo = &photos.back();
     }
   }
-  if (silhouette_points > 0 && log)
-    log(masked > 0 ? "silhouettes: the alpha masks' outlines of " + std::to_string(masked) + " of " +
-                         std::to_string(order.size()) + " frames (" +
-                         (fit_options.silhouette_face_only ? "the face's part" : "the whole head") + ")"
-                   : std::string("silhouettes: no frame has an alpha mask; landmarks only"));
+  if (silhouette_points > 0 && log) {
+    const std::string part = fit_options.silhouette_face_only ? "the face's part" : "the whole head";
+    if (masked > 0)
+      log("silhouettes: the alpha masks' outlines of " + std::to_string(masked) + " of " +
+          std::to_string(order.size()) + " frames (" + part + ")");
+    if (differenced > 0)
+      log("silhouettes: the outlines of " + std::to_string(differenced) + " of " + std::to_string(order.size()) +
+          " frames against the background image " + *d.background_file_path + " (" + part + ")");
+    if (masked + differenced == 0)
+      log("silhouettes: no frame has an alpha mask or a background image to tell it from; landmarks only");
+  }
   if (options.landmarks == RetrackLandmarks::kDatasetModel) {
     // The face model's own landmarks, as exact as the data that carries them: the priors of a
     // sub-pixel source (track_fit_test's), not those balanced against dlib's scatter.

@@ -49,8 +49,9 @@ int RetrackSilhouettePoints(RetrackLandmarks landmarks);
 struct RetrackOptions {
   RetrackLandmarks landmarks = RetrackLandmarks::kDetect;
   bool skip_bad = false;  // drop frames without landmarks (no face found) instead of stopping
-  // Frames whose image has an alpha channel (a foreground mask: icef synth, icef track) add this many
-  // points of its edge (alpha 0.5) to the fit (TrackFrame::silhouette; which part of the outline:
+  // Frames whose image has an alpha channel (a foreground mask: icef synth, icef track), or, RGB, whose
+  // dataset has a background image (NerFace; head_mask.h's BackgroundDifferenceMask), add this many
+  // points of the mask's edge to the fit (TrackFrame::silhouette; which part of the outline:
   // fit.silhouette_face_only); 0: landmarks only; < 0 (the default): the landmark source's default,
   // RetrackSilhouettePoints(landmarks). With every camera known, the outlines place the head where
   // dlib's landmarks, biased differently in each view, leave it a few degrees off.

@@ -3,10 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
 #include "icef/face/expression.h"
+#include "icef/io/image.h"
 #include "icef/landmarks/face_landmark_detector.h"
 #include "icef/synth/synthesize.h"
 
@@ -92,6 +94,45 @@ TEST(DatasetRetrackTest, SyntheticDatasetKeepsItsCamerasAndGetsItsExpressionsBac
     for (int e = 0; e < face::kNumExpressions; ++e)
       if (e != face::kCheekPuff) exact2 += std::pow(exact->dataset.train[i].expression[e] - source->train[i].expression[e], 2);
   EXPECT_LT(std::sqrt(exact2 / n), 0.12);
+
+  // RGB frames in front of a background image (NerFace's kind): their outlines come from the
+  // difference to it. The dataset's own landmarks keep it quick; the outlines asked for.
+  {
+    Dataset rgb = *source;
+    rgb.root = dir / "rgb";
+    fs::create_directories(rgb.root / "images");
+    Image bg(source->train[0].camera.width(), source->train[0].camera.height(), 3);
+    for (int y = 0; y < bg.height; ++y)
+      for (int x = 0; x < bg.width; ++x)
+        for (int c = 0; c < 3; ++c) bg.At(x, y, c) = ((x / 8 + y / 8 + c) % 3) * 0.3f + 0.1f;
+    ASSERT_TRUE(WritePng(rgb.root / "bg.png", bg).ok());
+    rgb.background_file_path = "bg.png";
+    for (std::vector<Frame>* frames : {&rgb.train, &rgb.test})
+      for (Frame& f : *frames) {
+        const Result<Image> rgba = LoadFrameImage(*source, f);
+        ASSERT_TRUE(rgba.ok()) << rgba.status().message();
+        Image over(rgba->width, rgba->height, 3);
+        for (int y = 0; y < over.height; ++y)
+          for (int x = 0; x < over.width; ++x)
+            for (int c = 0; c < 3; ++c)
+              over.At(x, y, c) = rgba->At(x, y, 3) * rgba->At(x, y, c) + (1 - rgba->At(x, y, 3)) * bg.At(x, y, c);
+        ASSERT_TRUE(WritePng(rgb.root / f.file_path, over).ok());
+        f.neutral_file_path.reset();
+      }
+    ASSERT_TRUE(SaveDataset(rgb).ok());
+    const Result<Dataset> loaded_rgb = LoadDataset(rgb.root);
+    ASSERT_TRUE(loaded_rgb.ok()) << loaded_rgb.status().message();
+    RetrackOptions outlines = own;
+    outlines.silhouette_points = 200;
+    std::vector<std::string> lines;
+    const Result<RetrackResult> b =
+        RetrackDataset(*loaded_rgb, outlines, Executor(2), [&](const std::string& l) { lines.push_back(l); });
+    ASSERT_TRUE(b.ok()) << b.status().message();
+    for (const TrackedFrame& f : b->fit.frames) EXPECT_GT(f.silhouette_used, 10) << f.ToString();
+    EXPECT_LT(Eigen::AngleAxisd(b->fit.head_from_world->rotation).angle() * 180 / M_PI, 1.0);
+    EXPECT_TRUE(std::any_of(lines.begin(), lines.end(),
+                            [](const std::string& l) { return l.find("against the background image bg.png") != std::string::npos; }));
+  }
 
   // Written, it loads back with its images; a second write does not replace it.
   ASSERT_TRUE(WriteRetrackedDataset(*r, dir / "out").ok());

@@ -7,6 +7,10 @@
 
 namespace icef::track {
 
+namespace {
+Image LargestFilledComponent(const cv::Mat& fore);
+}  // namespace
+
 Status HeadMaskOptions::Validate() const {
   if (!(sure_inside >= 0 && sure_inside < 0.5)) return Status::Error("sure_inside must be in [0, 0.5)");
   if (!(band > 0 && band < 1)) return Status::Error("band must be in (0, 1)");
@@ -77,8 +81,16 @@ Image HeadMask(const Image& image, const Image& silhouette, const Image& outside
     cv::Mat bgd_model, fgd_model;
     cv::grabCut(rgb, mask, cv::Rect(), bgd_model, fgd_model, options.iterations, cv::GC_INIT_WITH_MASK);
   }
-  cv::Mat fore = (mask == cv::GC_FGD) | (mask == cv::GC_PR_FGD);
-  // The largest component, then its holes filled (flood the background from the border).
+  return LargestFilledComponent((mask == cv::GC_FGD) | (mask == cv::GC_PR_FGD));
+}
+
+namespace {
+
+// The largest 8-connected component of `fore` (CV_8U, non-zero inside), its holes filled (the
+// background flooded from the border), as a 1-channel image of 0 and 1.
+Image LargestFilledComponent(const cv::Mat& fore) {
+  const int w = fore.cols, h = fore.rows;
+  Image out(w, h, 1);
   cv::Mat labels, stats, centroids;
   const int n = cv::connectedComponentsWithStats(fore, labels, stats, centroids, 8);
   int best = 0;
@@ -92,6 +104,23 @@ Image HeadMask(const Image& image, const Image& silhouette, const Image& outside
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) out.At(x, y, 0) = padded.at<uint8_t>(y + 1, x + 1) != 128 ? 1.f : 0.f;
   return out;
+}
+
+}  // namespace
+
+Image BackgroundDifferenceMask(const Image& frame, const Image& background, double threshold) {
+  ICEF_CHECK(frame.width == background.width && frame.height == background.height,
+             "BackgroundDifferenceMask: the frame and the background differ in size");
+  const int w = frame.width, h = frame.height;
+  cv::Mat fore(h, w, CV_8U);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      fore.at<uint8_t>(y, x) = (frame.Rgb(x, y) - background.Rgb(x, y)).cwiseAbs().maxCoeff() > threshold ? 255 : 0;
+  // Lone pixels of sensor noise and compression out, thin gaps closed.
+  const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(3, 3));
+  cv::morphologyEx(fore, fore, cv::MORPH_OPEN, kernel);
+  cv::morphologyEx(fore, fore, cv::MORPH_CLOSE, kernel);
+  return LargestFilledComponent(fore);
 }
 
 std::vector<Vec2f> MaskEdgePoints(const Image& mask, const Image& outside, int max_points) {

@@ -33,6 +33,13 @@ Image HeadSilhouette(const face::FaceModel& model, const std::vector<float>& exp
 // empty) marks pixels that lie outside the original photo. Deterministic.
 Image HeadMask(const Image& image, const Image& silhouette, const Image& outside, const HeadMaskOptions& options = {});
 
+// The mask (1-channel, 0 or 1) of what a frame shows in front of a known background image (NerFace's
+// static camera: bg/ holds the empty scene): pixels whose colour differs from the background's by
+// more than `threshold` in some channel (colours in [0, 1]), opened and closed by a 3x3 disk, the
+// largest component with its holes filled. The same size as `background`; RGB or RGBA (alpha
+// ignored).
+Image BackgroundDifferenceMask(const Image& frame, const Image& background, double threshold = 0.1);
+
 // Points on the edge of `mask` (1-channel, > 0.5 inside), in pixels (pixel centres at +0.5): the
 // midpoint between each inside pixel and each of its 4-neighbours outside, leaving out edges at the
 // image border and edges touching `outside` (1-channel, may be empty: pixels the photo does not

@@ -253,6 +253,44 @@ TEST(HeadMaskTest, SkinEdgesKeepTheFaceOutlineNotHair) {
   for (bool k : SkinEdges(image, mask, points, none, 2.0)) EXPECT_TRUE(k);
 }
 
+TEST(HeadMaskTest, BackgroundDifferenceMaskIsWhatStandsInFrontOfTheBackground) {
+  // A striped background; the frame shows it with a disk (radius 12 about (32, 30)) in front, a
+  // background-coloured hole in the disk, a lone changed pixel and a second, smaller blob.
+  Image background(64, 48, 3), frame(64, 48, 4);
+  for (int y = 0; y < 48; ++y)
+    for (int x = 0; x < 64; ++x) {
+      const Vec3f bg = (x / 4) % 2 ? Vec3f(0.2f, 0.6f, 0.3f) : Vec3f(0.7f, 0.3f, 0.5f);
+      const float dx = x + 0.5f - 32.f, dy = y + 0.5f - 30.f;
+      const bool disk = dx * dx + dy * dy < 144.f, hole = std::abs(dx) < 2.f && std::abs(dy) < 2.f;
+      const bool blob = x >= 55 && x < 59 && y >= 4 && y < 8;
+      Vec3f c = bg;
+      if ((disk && !hole) || blob) c = Vec3f(0.85f, 0.65f, 0.5f);
+      if (x == 5 && y == 40) c = Vec3f(1.f, 1.f, 1.f);
+      c += Vec3f::Constant(0.03f * ((x * 7 + y * 13) % 3 - 1));  // noise below the threshold
+      for (int ch = 0; ch < 3; ++ch) background.At(x, y, ch) = bg[ch], frame.At(x, y, ch) = c[ch];
+      frame.At(x, y, 3) = 1.f;  // alpha is ignored
+    }
+  const Image mask = BackgroundDifferenceMask(frame, background);
+  ASSERT_EQ(mask.width, 64);
+  ASSERT_EQ(mask.height, 48);
+  int wrong = 0, inside = 0;
+  for (int y = 0; y < 48; ++y)
+    for (int x = 0; x < 64; ++x) {
+      const float dx = x + 0.5f - 32.f, dy = y + 0.5f - 30.f;
+      const bool disk = dx * dx + dy * dy < 144.f;  // the hole filled
+      inside += disk;
+      wrong += (mask.At(x, y, 0) > 0.5f) != disk;
+    }
+  EXPECT_LT(wrong, 0.05 * inside);           // the disk, with its hole filled
+  EXPECT_EQ(mask.At(32, 30, 0), 1.f);        // the hole
+  EXPECT_EQ(mask.At(5, 40, 0), 0.f);         // the lone pixel
+  EXPECT_EQ(mask.At(56, 5, 0), 0.f);         // the smaller blob: only the largest component stays
+  EXPECT_EQ(mask.At(32, 30 - 15, 0), 0.f);   // background outside the disk
+  // Nothing in front: an empty mask.
+  const Image none = BackgroundDifferenceMask(background, background);
+  for (float v : none.pixels) EXPECT_EQ(v, 0.f);
+}
+
 TEST(PhotoCropTest, CropCarriesTheCameraAndThePoints) {
   Intrinsics k;
   k.width = 640;
