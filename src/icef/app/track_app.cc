@@ -100,16 +100,7 @@ Image RetrackOverlay(const Image& frame, const Vec3f& background, std::span<cons
   return out;
 }
 
-std::vector<int> RetrackOverlayFrames(int n) {
-  std::vector<int> frames;
-  if (n <= kMaxRetrackOverlays) {
-    for (int i = 0; i < n; ++i) frames.push_back(i);
-    return frames;
-  }
-  for (int i = 0; i < kMaxRetrackOverlays; ++i)
-    frames.push_back(static_cast<int>(std::lround(double(i) * (n - 1) / (kMaxRetrackOverlays - 1))));
-  return frames;
-}
+std::vector<int> RetrackOverlayFrames(int n) { return track::SpreadFrames(n, kMaxRetrackOverlays); }
 
 namespace {
 

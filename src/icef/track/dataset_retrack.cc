@@ -1,5 +1,6 @@
 #include "icef/track/dataset_retrack.h"
 
+#include <cmath>
 #include <set>
 #include <system_error>
 
@@ -25,6 +26,16 @@ std::string FrameName(const std::string& split, int index, const Frame& f) {
 }
 
 }  // namespace
+
+std::vector<int> SpreadFrames(int n, int max) {
+  std::vector<int> frames;
+  if (n <= max) {
+    for (int i = 0; i < n; ++i) frames.push_back(i);
+    return frames;
+  }
+  for (int i = 0; i < max; ++i) frames.push_back(static_cast<int>(std::lround(double(i) * (n - 1) / (max - 1))));
+  return frames;
+}
 
 const char* RetrackLandmarksName(RetrackLandmarks landmarks) {
   switch (landmarks) {
@@ -132,12 +143,16 @@ Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions
     background_image = std::move(*bg);
   }
   int masked = 0, differenced = 0;
+  std::vector<char> outlined(order.size(), 0);
+  if (silhouette_points > 0)
+    for (const int k : SpreadFrames(static_cast<int>(order.size()), kMaxSilhouetteFrames)) outlined[k] = 1;
   if (photometric || silhouette_points > 0) {
     for (size_t k = 0; k < order.size(); ++k) {
+      if (!photometric && !outlined[k]) continue;
       ICEF_ASSIGN_OR_RETURN(Image rgba, LoadFrameImage(d, *order[k]));
       const bool by_background = !rgba.HasAlpha() && background_image && background_image->width == rgba.width &&
                                  background_image->height == rgba.height;
-      if (silhouette_points > 0 && (rgba.HasAlpha() || by_background)) {
+      if (outlined[k] && (rgba.HasAlpha() || by_background)) {
         Image mask(rgba.width, rgba.height, 1);
         if (by_background) {
           mask = BackgroundDifferenceMask(rgba, *background_image);
@@ -149,11 +164,13 @@ Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions
         if (fit_options.silhouette_face_only) {  // as photo tracking: where skin lies just inside the edge
           const std::vector<Vec2f>& lm = track_frames[k].landmarks_2d;
           const float iod = ((lm[36] + lm[39]) * 0.5f - (lm[42] + lm[45]) * 0.5f).norm();
-          const std::vector<bool> keep = SkinEdges(rgba, mask, points, FitSkinModel(rgba, lm), 0.08 * iod);
-          std::vector<Vec2f> skin;
-          for (size_t i = 0; i < points.size(); ++i)
-            if (keep[i]) skin.push_back(points[i]);
-          points = std::move(skin);
+          if (std::isfinite(iod) && iod > 0) {  // else no skin model: every point stays
+            const std::vector<bool> keep = SkinEdges(rgba, mask, points, FitSkinModel(rgba, lm), 0.08 * iod);
+            std::vector<Vec2f> skin;
+            for (size_t i = 0; i < points.size(); ++i)
+              if (keep[i]) skin.push_back(points[i]);
+            points = std::move(skin);
+          }
         }
         track_frames[k].silhouette = std::move(points);
         (by_background ? differenced : masked) += !track_frames[k].silhouette.empty();
@@ -174,6 +191,9 @@ Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions
     if (masked > 0)
       log("silhouettes: the alpha masks' outlines of " + std::to_string(masked) + " of " +
           std::to_string(order.size()) + " frames (" + part + ")");
+    if (masked + differenced > 0 && order.size() > static_cast<size_t>(kMaxSilhouetteFrames))
+      log("silhouettes: at most " + std::to_string(kMaxSilhouetteFrames) +
+          " frames, spread over the sequence, add their outlines; the others keep their landmarks");
     if (differenced > 0)
       log("silhouettes: the outlines of " + std::to_string(differenced) + " of " + std::to_string(order.size()) +
           " frames against the background image " + *d.background_file_path + " (" + part + ")");

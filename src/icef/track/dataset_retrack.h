@@ -37,6 +37,14 @@ std::optional<RetrackLandmarks> ParseRetrackLandmarks(const std::string& name); 
 // (track_fit.h) solves all frames at once, with every image in memory.
 inline constexpr int kMaxPhotometricFrames = 64;
 
+// At most this many frames add their outlines (RetrackOptions::silhouette_points), spread over the
+// sequence (SpreadFrames): they place the similarity all frames share, and each costs the solve a
+// few hundred residuals; the other frames keep their landmarks.
+inline constexpr int kMaxSilhouetteFrames = 64;
+
+// Indices into n frames: all of them up to `max`, else `max` spread evenly from the first to the last.
+std::vector<int> SpreadFrames(int n, int max);
+
 // The photometric refit's default weight for a landmark source: on (TrackFitOptions' 16) for dlib's
 // landmarks, whose scatter it reads past; off for the face model's own, which are exact and which it
 // only pulls away from (docs/tracking.md: the round trips of validation identities 101-103).

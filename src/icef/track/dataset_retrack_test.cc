@@ -144,6 +144,17 @@ TEST(DatasetRetrackTest, SyntheticDatasetKeepsItsCamerasAndGetsItsExpressionsBac
   fs::remove_all(dir);
 }
 
+TEST(DatasetRetrackTest, OutlinesComeFromFramesSpreadOverALongSequence) {
+  const std::vector<int> all = SpreadFrames(10, kMaxSilhouetteFrames);
+  ASSERT_EQ(all.size(), 10u);
+  for (int i = 0; i < 10; ++i) EXPECT_EQ(all[i], i);
+  const std::vector<int> spread = SpreadFrames(5000, kMaxSilhouetteFrames);
+  ASSERT_EQ(static_cast<int>(spread.size()), kMaxSilhouetteFrames);
+  EXPECT_EQ(spread.front(), 0);
+  EXPECT_EQ(spread.back(), 4999);
+  for (size_t i = 1; i < spread.size(); ++i) EXPECT_NEAR(spread[i] - spread[i - 1], 4999.0 / (kMaxSilhouetteFrames - 1), 1.0);
+}
+
 TEST(DatasetRetrackTest, LandmarkSourcesParse) {
   for (RetrackLandmarks l : {RetrackLandmarks::kDetect, RetrackLandmarks::kDatasetDlib, RetrackLandmarks::kDatasetModel})
     EXPECT_EQ(ParseRetrackLandmarks(RetrackLandmarksName(l)), l);
