@@ -56,8 +56,9 @@ CommandFn RegisterTrack(CLI::App& app) {
   app.add_option("--photometric-weight", *photometric,
                  "Refine each photo's expression and pose on the photos themselves: points of the neutral face, "
                  "carried into every photo by the fitted warp and pose, must find the same colour there; their "
-                 "weight against the landmarks (0 = landmarks and outline only; default 16, and with --keep-cameras "
-                 "16 for dlib's landmarks and 0 for --landmarks model, which are exact: docs/tracking.md)")
+                 "weight against the landmarks (0 = landmarks and outline only; default 16; with --keep-cameras 0 for "
+                 "--landmarks model, which are exact, and for dlib's landmarks 64 where the frames' outlines place "
+                 "the head, which the refit then holds, else 16: docs/tracking.md)")
       ->check(CLI::NonNegativeNumber);
   auto region = std::make_shared<std::string>("face");
   app.add_option("--silhouette-region", *region,

@@ -123,7 +123,8 @@ Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions
     }
   }
   TrackFitOptions fit_options = options.fit;
-  if (fit_options.photometric_weight < 0) fit_options.photometric_weight = RetrackPhotometricWeight(options.landmarks);
+  const bool default_weight = fit_options.photometric_weight < 0;
+  if (default_weight) fit_options.photometric_weight = RetrackPhotometricWeight(options.landmarks);
   const int silhouette_points =
       options.silhouette_points < 0 ? RetrackSilhouettePoints(options.landmarks) : options.silhouette_points;
   // The images: for the photometric refit (track_fit.h), composited over the dataset's background;
@@ -200,6 +201,18 @@ Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions
     if (masked + differenced == 0)
       log("silhouettes: no frame has an alpha mask or a background image to tell it from; landmarks only");
   }
+  // Outlines place the similarity: the refit then holds it and reads the expressions, by default at
+  // a higher weight (without them its colours help place the head, at the landmarks' default).
+  result.outlined_frames = masked + differenced;
+  if (result.outlined_frames > 0 && photometric) {
+    fit_options.photometric_hold_similarity = true;
+    if (default_weight) fit_options.photometric_weight = kRetrackPhotometricWeightWithOutlines;
+    if (log)
+      log("photometric refit: weight " + std::to_string(static_cast<int>(std::lround(fit_options.photometric_weight))) +
+          ", the similarity the outlines placed held; the colours read the expressions");
+  }
+  result.photometric_weight = photometric ? fit_options.photometric_weight : 0.0;
+  result.similarity_held = fit_options.photometric_hold_similarity;
   if (options.landmarks == RetrackLandmarks::kDatasetModel) {
     // The face model's own landmarks, as exact as the data that carries them: the priors of a
     // sub-pixel source (track_fit_test's), not those balanced against dlib's scatter.

@@ -50,6 +50,11 @@ std::vector<int> SpreadFrames(int n, int max);
 // only pulls away from (docs/tracking.md: the round trips of validation identities 101-103).
 double RetrackPhotometricWeight(RetrackLandmarks landmarks);
 
+// The photometric refit's default weight when outlines place the similarity (RetrackOptions::
+// silhouette_points): the similarity is then held in the refit and the colours read the expressions
+// only, at this weight (chosen on validation identities 101-103; docs/tracking.md).
+inline constexpr double kRetrackPhotometricWeightWithOutlines = 64;
+
 // The silhouette term's default for a landmark source, as the refit's: 200 mask-edge points per frame
 // for dlib's landmarks, none with the face model's own (exact: they place the head already).
 int RetrackSilhouettePoints(RetrackLandmarks landmarks);
@@ -80,6 +85,9 @@ struct RetrackResult {
   Dataset dataset;                   // the source dataset re-expressed (root: the source's)
   std::vector<std::string> skipped;  // "train[3] images/...: no face found"
   std::vector<std::string> frame_names;  // per fitted frame, in fit order: "train[0] images/..."
+  int outlined_frames = 0;           // frames that added their outlines
+  double photometric_weight = 0;     // the refit's weight as used (0: off)
+  bool similarity_held = false;      // the refit kept the similarity the outlines placed
   TrackFit fit;
 };
 

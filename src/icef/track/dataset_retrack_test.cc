@@ -47,6 +47,20 @@ TEST(DatasetRetrackTest, SyntheticDatasetKeepsItsCamerasAndGetsItsExpressionsBac
   const double rotation_deg = Eigen::AngleAxisd(s.rotation).angle() * 180 / M_PI;
   EXPECT_LT(rotation_deg, 7.0) << s.ToString();
   for (const TrackedFrame& f : r->fit.frames) EXPECT_GT(f.silhouette_used, 10) << f.ToString();
+  // The outlines placed the similarity: the refit holds it (the same as without the refit, below)
+  // and reads the expressions at its higher weight.
+  EXPECT_EQ(r->outlined_frames, static_cast<int>(r->fit.frames.size()));
+  EXPECT_TRUE(r->similarity_held);
+  EXPECT_EQ(r->photometric_weight, kRetrackPhotometricWeightWithOutlines);
+  RetrackOptions no_refit;
+  no_refit.fit.photometric_weight = 0;
+  const Result<RetrackResult> outlines_only = RetrackDataset(*source, no_refit, Executor(2));
+  ASSERT_TRUE(outlines_only.ok()) << outlines_only.status().message();
+  EXPECT_FALSE(outlines_only->similarity_held);
+  EXPECT_EQ(outlines_only->photometric_weight, 0.0);
+  EXPECT_TRUE(outlines_only->fit.head_from_world->rotation.isApprox(s.rotation, 1e-12));
+  EXPECT_NEAR(outlines_only->fit.head_from_world->scale, s.scale, 1e-12);
+  EXPECT_TRUE(outlines_only->fit.head_from_world->translation.isApprox(s.translation, 1e-12));
   double sum2 = 0;
   int n = 0;
   for (size_t i = 0; i < d.train.size(); ++i) {
@@ -74,6 +88,7 @@ TEST(DatasetRetrackTest, SyntheticDatasetKeepsItsCamerasAndGetsItsExpressionsBac
   ASSERT_TRUE(p.ok()) << p.status().message();
   EXPECT_EQ(p->fit.photometric, "off");
   for (const TrackedFrame& f : p->fit.frames) EXPECT_EQ(f.silhouette_used, 0);
+  EXPECT_EQ(p->outlined_frames, 0);
   const double landmarks_only_deg = Eigen::AngleAxisd(p->fit.head_from_world->rotation).angle() * 180 / M_PI;
   EXPECT_GT(landmarks_only_deg, rotation_deg + 2.0);
   EXPECT_LT(landmarks_only_deg, 15.0);  // loose: catches a fit gone wrong

@@ -230,7 +230,8 @@ Status PhotometricRefit(std::vector<FrameProblem>& problems, Shared& shared, con
       for (int c = 0; c < 3; ++c) colour[p][c] /= std::max(seen_by[p], 1);
 
     ceres::Problem cp;
-    AddLandmarkBlocks(cp, problems, all, shared, refit_options, /*fit_shape=*/false, /*fit_pose=*/true, s);
+    const bool fit_pose = !(shared.known_cameras && options.photometric_hold_similarity);
+    AddLandmarkBlocks(cp, problems, all, shared, refit_options, /*fit_shape=*/false, fit_pose, s);
     for (int k = 0; k < n; ++k) {
       int used = 0;
       for (size_t p = 0; p < points.size(); ++p) used += visible[k][p] && seen_by[p] >= 2;

@@ -519,6 +519,7 @@ std::string TrackFitOptions::ToString() const {
      << ", dlib_convention=" << dlib_convention << ", landmark_sigma_iod=" << landmark_sigma_iod
      << ", silhouette_sigma_iod=" << silhouette_sigma_iod << ", silhouette_max_gap_iod=" << silhouette_max_gap_iod
      << ", silhouette_face_only=" << silhouette_face_only << ", photometric_weight=" << photometric_weight
+     << ", photometric_hold_similarity=" << photometric_hold_similarity
      << ", photometric_sigma=" << photometric_sigma
      << ", expression_prior_laplace=" << expression_prior_laplace
      << ", photometric_expression_prior_sigma=" << photometric_expression_prior_sigma

@@ -68,6 +68,9 @@ struct TrackFitOptions {
   // together this many times as much as its 68 landmarks (0: no refit).
   double photometric_weight = 16;
   double photometric_sigma = 0.05;     // colour noise (colours in [0, 1]); also where the Cauchy loss discounts a point
+  // Known cameras: the refit keeps the shared similarity as the landmark and outline fit left it and
+  // moves the expressions only (with outlines the similarity is placed; colours then pull it).
+  bool photometric_hold_similarity = false;
   double photometric_expression_prior_sigma = 0.2;  // the refit's expression_prior_sigma
   double photometric_expression_prior_laplace = 0.3;  // the refit's expression_prior_laplace
   int photometric_points = 400;        // points on the neutral face (track/photometric.h)
