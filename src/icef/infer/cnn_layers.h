@@ -6,6 +6,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace icef::infer {
@@ -50,6 +51,21 @@ struct Padding {
 //                                      * filters[i, j, c, o]   (zero outside the input).
 // Output size: (h + top + bottom - kh) / stride + 1 (floor), likewise for width.
 Tensor3 Conv2d(const Tensor3& input, const ConvWeights& weights, int stride, const Padding& pad);
+
+// Depthwise convolution with one filter per channel (channel multiplier 1): filters [kh, kw, c]
+// (TF's [kh, kw, c, 1]), out[y, x, c] = sum_{i, j} in[y * stride + i - pad.top, x * stride + j - pad.left, c]
+// * filters[i, j, c] (zero outside the input); no bias.
+Tensor3 DepthwiseConv2d(const Tensor3& input, const std::vector<float>& filters, int kh, int kw, int stride,
+                        const Padding& pad);
+// x = x > 0 ? x : alpha[c] * x (TF's Prelu, alpha per channel).
+void Prelu(Tensor3& x, const std::vector<float>& alpha);
+// x = 1 / (1 + exp(-x)).
+void Sigmoid(Tensor3& x);
+// Zero padding: `before` / `after` pixels or channels on each side, per dimension (h, w, c).
+Tensor3 Pad(const Tensor3& input, const int before[3], const int after[3]);
+// TF's 'SAME' padding of one dimension: output ceil(in / stride), the total padding split with the
+// smaller half before. Returns {before, after}.
+std::pair<int, int> SamePadding(int in, int kernel, int stride);
 
 // x[..., c] = x[..., c] * scale[c] + shift[c] (dlib's affine layer / face-api's scale layer).
 void ChannelAffine(Tensor3& x, const std::vector<float>& scale, const std::vector<float>& shift);

@@ -1,5 +1,7 @@
 #include "icef/infer/tfjs_weights.h"
 
+#include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -18,13 +20,32 @@ std::string NamedTensor::ToString() const {
 
 namespace {
 
+float HalfToFloat(uint16_t h) {
+  const int sign = (h >> 15) & 1;
+  const int exponent = (h >> 10) & 0x1f;
+  const int mantissa = h & 0x3ff;
+  double v;
+  if (exponent == 0) v = std::ldexp(double(mantissa), -24);  // subnormal (or zero)
+  else if (exponent == 31) v = mantissa ? std::nan("") : HUGE_VAL;
+  else v = std::ldexp(double(mantissa | 0x400), exponent - 25);
+  return float(sign ? -v : v);
+}
+
 // Decodes `count` values of `dtype` (optionally quantised) from `bytes` at `offset`.
 Status Decode(const nlohmann::json& entry, const std::string& where, const std::string& bytes,
               size_t& offset, size_t count, std::vector<float>& out) {
   const std::string dtype = entry.value("dtype", "");
-  if (dtype != "float32") return Status::Error(where + ".dtype: unsupported '" + dtype + "'");
+  if (dtype != "float32" && dtype != "int32") return Status::Error(where + ".dtype: unsupported '" + dtype + "'");
   out.resize(count);
-  if (entry.contains("quantization")) {
+  const std::string qtype = entry.contains("quantization") ? entry["quantization"].value("dtype", "") : "";
+  if (qtype == "float16") {  // IEEE half precision, no scale / min
+    if (offset + count * 2 > bytes.size())
+      return Status::Error(where + ": weights file too short (needs " + std::to_string(offset + count * 2) +
+                           " bytes, has " + std::to_string(bytes.size()) + ")");
+    const auto* p = reinterpret_cast<const unsigned char*>(bytes.data() + offset);
+    for (size_t i = 0; i < count; ++i) out[i] = HalfToFloat(uint16_t(p[2 * i] | (p[2 * i + 1] << 8)));
+    offset += count * 2;
+  } else if (entry.contains("quantization")) {
     const auto& q = entry["quantization"];
     const std::string qtype = q.value("dtype", "");
     if (!q.contains("scale") || !q.contains("min") || !q["scale"].is_number() || !q["min"].is_number())
@@ -48,7 +69,15 @@ Status Decode(const nlohmann::json& entry, const std::string& where, const std::
     if (offset + count * 4 > bytes.size())
       return Status::Error(where + ": weights file too short (needs " + std::to_string(offset + count * 4) +
                            " bytes, has " + std::to_string(bytes.size()) + ")");
-    std::memcpy(out.data(), bytes.data() + offset, count * 4);  // little-endian float32
+    if (dtype == "int32") {  // shapes and paddings: small integers, exact in float
+      for (size_t i = 0; i < count; ++i) {
+        int32_t v;
+        std::memcpy(&v, bytes.data() + offset + 4 * i, 4);
+        out[i] = float(v);
+      }
+    } else {
+      std::memcpy(out.data(), bytes.data() + offset, count * 4);  // little-endian float32
+    }
     offset += count * 4;
   }
   return Status::Ok();
@@ -65,6 +94,8 @@ Result<TensorMap> ReadTfjsWeights(const std::filesystem::path& manifest_path) {
   } catch (const nlohmann::json::parse_error& e) {
     return Status::Error(file + ": invalid JSON: " + e.what());
   }
+  // A graph model's model.json carries its manifest in 'weightsManifest'.
+  if (manifest.is_object() && manifest.contains("weightsManifest")) manifest = manifest["weightsManifest"];
   if (!manifest.is_array()) return Status::Error(file + ": expected an array of weight groups");
   TensorMap tensors;
   for (size_t g = 0; g < manifest.size(); ++g) {

@@ -1,0 +1,58 @@
+// A TensorFlow.js graph model (`model.json` with a `modelTopology` of TF nodes and its weights),
+// run forward on one image. Supports the ops of the small mobile CNNs shipped as TF.js graphs
+// (MediaPipe's face mesh among them): Placeholder, Const, Identity, Conv2D and _FusedConv2D
+// (BiasAdd, then optionally Relu / Relu6 / Prelu), DepthwiseConv2dNative, AddV2 / Add, Prelu, Relu,
+// Relu6, Sigmoid, MaxPool ('VALID'), Pad (zeros) and Reshape. Tensors are NHWC with a batch of one,
+// held as Tensor3 [h, w, c]; a rank-2 result [1, n] is a Tensor3 [1, 1, n].
+// Loading checks every node (op, inputs, attributes, weight shapes) so that a bad or unsupported
+// model fails at load, naming the file and the node, never at run time.
+#pragma once
+
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "icef/core/status.h"
+#include "icef/infer/cnn_layers.h"
+#include "icef/infer/tfjs_weights.h"
+
+namespace icef::infer {
+
+class TfjsGraph {
+ public:
+  static Result<TfjsGraph> Load(const std::filesystem::path& model_json);
+
+  // Runs the graph on `input` (fed to its one Placeholder) and returns the requested outputs,
+  // each named as a node ("Identity_2") or a tensor ("Identity_2:0"), or by its signature name
+  // ("output_mesh"). Errors name the node whose shapes do not fit.
+  Result<std::map<std::string, Tensor3>> Run(const Tensor3& input, const std::vector<std::string>& outputs) const;
+
+  // The input's [h, w, c] as the signature gives it (−1 where unknown).
+  const std::vector<int>& input_shape() const { return input_shape_; }
+  std::string ToString() const;
+
+ private:
+  struct Node {
+    std::string name;
+    std::string op;
+    std::vector<std::string> inputs;  // node names (":0" and control inputs removed)
+    std::vector<std::string> fused;   // _FusedConv2D's fused ops
+    int stride = 1;
+    int window = 0;                   // MaxPool
+    bool same_padding = false;
+  };
+
+  Result<Tensor3> Evaluate(const std::string& name, const Tensor3& input, std::map<std::string, Tensor3>& cache) const;
+  Result<Tensor3> Apply(const Node& node, const std::vector<const Tensor3*>& args) const;
+  const NamedTensor* Weight(const std::string& name) const;
+
+  std::string file_;
+  std::map<std::string, Node> nodes_;
+  std::map<std::string, std::string> signature_outputs_;  // signature name -> node name
+  TensorMap weights_;
+  std::string placeholder_;
+  std::vector<int> input_shape_;
+};
+
+}  // namespace icef::infer
