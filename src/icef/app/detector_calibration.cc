@@ -2,9 +2,11 @@
 
 #include <cmath>
 #include <iomanip>
+#include <optional>
 
 #include "icef/face/face_model.h"
 #include "icef/landmarks/face_landmark_detector.h"
+#include "icef/landmarks/face_mesh.h"
 #include "icef/synth/ground_truth_renderer.h"
 #include "icef/synth/head_model.h"
 #include "icef/synth/identity.h"
@@ -23,8 +25,13 @@ constexpr double kDistance = 3.0;
 }  // namespace
 
 Result<DetectorCalibration> CalibrateDetector(const std::vector<uint64_t>& seeds, const Executor& executor,
-                                              std::ostream* log) {
+                                              std::ostream* log, bool mesh) {
   ICEF_ASSIGN_OR_RETURN(const FaceLandmarkDetector detector, FaceLandmarkDetector::Load());
+  std::optional<FaceMesh> face_mesh;
+  if (mesh) {
+    ICEF_ASSIGN_OR_RETURN(FaceMesh loaded, FaceMesh::Load());
+    face_mesh = std::move(loaded);
+  }
   Intrinsics k;
   k.width = kWidth;
   k.height = kHeight;
@@ -57,7 +64,8 @@ Result<DetectorCalibration> CalibrateDetector(const std::vector<uint64_t>& seeds
       for (double yaw : kYaws) {
         const Camera camera = synth::OrbitCamera(k, kDistance, yaw, pitch);
         const Image image = CompositeOver(synth::RenderGroundTruth(head, camera, neutral, executor, ro), ro.background);
-        const Result<FaceDetection> d = detector.DetectFace(image, /*averaged=*/true);  // as the tracker detects
+        const Result<FaceDetection> d = face_mesh ? DetectFaceWithMesh(detector, *face_mesh, image)
+                                                  : detector.DetectFace(image, /*averaged=*/true);  // as the tracker detects
         if (!d.ok() || d->num_faces != 1) continue;
         ++views;
         const std::array<float, 4> f = track::ViewFeatures(camera.Center().cast<float>());

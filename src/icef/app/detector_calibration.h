@@ -24,8 +24,9 @@ struct DetectorCalibration {
   int identities = 0, views = 0;
 };
 
+// mesh: calibrate the face mesh's 68 landmarks (DetectFaceWithMesh) instead of dlib's.
 Result<DetectorCalibration> CalibrateDetector(const std::vector<uint64_t>& seeds, const Executor& executor,
-                                              std::ostream* log = nullptr);
+                                              std::ostream* log = nullptr, bool mesh = false);
 
 // The table as C++ (track/detector_landmarks.inc, the body of detector_landmarks.cc's array).
 void PrintDetectorTable(const DetectorCalibration& calibration, std::ostream& out);

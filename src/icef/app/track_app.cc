@@ -128,6 +128,7 @@ Status RunRetrack(const TrackAppOptions& options, std::ostream& out) {
   ro.landmarks = options.landmarks;
   ro.predictor_path = options.predictor;
   ro.fit = options.track.fit;
+  ro.detector = options.track.fit.detector;
   ro.silhouette_points = options.track.silhouette_points;
   out << "icef track --keep-cameras: " << options.photos[0].string() << " (" << source.train.size() << " training, "
       << source.test.size() << " test frames, expression_dim " << source.expression_dim << ")\n";

@@ -41,8 +41,8 @@ CommandFn RegisterTrack(CLI::App& app) {
                "PHOTOS is one dataset: keep its cameras and images, re-express its expressions in the face model's");
   auto landmarks = std::make_shared<std::string>("detect");
   app.add_option("--landmarks", *landmarks,
-                 "With --keep-cameras: whose 2D landmarks to fit: detect (dlib, in every frame; default), dlib (the "
-                 "dataset's own landmarks_2d, from icef landmarks or icef track), model (the dataset's own, in the face "
+                 "With --keep-cameras: whose 2D landmarks to fit: detect (--detector's, in every frame; default), dlib (the "
+                 "dataset's own landmarks_2d in dlib's convention, from icef landmarks), model (the dataset's own, in the face "
                  "model's convention, as icef synth writes them)");
   auto silhouette_points = std::make_shared<int>(-1);  // -1: the mode's default
   app.add_option("--silhouette-points", *silhouette_points,
@@ -70,11 +70,23 @@ CommandFn RegisterTrack(CLI::App& app) {
   app.add_option("--threads", options->threads, "Worker threads (0 = all cores)");
   app.add_option("--predictor", options->predictor,
                  "dlib 68-point shape predictor (default " + std::string(kDefaultShapePredictorPath) + ")");
+  auto detector = std::make_shared<std::string>("mesh");
+  app.add_option("--detector", *detector,
+                 "Whose 68 landmarks the fit reads from the images: mesh (MediaPipe's face mesh, in a crop placed by "
+                 "dlib's face; default; scripts/install-deps.sh installs its weights) or dlib (dlib's shape predictor, "
+                 "averaged over shifted boxes). With --keep-cameras: for --landmarks detect")
+      ->check(CLI::IsMember({"dlib", "mesh"}));
+  auto landmark_sigma = std::make_shared<double>(-1);
+  app.add_option("--landmark-sigma", *landmark_sigma,
+                 "The landmarks' noise in inter-ocular distances, which the priors are balanced against (default: "
+                 "0.05; docs/tracking.md)")
+      ->check(CLI::PositiveNumber);
   auto calibrate = std::make_shared<bool>(false);
   app.add_flag("--calibrate-detector", *calibrate,
-               "Developer: measure where dlib puts its landmarks on the face model (renders of validation "
-               "identities) and print the table of src/icef/track/detector_landmarks.inc");
-  return [options, focal, calibrate, landmarks, region, photometric, silhouette_points, &app]() -> Status {
+               "Developer: measure where the detector (--detector) puts its landmarks on the face model (renders of "
+               "validation identities) and print the table of src/icef/track/detector_landmarks.inc (dlib) or "
+               "mesh_landmarks.inc (mesh)");
+  return [options, focal, calibrate, detector, landmark_sigma, landmarks, region, photometric, silhouette_points, &app]() -> Status {
     options->track.fit.silhouette_face_only = *region == "face";
     if (*photometric >= 0) {
       options->track.fit.photometric_weight = *photometric;
@@ -89,10 +101,12 @@ CommandFn RegisterTrack(CLI::App& app) {
     const auto parsed = track::ParseRetrackLandmarks(*landmarks);
     if (!parsed) return Status::Error("--landmarks: expected detect, dlib or model, got \"" + *landmarks + "\"");
     options->landmarks = *parsed;
+    options->track.fit.detector = *detector == "mesh" ? track::LandmarkDetector::kMesh : track::LandmarkDetector::kDlib;
+    if (*landmark_sigma > 0) options->track.fit.landmark_sigma_iod = *landmark_sigma;  // else the default
     if (*calibrate) {
       const std::vector<uint64_t> validation_seeds = {101, 102, 103, 104, 105, 106, 107, 108, 109, 110, 111, 112};
       ICEF_ASSIGN_OR_RETURN(const DetectorCalibration c,
-                            CalibrateDetector(validation_seeds, Executor(options->threads), &std::cerr));
+                            CalibrateDetector(validation_seeds, Executor(options->threads), &std::cerr, *detector == "mesh"));
       PrintDetectorTable(c, std::cout);
       return Status::Ok();
     }

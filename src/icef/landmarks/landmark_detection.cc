@@ -3,11 +3,13 @@
 #include <algorithm>
 #include <atomic>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <sstream>
 
 #include "icef/io/atomic_file.h"
 #include "icef/io/json_util.h"
+#include "icef/landmarks/face_mesh.h"
 
 namespace icef {
 namespace {
@@ -42,6 +44,7 @@ std::string LandmarkDetectionOptions::ToString() const {
   std::string s = "LandmarkDetectionOptions(splits=";
   for (size_t i = 0; i < splits.size(); ++i) s += (i ? "," : "") + splits[i];
   return s + ", overwrite=" + (overwrite ? "true" : "false") + ", averaged=" + (averaged ? "true" : "false") +
+         ", mesh=" + (mesh ? "true" : "false") +
          ", predictor=" + (predictor_path.empty() ? std::string(kDefaultShapePredictorPath) : predictor_path.string()) +
          ")";
 }
@@ -133,6 +136,11 @@ Result<LandmarkDetectionReport> DetectDatasetLandmarks(
     ICEF_ASSIGN_OR_RETURN(background_image, ReadImage(dataset.root / *dataset.background_file_path));
   }
   ICEF_ASSIGN_OR_RETURN(const FaceLandmarkDetector detector, FaceLandmarkDetector::Load(options.predictor_path));
+  std::optional<FaceMesh> face_mesh;
+  if (options.mesh) {
+    ICEF_ASSIGN_OR_RETURN(FaceMesh loaded, FaceMesh::Load(options.mesh_dir));
+    face_mesh = std::move(loaded);
+  }
   const Executor workers(std::min<int>(executor.num_threads(), int(jobs.size())));
   std::vector<FaceLandmarkDetector> detectors;  // one per thread, cloned here (not concurrently)
   for (int t = 0; t < workers.num_threads(); ++t) detectors.push_back(detector.Clone());
@@ -149,7 +157,8 @@ Result<LandmarkDetectionReport> DetectDatasetLandmarks(
         errors[j] = image.status();
         continue;
       }
-      Result<FaceDetection> face = detectors[thread].DetectFace(*image, options.averaged);
+      Result<FaceDetection> face = face_mesh ? DetectFaceWithMesh(detectors[thread], *face_mesh, *image)
+                                             : detectors[thread].DetectFace(*image, options.averaged);
       if (face.ok()) {
         out.outcome = LandmarkOutcome::kDetected;
         out.detection = std::move(face).value();

@@ -29,6 +29,10 @@ struct LandmarkDetectionOptions {
   std::filesystem::path predictor_path;
   // FaceLandmarkDetector::DetectFace's averaged landmarks (icef track's) instead of one run's.
   bool averaged = false;
+  // The 68 landmarks read off MediaPipe's face mesh (DetectFaceWithMesh: placed by dlib's averaged
+  // landmarks) instead of dlib's; the model from mesh_dir (empty: FaceMesh::Load's default).
+  bool mesh = false;
+  std::filesystem::path mesh_dir;
   Status Validate() const;
   std::string ToString() const;
 };

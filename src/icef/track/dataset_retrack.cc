@@ -66,7 +66,7 @@ Status RetrackOptions::Validate() const {
 
 std::string RetrackOptions::ToString() const {
   return "RetrackOptions(landmarks=" + std::string(RetrackLandmarksName(landmarks)) + ", skip_bad=" + std::to_string(skip_bad) +
-         ", silhouette_points=" + std::to_string(silhouette_points) + ", predictor=" +
+         ", silhouette_points=" + std::to_string(silhouette_points) + ", detector=" + LandmarkDetectorName(detector) + ", predictor=" +
          (predictor_path.empty() ? std::string("default") : predictor_path.string()) + ", " + fit.ToString() + ")";
 }
 
@@ -83,7 +83,8 @@ Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions
     lo.predictor_path = options.predictor_path;
     lo.overwrite = true;
     lo.averaged = true;  // as icef track detects (and as detector_landmarks.inc was measured)
-    if (log) log("detecting the landmarks of every frame (dlib)");
+    lo.mesh = options.detector == LandmarkDetector::kMesh;
+    if (log) log(std::string("detecting the landmarks of every frame (") + LandmarkDetectorName(options.detector) + ")");
     ICEF_ASSIGN_OR_RETURN(const LandmarkDetectionReport report, DetectDatasetLandmarks(source, lo, executor));
     for (const FrameLandmarks& fl : report.frames) {
       Frame& f = (*Split(d, fl.split))[fl.index];
@@ -213,6 +214,7 @@ Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions
   }
   result.photometric_weight = photometric ? fit_options.photometric_weight : 0.0;
   result.similarity_held = fit_options.photometric_hold_similarity;
+  fit_options.detector = options.landmarks == RetrackLandmarks::kDetect ? options.detector : LandmarkDetector::kDlib;
   if (options.landmarks == RetrackLandmarks::kDatasetModel) {
     // The face model's own landmarks, as exact as the data that carries them: the priors of a
     // sub-pixel source (track_fit_test's), not those balanced against dlib's scatter.

@@ -70,6 +70,9 @@ struct RetrackOptions {
   // dlib's landmarks, biased differently in each view, leave it a few degrees off.
   int silhouette_points = -1;
   std::filesystem::path predictor_path;  // dlib's shape predictor; empty: the Debian default
+  // With landmarks kDetect: whose 68 landmarks are detected (dlib's, or the face mesh's placed by
+  // dlib's face); the fit uses that detector's offsets (fit.detector is set to match).
+  LandmarkDetector detector = LandmarkDetector::kMesh;
   // fit.photometric_weight < 0 (the default): the landmark source's default,
   // RetrackPhotometricWeight(landmarks).
   TrackFitOptions fit = [] {

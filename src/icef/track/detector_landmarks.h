@@ -21,8 +21,16 @@ namespace icef::track {
 // head frame's origin towards the camera centre `camera_head` (head frame).
 std::array<float, 4> ViewFeatures(const Vec3f& camera_head);
 
-// Canonical offsets (head units) from the face model's landmarks to dlib's, per iBUG-68 index, for
-// a camera centred at `camera_head` (head frame).
-std::array<Vec3f, 68> DlibLandmarkOffsets(const Vec3f& camera_head);
+// Which detector's 68 landmarks: dlib's shape predictor (averaged, FaceLandmarkDetector) or the
+// 68 points read off MediaPipe's face mesh (landmarks/face_mesh.h, DetectFaceWithMesh).
+enum class LandmarkDetector { kDlib, kMesh };
+const char* LandmarkDetectorName(LandmarkDetector detector);  // "dlib", "mesh"
+
+// Canonical offsets (head units) from the face model's landmarks to the detector's, per iBUG-68
+// index, for a camera centred at `camera_head` (head frame). The face mesh's table is
+// mesh_landmarks.inc, measured the same way (`icef track --calibrate-detector --detector mesh`).
+std::array<Vec3f, 68> DetectorLandmarkOffsets(LandmarkDetector detector, const Vec3f& camera_head);
+std::array<Vec3f, 68> DlibLandmarkOffsets(const Vec3f& camera_head);  // DetectorLandmarkOffsets(kDlib, ...)
+
 
 }  // namespace icef::track

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <system_error>
 
@@ -10,6 +11,7 @@
 #include "icef/face/face_model.h"
 #include "icef/face/shape_params.h"
 #include "icef/io/atomic_file.h"
+#include "icef/landmarks/face_mesh.h"
 
 namespace icef::track {
 
@@ -44,8 +46,9 @@ struct Detected {
 };
 
 // Reads and detects every photo (in parallel, one detector per thread, each photo into its slot).
+// mesh: the face mesh's 68 landmarks (DetectFaceWithMesh) instead of dlib's.
 Result<std::vector<Detected>> DetectAll(const std::vector<fs::path>& photos, const FaceLandmarkDetector& detector,
-                                        const Executor& executor) {
+                                        const FaceMesh* mesh, const Executor& executor) {
   std::vector<Detected> out(photos.size());
   std::vector<Status> read_errors(photos.size());
   ParallelFor(executor, static_cast<int64_t>(photos.size()), [&](int64_t begin, int64_t end, int) {
@@ -58,7 +61,7 @@ Result<std::vector<Detected>> DetectAll(const std::vector<fs::path>& photos, con
       }
       const Image upright = Oriented(*image, ExifOrientation(photos[i]));
       out[i].photo = upright.HasAlpha() ? CompositeOver(upright, Vec3f::Ones()) : upright;
-      out[i].detection = local.DetectFace(out[i].photo, /*averaged=*/true);
+      out[i].detection = mesh ? DetectFaceWithMesh(local, *mesh, out[i].photo) : local.DetectFace(out[i].photo, /*averaged=*/true);
     }
   });
   for (size_t i = 0; i < photos.size(); ++i)
@@ -183,7 +186,12 @@ Result<TrackResult> TrackPhotos(const std::vector<fs::path>& photos, const Track
                                 const std::function<void(const std::string&)>& log) {
   ICEF_RETURN_IF_ERROR(options.Validate().WithContext("track options"));
   if (photos.empty()) return Status::Error("icef track: no photos given");
-  ICEF_ASSIGN_OR_RETURN(std::vector<Detected> detected, DetectAll(photos, detector, executor));
+  std::optional<FaceMesh> mesh;
+  if (options.fit.detector == LandmarkDetector::kMesh) {
+    ICEF_ASSIGN_OR_RETURN(FaceMesh loaded, FaceMesh::Load());
+    mesh = std::move(loaded);
+  }
+  ICEF_ASSIGN_OR_RETURN(std::vector<Detected> detected, DetectAll(photos, detector, mesh ? &*mesh : nullptr, executor));
 
   TrackResult result;
   for (size_t i = 0; i < photos.size(); ++i) {

@@ -143,6 +143,37 @@ TEST_F(PhotoTrackTest, SyntheticPhotosBecomeADatasetInTheHeadFrame) {
   EXPECT_EQ(again->fit.frames[1].expression, r.fit.frames[1].expression);
 }
 
+// The default detector is the face mesh (its 68 points read off MediaPipe's mesh); dlib's own
+// landmarks remain a choice, fitted with their own offsets and noise.
+TEST_F(PhotoTrackTest, EitherDetectorTracks) {
+  const Photos photos = MakePhotos(scratch_.dir, 2);
+  EXPECT_EQ(TrackFitOptions().detector, LandmarkDetector::kMesh);
+  std::vector<std::vector<Vec2f>> landmarks;
+  for (LandmarkDetector detector : {LandmarkDetector::kMesh, LandmarkDetector::kDlib}) {
+    TrackOptions options = Options();
+    options.fit.detector = detector;
+    const Result<TrackResult> r = TrackPhotos(photos.files, options, *detector_, Executor(2));
+    ASSERT_TRUE(r.ok()) << r.status().message();
+    for (size_t i = 0; i < 3; ++i) {
+      const Frame& f = r->dataset.train[r->photos[i].frame_index];
+      const Mat3d d = f.camera.world_from_cam().block<3, 3>(0, 0).transpose() *
+                      photos.truth[i].camera.world_from_cam().block<3, 3>(0, 0);
+      EXPECT_LT(Eigen::AngleAxisd(d).angle() * 180 / M_PI, 10.0) << LandmarkDetectorName(detector) << " photo " << i;
+      EXPECT_LT(r->fit.frames[i].rms_iod, 0.1) << LandmarkDetectorName(detector) << " photo " << i;
+    }
+    landmarks.push_back(r->photos[0].detection.landmarks);
+  }
+  // Two detectors, two sets of landmarks: the same face (within a tenth of the inter-ocular
+  // distance, about 6 px here, at the eye corners) but not the same points.
+  ASSERT_EQ(landmarks[0].size(), 68u);
+  double differ = 0;
+  for (int i = 0; i < 68; ++i) differ = std::max(differ, double((landmarks[0][i] - landmarks[1][i]).norm()));
+  EXPECT_GT(differ, 0.5);
+  for (int i : {36, 39, 42, 45}) EXPECT_LT((landmarks[0][i] - landmarks[1][i]).norm(), 8.0) << "landmark " << i;
+  EXPECT_NE(DetectorLandmarkOffsets(LandmarkDetector::kMesh, Vec3f(0, 0, 3))[48],
+            DetectorLandmarkOffsets(LandmarkDetector::kDlib, Vec3f(0, 0, 3))[48]);
+}
+
 TEST_F(PhotoTrackTest, BadPhotosAreClearErrorsAndNothingIsWritten) {
   const Photos photos = MakePhotos(scratch_.dir, 3);
   // An unreadable file, named.

@@ -74,7 +74,7 @@ std::vector<std::optional<Vec2d>> Project(const FrameProblem& fp, Shared& shared
   const Vec3d camera_head = sim ? sim->Apply(camera.Center()) : camera.Center();
   std::array<Vec3f, 68> offsets;
   if (shared.dlib_convention) {
-    offsets = DlibLandmarkOffsets(camera_head.cast<float>());
+    offsets = DetectorLandmarkOffsets(shared.detector, camera_head.cast<float>());
   } else {
     offsets.fill(Vec3f::Zero());
   }
@@ -516,7 +516,7 @@ std::string TrackFitOptions::ToString() const {
   os << "TrackFitOptions(shape_prior_sigma=" << shape_prior_sigma << ", expression_prior_sigma="
      << expression_prior_sigma << ", max_expression=" << max_expression << ", jaw_line_weight=" << jaw_line_weight
      << ", max_iterations=" << max_iterations << ", outlier_iod=" << outlier_iod
-     << ", dlib_convention=" << dlib_convention << ", landmark_sigma_iod=" << landmark_sigma_iod
+     << ", dlib_convention=" << dlib_convention << ", detector=" << LandmarkDetectorName(detector) << ", landmark_sigma_iod=" << landmark_sigma_iod
      << ", silhouette_sigma_iod=" << silhouette_sigma_iod << ", silhouette_max_gap_iod=" << silhouette_max_gap_iod
      << ", silhouette_face_only=" << silhouette_face_only << ", photometric_weight=" << photometric_weight
      << ", photometric_hold_similarity=" << photometric_hold_similarity
@@ -548,6 +548,7 @@ Result<TrackFit> FitTrack(std::span<const TrackFrame> frames, const TrackFitOpti
   shared.max_expression = options.max_expression;
   shared.known_cameras = frames[0].world_from_cam.has_value();
   shared.dlib_convention = options.dlib_convention;
+  shared.detector = options.detector;
   shared.landmark_sigma = options.landmark_sigma_iod;
   shared.silhouette_sigma = options.silhouette_sigma_iod;
   shared.iod_head = iod_head;

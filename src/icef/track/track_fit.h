@@ -22,6 +22,7 @@
 #include "icef/face/shape_params.h"
 #include "icef/io/image.h"
 #include "icef/math/camera.h"
+#include "icef/track/detector_landmarks.h"
 #include "icef/math/types.h"
 
 namespace icef::track {
@@ -43,8 +44,12 @@ struct TrackFrame {
 
 // The defaults were chosen on synthetic photos of validation identities 101-106 (scripts/track_eval.py).
 struct TrackFitOptions {
-  // Landmark noise the priors are balanced against (IOD): dlib's averaged landmarks' scatter on our
-  // head around detector_landmarks.inc (2.5 px at 360x480, about 0.05 IOD; one run's: 2.9 px, 0.06).
+  // Landmark noise the priors are balanced against (IOD), for either detector. dlib's averaged
+  // landmarks scatter by about this much around detector_landmarks.inc (2.5 px at 360x480). The
+  // face mesh's scatter less (1.9 px), and on synthetic photos of validation identities 101-112 a
+  // looser 0.1 scored better (docs/results/track_eval), but synthetic heads are drawn from the
+  // shape prior itself: on real photos 0.1 left the fitted head visibly off the face (landmark RMS
+  // 0.06-0.10 IOD on the astronaut and Grace Hopper, against 0.035-0.042 at 0.05).
   double landmark_sigma_iod = 0.05;
   double shape_prior_sigma = 0.1;       // std of each shape scale around 1
   double expression_prior_sigma = 0.3;  // std of each expression weight around 0 (neutral)
@@ -55,7 +60,8 @@ struct TrackFitOptions {
   double jaw_line_weight = 0.5;         // weight of landmarks 0-16: the detector follows the silhouette there
   int max_iterations = 80;              // Levenberg-Marquardt iterations per pass
   double outlier_iod = 0.1;             // second pass: drop landmarks farther than this (IOD) and 3x the median
-  bool dlib_convention = true;          // the landmarks are dlib's: fit the model's landmarks moved by DlibLandmarkOffsets()
+  bool dlib_convention = true;          // the landmarks are a detector's: fit the model's landmarks moved by its offsets
+  LandmarkDetector detector = LandmarkDetector::kMesh;  // whose (DetectorLandmarkOffsets), with dlib_convention
   // Silhouette points (TrackFrame::silhouette): their noise (IOD). A frame's points weigh together
   // as much as 68 landmarks at this noise would, however many there are.
   double silhouette_sigma_iod = 0.03;

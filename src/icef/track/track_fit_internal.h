@@ -60,7 +60,8 @@ struct Shared {
   face::Similarity base;  // known cameras: the initial head_from_world
   double max_expression = 1.5;
   bool known_cameras = false;
-  bool dlib_convention = true;  // fit the model's landmarks moved by DlibLandmarkOffsets()
+  bool dlib_convention = true;  // fit the model's landmarks moved by DetectorLandmarkOffsets(detector)
+  LandmarkDetector detector = LandmarkDetector::kDlib;
   double landmark_sigma = 0.06;  // TrackFitOptions::landmark_sigma_iod
   double silhouette_sigma = 0.03;  // TrackFitOptions::silhouette_sigma_iod
   double iod_head = 1;  // the average head's inter-ocular distance (head units)
