@@ -79,7 +79,7 @@ CommandFn RegisterTrack(CLI::App& app) {
   auto landmark_sigma = std::make_shared<double>(-1);
   app.add_option("--landmark-sigma", *landmark_sigma,
                  "The landmarks' noise in inter-ocular distances, which the priors are balanced against (default: "
-                 "0.05; docs/tracking.md)")
+                 "0.05; with --keep-cameras 0.1; docs/tracking.md)")
       ->check(CLI::PositiveNumber);
   auto calibrate = std::make_shared<bool>(false);
   app.add_flag("--calibrate-detector", *calibrate,
@@ -102,7 +102,11 @@ CommandFn RegisterTrack(CLI::App& app) {
     if (!parsed) return Status::Error("--landmarks: expected detect, dlib or model, got \"" + *landmarks + "\"");
     options->landmarks = *parsed;
     options->track.fit.detector = *detector == "mesh" ? track::LandmarkDetector::kMesh : track::LandmarkDetector::kDlib;
-    if (*landmark_sigma > 0) options->track.fit.landmark_sigma_iod = *landmark_sigma;  // else the default
+    if (*landmark_sigma > 0) {
+      options->track.fit.landmark_sigma_iod = *landmark_sigma;
+    } else if (options->keep_cameras) {
+      options->track.fit.landmark_sigma_iod = track::RetrackOptions().fit.landmark_sigma_iod;
+    }
     if (*calibrate) {
       const std::vector<uint64_t> validation_seeds = {101, 102, 103, 104, 105, 106, 107, 108, 109, 110, 111, 112};
       ICEF_ASSIGN_OR_RETURN(const DetectorCalibration c,

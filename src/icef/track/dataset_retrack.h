@@ -59,6 +59,14 @@ inline constexpr double kRetrackPhotometricWeightWithOutlines = 64;
 // for dlib's landmarks, none with the face model's own (exact: they place the head already).
 int RetrackSilhouettePoints(RetrackLandmarks landmarks);
 
+// The detected landmarks' noise (IOD) with every camera known: looser than photo tracking's 0.05.
+// The similarity is shared by every frame and the outlines of many views place it, so the
+// landmarks weigh in each frame's expression against the refit's colours and the priors. Round
+// trips of validation identities 101-103 (face mesh, icef-prior trained on the result), mean PSNR
+// observed / near / moderate / far: 30.87 / 30.94 / 30.84 / 29.99 dB at 0.05, 31.23 / 31.21 /
+// 31.19 / 30.30 at 0.1 (docs/results/track_roundtrip/mesh.json).
+constexpr double kRetrackLandmarkSigmaIod = 0.1;
+
 struct RetrackOptions {
   RetrackLandmarks landmarks = RetrackLandmarks::kDetect;
   bool skip_bad = false;  // drop frames without landmarks (no face found) instead of stopping
@@ -74,10 +82,11 @@ struct RetrackOptions {
   // dlib's face); the fit uses that detector's offsets (fit.detector is set to match).
   LandmarkDetector detector = LandmarkDetector::kMesh;
   // fit.photometric_weight < 0 (the default): the landmark source's default,
-  // RetrackPhotometricWeight(landmarks).
+  // RetrackPhotometricWeight(landmarks). fit.landmark_sigma_iod: kRetrackLandmarkSigmaIod.
   TrackFitOptions fit = [] {
     TrackFitOptions o;
     o.photometric_weight = -1;
+    o.landmark_sigma_iod = kRetrackLandmarkSigmaIod;
     return o;
   }();
   Status Validate() const;
