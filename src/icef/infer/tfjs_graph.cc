@@ -193,7 +193,7 @@ Result<TfjsGraph> TfjsGraph::Load(const std::filesystem::path& model_json) {
   return graph;
 }
 
-Result<Tensor3> TfjsGraph::Apply(const Node& node, const std::vector<const Tensor3*>& args) const {
+Result<Tensor3> TfjsGraph::Apply(const Node& node, const std::vector<const Tensor3*>& args, double& flops) const {
   const std::string at = file_ + ": node '" + node.name + "' (" + node.op + ")";
   auto weight = [&](size_t i) -> const NamedTensor& { return *Weight(node.inputs[i]); };
   auto slopes = [&](size_t i, int channels) -> Result<std::vector<float>> {
@@ -220,6 +220,7 @@ Result<Tensor3> TfjsGraph::Apply(const Node& node, const std::vector<const Tenso
       std::tie(pad.left, pad.right) = SamePadding(x.w, w.kw, node.stride);
     }
     Tensor3 y = Conv2d(x, w, node.stride, pad);
+    flops += 2.0 * y.h * y.w * double(w.kh) * w.kw * w.cin * w.cout;
     if (node.fused.size() == 2) {
       if (node.fused[1] == "Relu") Relu(y);
       else if (node.fused[1] == "Relu6") Relu6(y);
@@ -238,7 +239,9 @@ Result<Tensor3> TfjsGraph::Apply(const Node& node, const std::vector<const Tenso
       std::tie(pad.top, pad.bottom) = SamePadding(x.h, f.shape[0], node.stride);
       std::tie(pad.left, pad.right) = SamePadding(x.w, f.shape[1], node.stride);
     }
-    return DepthwiseConv2d(x, f.values, f.shape[0], f.shape[1], node.stride, pad);
+    Tensor3 y = DepthwiseConv2d(x, f.values, f.shape[0], f.shape[1], node.stride, pad);
+    flops += 2.0 * y.h * y.w * double(f.shape[0]) * f.shape[1] * y.c;
+    return y;
   }
   if (node.op == "AddV2" || node.op == "Add") {
     const Tensor3& b = *args[1];
@@ -292,7 +295,7 @@ Result<Tensor3> TfjsGraph::Apply(const Node& node, const std::vector<const Tenso
 }
 
 Result<Tensor3> TfjsGraph::Evaluate(const std::string& name, const Tensor3& input,
-                                    std::map<std::string, Tensor3>& cache) const {
+                                    std::map<std::string, Tensor3>& cache, double& flops) const {
   if (const auto it = cache.find(name); it != cache.end()) return it->second;
   const Node& node = nodes_.at(name);
   if (node.op == "Placeholder") return input;
@@ -303,17 +306,18 @@ Result<Tensor3> TfjsGraph::Evaluate(const std::string& name, const Tensor3& inpu
   for (size_t i = 0; i < node.inputs.size(); ++i) {
     // Parameters (filters, biases, slopes, shapes, paddings) are read from the weights by Apply.
     if (nodes_.at(node.inputs[i]).op == "Const") continue;
-    ICEF_ASSIGN_OR_RETURN(Tensor3 v, Evaluate(node.inputs[i], input, cache));
+    ICEF_ASSIGN_OR_RETURN(Tensor3 v, Evaluate(node.inputs[i], input, cache, flops));
     values.push_back(std::move(v));
   }
   for (const Tensor3& v : values) args.push_back(&v);
   if (args.empty()) return Status::Error(file_ + ": node '" + name + "' (" + node.op + "): no tensor input");
-  ICEF_ASSIGN_OR_RETURN(Tensor3 out, Apply(node, args));
+  ICEF_ASSIGN_OR_RETURN(Tensor3 out, Apply(node, args, flops));
   cache[name] = out;
   return out;
 }
 
-Result<std::map<std::string, Tensor3>> TfjsGraph::Run(const Tensor3& input, const std::vector<std::string>& outputs) const {
+Result<std::map<std::string, Tensor3>> TfjsGraph::Run(const Tensor3& input, const std::vector<std::string>& outputs,
+                                                      double* flops) const {
   if (input_shape_.size() == 3) {
     const int want[3] = {input_shape_[0], input_shape_[1], input_shape_[2]};
     const int have[3] = {input.h, input.w, input.c};
@@ -324,14 +328,16 @@ Result<std::map<std::string, Tensor3>> TfjsGraph::Run(const Tensor3& input, cons
   }
   std::map<std::string, Tensor3> cache;
   std::map<std::string, Tensor3> result;
+  double counted = 0;
   for (const std::string& requested : outputs) {
     std::string name = requested;
     if (const auto it = signature_outputs_.find(requested); it != signature_outputs_.end()) name = it->second;
     name = StripTensorIndex(name);
     if (!nodes_.count(name)) return Status::Error(file_ + ": no output or node named '" + requested + "'");
-    ICEF_ASSIGN_OR_RETURN(Tensor3 value, Evaluate(name, input, cache));
+    ICEF_ASSIGN_OR_RETURN(Tensor3 value, Evaluate(name, input, cache, counted));
     result[requested] = std::move(value);
   }
+  if (flops) *flops = counted;
   return result;
 }
 

@@ -25,8 +25,10 @@ class TfjsGraph {
 
   // Runs the graph on `input` (fed to its one Placeholder) and returns the requested outputs,
   // each named as a node ("Identity_2") or a tensor ("Identity_2:0"), or by its signature name
-  // ("output_mesh"). Errors name the node whose shapes do not fit.
-  Result<std::map<std::string, Tensor3>> Run(const Tensor3& input, const std::vector<std::string>& outputs) const;
+  // ("output_mesh"). Errors name the node whose shapes do not fit. flops: if given, receives the
+  // floating-point operations of the convolutions run (2 per multiply-add).
+  Result<std::map<std::string, Tensor3>> Run(const Tensor3& input, const std::vector<std::string>& outputs,
+                                             double* flops = nullptr) const;
 
   // The input's [h, w, c] as the signature gives it (−1 where unknown).
   const std::vector<int>& input_shape() const { return input_shape_; }
@@ -43,8 +45,9 @@ class TfjsGraph {
     bool same_padding = false;
   };
 
-  Result<Tensor3> Evaluate(const std::string& name, const Tensor3& input, std::map<std::string, Tensor3>& cache) const;
-  Result<Tensor3> Apply(const Node& node, const std::vector<const Tensor3*>& args) const;
+  Result<Tensor3> Evaluate(const std::string& name, const Tensor3& input, std::map<std::string, Tensor3>& cache,
+                           double& flops) const;
+  Result<Tensor3> Apply(const Node& node, const std::vector<const Tensor3*>& args, double& flops) const;
   const NamedTensor* Weight(const std::string& name) const;
 
   std::string file_;

@@ -134,8 +134,11 @@ TEST(TfjsGraphTest, RunsEveryOpAsItsDefinitionSays) {
   EXPECT_EQ(graph->input_shape(), (std::vector<int>{3, 4, 2}));
   for (uint64_t item : {3, 4, 5}) {
     const Tensor3 x = testing::RandomTensor(3, 4, 2, item);
-    auto out = graph->Run(x, {"probability", "conv:0", "pad"});
+    double flops = 0;
+    auto out = graph->Run(x, {"probability", "conv:0", "pad"}, &flops);
     ASSERT_TRUE(out.ok()) << out.status().message();
+    // The conv: 2 x 2 outputs x 3x3x2 inputs x 3 channels; the depthwise conv: 2 x 2 x 3x3 x 3.
+    EXPECT_EQ(flops, 2.0 * (2 * 2 * 9 * 2 * 3 + 2 * 2 * 9 * 3));
     const Tensor3& p = out->at("probability");
     ASSERT_EQ(p.data.size(), 5u);
     EXPECT_EQ(out->at("pad").h, 3);
