@@ -161,6 +161,8 @@ Result<FaceDetection> DetectFaceWithMesh(const FaceLandmarkDetector& detector, c
   ICEF_ASSIGN_OR_RETURN(FaceDetection face, detector.DetectFace(image, /*averaged=*/true));
   const Image rgb = image.HasAlpha() ? CompositeOver(image, Vec3f::Ones()) : image;
   ICEF_ASSIGN_OR_RETURN(const FaceMeshResult result, mesh.Run(rgb, face.landmarks));
+  if (!(result.face_score >= FaceMesh::kMinFaceScore))
+    return Status::Error("no face found (the face mesh's face score is " + std::to_string(result.face_score) + ")");
   face.landmarks = result.landmarks;
   return face;
 }

@@ -41,6 +41,7 @@ class FaceMesh {
   static constexpr int kInputSize = 192;
   static constexpr int kPoints = 468;
   static constexpr float kRoiScale = 1.5f;
+  static constexpr float kMinFaceScore = 0.5f;
 
   // Reads facemesh.json and facemesh.bin from `dir` (empty: $ICEF_FACEMESH_MODEL, else
   // kDefaultFaceMeshDir). Errors name the file.
@@ -64,7 +65,8 @@ class FaceMesh {
 };
 
 // dlib's face (DetectFace, averaged) with its 68 landmarks replaced by those the face mesh reads
-// (FaceMesh::Run placed by dlib's). The box and face count stay dlib's.
+// (FaceMesh::Run placed by dlib's). The box and face count stay dlib's. Error "no face found" when
+// the mesh's face score is below kMinFaceScore: what dlib took for a face, the mesh does not.
 Result<FaceDetection> DetectFaceWithMesh(const FaceLandmarkDetector& detector, const FaceMesh& mesh, const Image& image);
 
 // The square crop (MediaPipe's region of interest) around `points`: centred on their bounding box,

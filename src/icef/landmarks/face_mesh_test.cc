@@ -71,6 +71,20 @@ TEST(FaceMeshTest, AgreesWithDlibOnRealPhotos) {
   }
 }
 
+// A crop without a face scores low: the fish of opencv-doc, cropped where a face would be.
+TEST(FaceMeshTest, ACropWithoutAFaceScoresLow) {
+  auto mesh = FaceMesh::Load();
+  if (!mesh.ok()) GTEST_SKIP() << mesh.status().message();
+  const char* fish = "/usr/share/doc/opencv-doc/examples/data/HappyFish.jpg";
+  if (!fs::exists(fish)) GTEST_SKIP() << "photo not installed: " << fish;
+  auto image = ReadImage(fish);
+  ASSERT_TRUE(image.ok()) << image.status().message();
+  auto result = mesh->RunCrop(*image, Vec2f(image->width * 0.5f, image->height * 0.5f),
+                              0.8f * std::min(image->width, image->height), 0.f);
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  EXPECT_LT(result->face_score, FaceMesh::kMinFaceScore);
+}
+
 TEST(FaceMeshTest, MissingModelIsAnErrorNamingTheFile) {
   auto mesh = FaceMesh::Load(fs::path(::testing::TempDir()) / "icef_no_facemesh");
   ASSERT_FALSE(mesh.ok());
