@@ -96,14 +96,27 @@ for f in overlay_train_000.png overlay_train_002.png overlay_test_000.png overla
 done
 [ "$(ls "$TMP/syn_tracked/track" | grep -c '^overlay_')" = 9 ] || fail "--keep-cameras: not one overlay per frame"
 grep -q "9 overlays" "$TMP/keep.log" || fail "--keep-cameras: the log does not count the overlays"
-# dlib's landmarks: the photometric refit runs by default; the face model's exact ones: it does not.
+# Detected landmarks: the photometric refit runs by default; the face model's exact ones: it does not.
 grep -q '"photometric_refit": "used"' "$TMP/syn_tracked/track/report.json" || fail "--keep-cameras: the photometric refit was not used"
 "$ICEF" track "$TMP/syn" --keep-cameras --landmarks model --out "$TMP/syn_model" >/dev/null || fail "--landmarks model"
 grep -q '"photometric_refit": "off"' "$TMP/syn_model/track/report.json" || fail "--landmarks model: the photometric refit ran"
-# The alpha masks' outlines join the fit by default with dlib's landmarks, not with the exact ones.
+# The alpha masks' outlines join the fit by default with detected landmarks, not with the exact ones.
 grep -q '"silhouette_points_used": [1-9]' "$TMP/syn_tracked/track/report.json" || fail "--keep-cameras: no silhouette point used"
 grep -q "silhouettes: the alpha masks' outlines of 9 of 9 frames" "$TMP/keep.log" || fail "--keep-cameras: the log does not report the silhouettes"
 grep -q '"silhouette_points_used": [1-9]' "$TMP/syn_model/track/report.json" && fail "--landmarks model: silhouettes used by default"
 "$ICEF" info "$TMP/syn_model" >/dev/null || fail "the dataset re-expressed from its own landmarks does not validate"
+# scripts/roundtrip_eval.py on the two re-expressed datasets (--reuse: no icef run): the exact
+# landmarks give the training frames' weights back more closely than the detector's (this dataset:
+# 0.099 and 0.212; validation identities 101-103: 0.05-0.08 and 0.15-0.20; docs/tracking.md).
+roundtrip() {  # roundtrip TRACKED_DIR -> the training frames' expression RMS
+  rm -rf "$TMP/rt" && mkdir "$TMP/rt" && ln -s "$TMP/syn" "$TMP/rt/orig_3" && ln -s "$1" "$TMP/rt/track_3"
+  /usr/bin/python3 "$HERE/../../scripts/roundtrip_eval.py" --icef "$ICEF" --out "$TMP/rt" --seeds 3 --reuse >/dev/null \
+    || fail "roundtrip_eval.py on $1"
+  /usr/bin/python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); r=d["rows"][0]; assert len(r["expressions"]["train"]["per_weight"]) == 11; print(r["expressions"]["train"]["rms"])' "$TMP/rt/roundtrip_eval.json"
+}
+exact=$(roundtrip "$TMP/syn_model") || fail "roundtrip_eval.json"
+detected=$(roundtrip "$TMP/syn_tracked") || fail "roundtrip_eval.json"
+awk -v e="$exact" -v d="$detected" 'BEGIN { exit !(e <= 0.15 && d <= 0.35 && e < d) }' \
+  || fail "expression RMS $exact (exact landmarks), $detected (detected)"
 expect_error "--landmarks: expected detect, dlib or model" "$TMP/syn" --keep-cameras --landmarks mediapipe --out "$TMP/bad5"
 echo "track_test: OK"
