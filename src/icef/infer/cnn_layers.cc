@@ -196,6 +196,59 @@ Tensor3 AvgPool(const Tensor3& input, int window, int stride) {
   return out;
 }
 
+Tensor3 ResizeBilinear(const Tensor3& input, int out_h, int out_w, bool align_corners, bool half_pixel_centers) {
+  ICEF_CHECK(out_h > 0 && out_w > 0 && input.h > 0 && input.w > 0, "ResizeBilinear: empty size");
+  // Per output row / column: the two source indices and the weight of the second.
+  auto axis = [&](int in, int out) {
+    std::vector<std::pair<int, int>> index(static_cast<size_t>(out));
+    std::vector<float> frac(static_cast<size_t>(out));
+    const double scale = align_corners && out > 1 ? double(in - 1) / (out - 1) : double(in) / out;
+    for (int o = 0; o < out; ++o) {
+      const double src = half_pixel_centers ? (o + 0.5) * scale - 0.5 : o * scale;
+      const double lo = std::floor(src);
+      index[size_t(o)] = {std::clamp(int(lo), 0, in - 1), std::clamp(int(std::ceil(src)), 0, in - 1)};
+      frac[size_t(o)] = float(src - lo);
+    }
+    return std::pair{index, frac};
+  };
+  const auto [ys, fy] = axis(input.h, out_h);
+  const auto [xs, fx] = axis(input.w, out_w);
+  Tensor3 out(out_h, out_w, input.c);
+  for (int y = 0; y < out_h; ++y)
+    for (int x = 0; x < out_w; ++x)
+      for (int c = 0; c < input.c; ++c) {
+        const auto [y0, y1] = ys[size_t(y)];
+        const auto [x0, x1] = xs[size_t(x)];
+        const float top = input.At(y0, x0, c) + (input.At(y0, x1, c) - input.At(y0, x0, c)) * fx[size_t(x)];
+        const float bottom = input.At(y1, x0, c) + (input.At(y1, x1, c) - input.At(y1, x0, c)) * fx[size_t(x)];
+        out.At(y, x, c) = top + (bottom - top) * fy[size_t(y)];
+      }
+  return out;
+}
+
+Tensor3 TransposedConv2d(const Tensor3& input, const std::vector<float>& filters, int kh, int kw, int cout,
+                         int stride, int out_h, int out_w, int pad_top, int pad_left) {
+  ICEF_CHECK(filters.size() == size_t(kh) * kw * cout * input.c, "TransposedConv2d: filter size mismatch");
+  Tensor3 out(out_h, out_w, cout);
+  for (int y = 0; y < input.h; ++y)
+    for (int x = 0; x < input.w; ++x)
+      for (int i = 0; i < kh; ++i) {
+        const int oy = y * stride + i - pad_top;
+        if (oy < 0 || oy >= out_h) continue;
+        for (int j = 0; j < kw; ++j) {
+          const int ox = x * stride + j - pad_left;
+          if (ox < 0 || ox >= out_w) continue;
+          const float* f = &filters[(size_t(i) * kw + j) * cout * input.c];
+          for (int o = 0; o < cout; ++o) {
+            float s = 0.f;
+            for (int c = 0; c < input.c; ++c) s += input.At(y, x, c) * f[size_t(o) * input.c + c];
+            out.At(oy, ox, o) += s;
+          }
+        }
+      }
+  return out;
+}
+
 Tensor3 ZeroPadTo(const Tensor3& input, int h, int w, int c) {
   ICEF_CHECK(h >= input.h && w >= input.w && c >= input.c, "ZeroPadTo: target smaller than input");
   Tensor3 out(h, w, c);

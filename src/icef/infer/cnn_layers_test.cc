@@ -105,6 +105,51 @@ TEST(CnnLayersTest, ZeroExtendedAddPadsBottomRightAndChannels) {
   EXPECT_EQ(padded.At(2, 2, 4), branch.At(2, 2, 4));
 }
 
+TEST(CnnLayersTest, ResizeBilinearFollowsTfCoordinateConventions) {
+  // One row 0, 10, 20, 30 doubled to 8 columns.
+  Tensor3 row(1, 4, 1);
+  for (int x = 0; x < 4; ++x) row.At(0, x, 0) = 10.f * x;
+  auto values = [](const Tensor3& t) { std::vector<float> v; for (int x = 0; x < t.w; ++x) v.push_back(t.At(0, x, 0)); return v; };
+  // half_pixel_centers: source (o + 0.5) / 2 - 0.5 = -0.25, 0.25, 0.75, ... clamped at the edges.
+  EXPECT_EQ(values(ResizeBilinear(row, 1, 8, false, true)),
+            (std::vector<float>{0.f, 2.5f, 7.5f, 12.5f, 17.5f, 22.5f, 27.5f, 30.f}));
+  // legacy: source o / 2.
+  EXPECT_EQ(values(ResizeBilinear(row, 1, 8, false, false)),
+            (std::vector<float>{0.f, 5.f, 10.f, 15.f, 20.f, 25.f, 30.f, 30.f}));
+  // align_corners: source o * 3 / 7, the corners land on the corners.
+  const std::vector<float> aligned = values(ResizeBilinear(row, 1, 8, true, false));
+  for (int o = 0; o < 8; ++o) EXPECT_NEAR(aligned[size_t(o)], 30.f * o / 7.f, 1e-5f) << o;
+  // Separable: a product of a row and a column ramp stays one, channel by channel.
+  Tensor3 grid(3, 2, 2);
+  for (int y = 0; y < 3; ++y)
+    for (int x = 0; x < 2; ++x)
+      for (int c = 0; c < 2; ++c) grid.At(y, x, c) = float((y + 1) * (x + 2) * (c + 1));
+  const Tensor3 up = ResizeBilinear(grid, 5, 4, true, false);
+  for (int y = 0; y < 5; ++y)
+    for (int x = 0; x < 4; ++x)
+      EXPECT_NEAR(up.At(y, x, 1), 2.f * (1 + y * 2.f / 4) * (2 + x / 3.f), 1e-5f) << y << "," << x;
+}
+
+// The transposed convolution is the adjoint of the convolution: <conv(x), y> = <x, conv^T(y)>
+// for every x and y, strides and paddings included.
+TEST(CnnLayersTest, TransposedConvIsTheAdjointOfConv) {
+  struct Case { int h, w, k, stride, pad, cin, cout; };
+  for (const Case& c : {Case{8, 8, 2, 2, 0, 3, 2}, Case{7, 9, 3, 2, 1, 2, 4}, Case{6, 5, 3, 1, 1, 4, 3}}) {
+    const Tensor3 x = RandomTensor(c.h, c.w, c.cin, 50 + c.k);
+    const ConvWeights w = RandomConv(c.k, c.k, c.cin, c.cout, false, 60 + c.k);
+    const Padding pad = Padding::Uniform(c.pad);
+    const Tensor3 y = Conv2d(x, w, c.stride, pad);
+    const Tensor3 r = RandomTensor(y.h, y.w, y.c, 70 + c.k);
+    // Conv2d's filter is [kh, kw, cin, cout]; the transposed op reads [kh, kw, cout', cin'] with
+    // cout' = cin (its output) and cin' = cout (its input): the same array.
+    const Tensor3 back = TransposedConv2d(r, w.filters, c.k, c.k, c.cin, c.stride, c.h, c.w, c.pad, c.pad);
+    double lhs = 0, rhs = 0;
+    for (size_t i = 0; i < y.data.size(); ++i) lhs += double(y.data[i]) * r.data[i];
+    for (size_t i = 0; i < x.data.size(); ++i) rhs += double(x.data[i]) * back.data[i];
+    EXPECT_NEAR(lhs, rhs, 1e-4 * (1 + std::abs(lhs))) << c.h << "x" << c.w << " k" << c.k << " s" << c.stride;
+  }
+}
+
 TEST(CnnLayersTest, GlobalMeanAndFullyConnected) {
   const Tensor3 in = RandomTensor(3, 5, 4, 40);
   const std::vector<float> mean = GlobalMean(in);

@@ -54,7 +54,14 @@ std::string StripTensorIndex(std::string name) {
 
 const std::set<std::string> kSupportedOps = {"Placeholder", "Const", "Identity", "Conv2D", "_FusedConv2D",
                                               "DepthwiseConv2dNative", "AddV2", "Add", "Prelu", "Relu", "Relu6",
-                                              "Sigmoid", "MaxPool", "Pad", "Reshape"};
+                                              "Sigmoid", "MaxPool", "Pad", "Reshape", "Mul", "AddN", "AvgPool",
+                                              "ResizeBilinear", "Conv2DBackpropInput"};
+
+bool BoolAttribute(const json& node, const std::string& key) {
+  if (!node.contains("attr") || !node["attr"].contains(key)) return false;
+  const json& a = node["attr"][key];
+  return a.contains("b") && a["b"].is_boolean() && a["b"].get<bool>();
+}
 
 void Relu6(Tensor3& x) {
   for (float& v : x.data) v = std::clamp(v, 0.f, 6.f);
@@ -126,11 +133,15 @@ Result<TfjsGraph> TfjsGraph::Load(const std::filesystem::path& model_json) {
           (node.fused.size() == 2 && node.fused[1] != "Relu" && node.fused[1] != "Relu6" && node.fused[1] != "Prelu"))
         return Status::Error(at + ".attr.fused_ops: only BiasAdd, then optionally Relu, Relu6 or Prelu, is supported");
     }
-    if (node.op == "MaxPool") {
+    if (node.op == "MaxPool" || node.op == "AvgPool") {
       const std::vector<long> k = IntList(n, "ksize");
       if (k.size() != 4 || k[1] != k[2] || k[1] < 1) return Status::Error(at + ".attr.ksize: expected a square window");
-      if (node.same_padding) return Status::Error(at + ".attr.padding: MaxPool supports 'VALID' only");
+      if (node.same_padding) return Status::Error(at + ".attr.padding: " + node.op + " supports 'VALID' only");
       node.window = int(k[1]);
+    }
+    if (node.op == "ResizeBilinear") {
+      node.align_corners = BoolAttribute(n, "align_corners");
+      node.half_pixel_centers = BoolAttribute(n, "half_pixel_centers");
     }
     if (node.op == "Const" && !graph.Weight(node.name))
       return Status::Error(at + ": constant has no tensor in the weights manifest");
@@ -184,6 +195,17 @@ Result<TfjsGraph> TfjsGraph::Load(const std::filesystem::path& model_json) {
       ICEF_RETURN_IF_ERROR(need(1, 1, "shape"));
     } else if (node.op == "Prelu") {
       ICEF_RETURN_IF_ERROR(need(1, 0, "slope"));
+    } else if (node.op == "ResizeBilinear") {
+      ICEF_RETURN_IF_ERROR(need(1, 1, "size [h, w]"));
+      const std::vector<float>& size = constant(1)->values;
+      if (size.size() != 2 || size[0] < 1 || size[1] < 1)
+        return Status::Error(file + ": node '" + name + "': size must be two positive integers");
+    } else if (node.op == "Conv2DBackpropInput") {
+      ICEF_RETURN_IF_ERROR(need(0, 1, "output size [1, h, w, c]"));
+      ICEF_RETURN_IF_ERROR(need(1, 4, "filter [kh, kw, cout, cin]"));
+      const std::vector<float>& size = constant(0)->values;
+      if (size.size() != 4 || size[0] != 1 || size[1] < 1 || size[2] < 1 || size[3] != constant(1)->shape[2])
+        return Status::Error(file + ": node '" + name + "': output size must be [1, h, w, the filter's cout]");
     }
   }
   if (model.contains("signature") && model["signature"].contains("outputs") && model["signature"]["outputs"].is_object())
@@ -243,12 +265,51 @@ Result<Tensor3> TfjsGraph::Apply(const Node& node, const std::vector<const Tenso
     flops += 2.0 * y.h * y.w * double(f.shape[0]) * f.shape[1] * y.c;
     return y;
   }
-  if (node.op == "AddV2" || node.op == "Add") {
-    const Tensor3& b = *args[1];
-    if (x.h != b.h || x.w != b.w || x.c != b.c) return Status::Error(at + ": shapes differ, " + x.ToString() + " and " + b.ToString());
-    Tensor3 y = x;
-    AddInPlace(y, b);
+  if (node.op == "AddV2" || node.op == "Add" || node.op == "Mul" || node.op == "AddN") {
+    // Both commutative: start from the largest tensor and fold in the rest, broadcasting tensors of
+    // one pixel and constants of one value or one per channel.
+    const bool multiply = node.op == "Mul";
+    const auto fold = [multiply](float& a, float b) { a = multiply ? a * b : a + b; };
+    size_t largest = 0;
+    for (size_t i = 1; i < args.size(); ++i)
+      if (args[i]->data.size() > args[largest]->data.size()) largest = i;
+    Tensor3 y = *args[largest];
+    for (size_t i = 0; i < args.size(); ++i) {
+      if (i == largest) continue;
+      const Tensor3& b = *args[i];
+      if (b.h == y.h && b.w == y.w && b.c == y.c) {
+        for (size_t k = 0; k < y.data.size(); ++k) fold(y.data[k], b.data[k]);
+      } else if (b.h == 1 && b.w == 1 && b.c == y.c && node.op != "AddN") {
+        for (size_t k = 0; k < y.data.size(); ++k) fold(y.data[k], b.data[k % size_t(y.c)]);
+      } else {
+        return Status::Error(at + ": shapes do not broadcast, " + y.ToString() + " and " + b.ToString());
+      }
+    }
+    for (const std::string& in : node.inputs) {
+      if (nodes_.at(in).op != "Const") continue;
+      const std::vector<float>& v = Weight(in)->values;
+      if (v.size() != 1 && v.size() != size_t(y.c))
+        return Status::Error(at + ": constant '" + in + "' has " + std::to_string(v.size()) + " values for " +
+                             std::to_string(y.c) + " channels");
+      for (size_t k = 0; k < y.data.size(); ++k) fold(y.data[k], v[v.size() == 1 ? 0 : k % size_t(y.c)]);
+    }
     return y;
+  }
+  if (node.op == "AvgPool") return AvgPool(x, node.window, node.stride);
+  if (node.op == "ResizeBilinear") {
+    const std::vector<float>& size = weight(1).values;
+    return ResizeBilinear(x, int(size[0]), int(size[1]), node.align_corners, node.half_pixel_centers);
+  }
+  if (node.op == "Conv2DBackpropInput") {
+    const std::vector<float>& size = weight(0).values;  // [1, h, w, cout]
+    const NamedTensor& f = weight(1);                  // [kh, kw, cout, cin]
+    if (f.shape[3] != x.c) return Status::Error(at + ": filter expects " + std::to_string(f.shape[3]) + " channels, input has " + x.ToString());
+    const int out_h = int(size[1]), out_w = int(size[2]);
+    // The padding of the forward convolution that maps [out_h, out_w] to the input.
+    const int top = node.same_padding ? SamePadding(out_h, f.shape[0], node.stride).first : 0;
+    const int left = node.same_padding ? SamePadding(out_w, f.shape[1], node.stride).first : 0;
+    flops += 2.0 * x.h * x.w * double(f.shape[0]) * f.shape[1] * f.shape[2] * x.c;
+    return TransposedConv2d(x, f.values, f.shape[0], f.shape[1], f.shape[2], node.stride, out_h, out_w, top, left);
   }
   if (node.op == "Prelu") {
     Tensor3 y = x;

