@@ -20,7 +20,8 @@ CommandFn RegisterTrack(CLI::App& app) {
   app.description(
       "Turn photos of one person into a dataset: detects the face and its 68 landmarks in each photo (exactly one "
       "face per photo), fits the face model to all photos at once (shared identity; per photo a head pose and "
-      "expression weights), crops a square around the head, masks the person (GrabCut seeded by the fitted head), "
+      "expression weights), crops a square around the head, masks the head (GrabCut seeded by the fitted head, "
+      "with what MediaPipe's selfie segmentation calls background as sure background), "
       "refits the face model to the landmarks and each mask's outline, refines each photo's expression and pose on "
       "the photos' colours (the photometric refit), crops and masks again, and writes the dataset in the fitted "
       "head's frame, with track/overlay_NNN.png to check the fit and "
@@ -37,6 +38,13 @@ CommandFn RegisterTrack(CLI::App& app) {
   app.add_option("--test", options->track.num_test, "Hold out the last N photos as test frames (default 0)");
   app.add_flag("--skip-bad", options->track.skip_bad,
                "Skip photos without exactly one face (default: stop, naming the photo, and write nothing)");
+  auto segmentation = std::make_shared<std::string>("selfie");
+  app.add_option("--segmentation", *segmentation,
+                 "The dataset's alpha mask: selfie (GrabCut seeded by the fitted head, with what MediaPipe's selfie "
+                 "segmentation calls background as sure background; default; scripts/install-deps.sh installs its "
+                 "weights), none (GrabCut alone) or selfie-only (the selfie segmentation's person: shoulders, arms and "
+                 "hands included, no GrabCut). The refit's silhouettes always come from GrabCut alone")
+      ->check(CLI::IsMember({"selfie", "none", "selfie-only"}));
   app.add_flag("--keep-cameras", options->keep_cameras,
                "PHOTOS is one dataset: keep its cameras and images, re-express its expressions in the face model's");
   auto landmarks = std::make_shared<std::string>("detect");
@@ -86,8 +94,12 @@ CommandFn RegisterTrack(CLI::App& app) {
                "Developer: measure where the detector (--detector) puts its landmarks on the face model (renders of "
                "validation identities) and print the table of src/icef/track/detector_landmarks.inc (dlib) or "
                "mesh_landmarks.inc (mesh)");
-  return [options, focal, calibrate, detector, landmark_sigma, landmarks, region, photometric, silhouette_points, &app]() -> Status {
+  return [options, focal, calibrate, detector, landmark_sigma, landmarks, region, photometric, silhouette_points,
+          segmentation, &app]() -> Status {
     options->track.fit.silhouette_face_only = *region == "face";
+    options->track.segmentation = *segmentation == "none"     ? track::TrackOptions::Segmentation::kNone
+                                  : *segmentation == "selfie" ? track::TrackOptions::Segmentation::kSelfie
+                                                              : track::TrackOptions::Segmentation::kSelfieOnly;
     if (*photometric >= 0) {
       options->track.fit.photometric_weight = *photometric;
     } else if (options->keep_cameras) {

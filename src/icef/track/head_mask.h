@@ -2,7 +2,10 @@
 // Well inside the silhouette is sure foreground, the rest of it probable foreground, a band around
 // it probable background, everything farther (and what lies outside the photo) sure background;
 // GrabCut's colour models then move the boundary onto the image's own edges (hair beyond the
-// skull, the neck). The largest connected component, holes filled, is the mask.
+// skull, the neck). Where a person segmentation is given (person_segmentation.h), what it calls
+// background with confidence is sure background too, unless deep inside the silhouette: GrabCut's
+// colour models alone keep background that resembles hair or skin (a door frame beside dark hair).
+// The largest connected component, holes filled, is the mask.
 #pragma once
 
 #include <string>
@@ -20,6 +23,7 @@ struct HeadMaskOptions {
   double sure_inside = 0.04;   // silhouette pixels deeper than this (fraction of the image width) are sure foreground
   double band = 0.12;          // outside pixels within this distance of the silhouette are probable background
   int iterations = 5;          // GrabCut iterations
+  double person_background = 0.05;  // person probability below which a pixel outside the sure core is sure background
 
   Status Validate() const;
   std::string ToString() const;
@@ -30,8 +34,16 @@ Image HeadSilhouette(const face::FaceModel& model, const std::vector<float>& exp
                      const Executor& executor = Executor(1));
 
 // The mask (1-channel, 0 or 1) of `image` (RGB or RGBA; alpha ignored). `outside` (1-channel, may be
-// empty) marks pixels that lie outside the original photo. Deterministic.
-Image HeadMask(const Image& image, const Image& silhouette, const Image& outside, const HeadMaskOptions& options = {});
+// empty) marks pixels that lie outside the original photo; `person` (1-channel, may be empty) is a
+// person segmentation's probability per pixel. Deterministic.
+Image HeadMask(const Image& image, const Image& silhouette, const Image& outside, const Image& person = Image(),
+               const HeadMaskOptions& options = {});
+
+// The mask (1-channel, 0 or 1) of the person alone: where `person` (a person segmentation's
+// probability) is above `threshold` and the pixel lies inside the photo (`outside`, may be empty),
+// the largest component with its holes filled. Shoulders, arms and whatever the network counts as
+// the person are in it.
+Image PersonMask(const Image& person, const Image& outside, double threshold = 0.5);
 
 // The mask (1-channel, 0 or 1) of what a frame shows in front of a known background image (NerFace's
 // static camera: bg/ holds the empty scene): pixels whose colour differs from the background's by

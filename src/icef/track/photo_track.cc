@@ -100,14 +100,22 @@ struct HeadCrop {
 };
 
 HeadCrop CropHead(const face::FaceModel& model, const TrackedFrame& tracked, const TrackedPhoto& photo,
-                  const TrackOptions& options, const Executor& executor) {
+                  const TrackOptions& options, const PersonSegmenter* segmenter, const Executor& executor) {
   HeadCrop c;
   const Camera photo_camera(photo.photo_intrinsics, Inverse(tracked.cam_from_head));
   c.box = HeadCropBox(photo_camera, options.crop_margin);
   c.rgb = CropImage(photo.photo, c.box, options.resolution, &c.outside);
   c.camera = Camera(CropIntrinsics(photo.photo_intrinsics, c.box, options.resolution), Inverse(tracked.cam_from_head));
   const Image silhouette = HeadSilhouette(model, tracked.expression, c.camera, executor);
-  c.mask = HeadMask(c.rgb, silhouette, c.outside, options.mask);
+  Image person;
+  if (segmenter) {
+    Result<Image> p = segmenter->Run(c.rgb);
+    ICEF_CHECK(p.ok(), p.status().message());  // the crop is always RGB
+    person = std::move(*p);
+  }
+  c.mask = segmenter && options.segmentation == TrackOptions::Segmentation::kSelfieOnly
+               ? PersonMask(person, c.outside)
+               : HeadMask(c.rgb, silhouette, c.outside, person, options.mask);
   return c;
 }
 
@@ -133,8 +141,8 @@ std::vector<Vec2f> SilhouettePoints(const HeadCrop& c, const TrackedPhoto& photo
 
 // The dataset frame and image of one tracked photo.
 void BuildFrame(const face::FaceModel& model, const TrackedFrame& tracked, const TrackOptions& options,
-                const Executor& executor, TrackedPhoto* photo, Frame* frame) {
-  const HeadCrop c = CropHead(model, tracked, *photo, options, executor);
+                const PersonSegmenter* segmenter, const Executor& executor, TrackedPhoto* photo, Frame* frame) {
+  const HeadCrop c = CropHead(model, tracked, *photo, options, segmenter, executor);
   photo->crop = c.box;
   photo->image = Image(options.resolution, options.resolution, 4);
   for (int y = 0; y < options.resolution; ++y)
@@ -176,7 +184,7 @@ std::string TrackOptions::ToString() const {
   std::ostringstream os;
   os << "TrackOptions(resolution=" << resolution << ", focal=" << (focal ? std::to_string(*focal) : "auto")
      << ", num_test=" << num_test << ", skip_bad=" << skip_bad << ", crop_margin=" << crop_margin
-     << ", silhouette_points=" << silhouette_points << ", "
+     << ", silhouette_points=" << silhouette_points << ", segmentation=" << static_cast<int>(segmentation) << ", "
      << fit.ToString() << ", " << mask.ToString() << ")";
   return os.str();
 }
@@ -190,6 +198,11 @@ Result<TrackResult> TrackPhotos(const std::vector<fs::path>& photos, const Track
   if (options.fit.detector == LandmarkDetector::kMesh) {
     ICEF_ASSIGN_OR_RETURN(FaceMesh loaded, FaceMesh::Load());
     mesh = std::move(loaded);
+  }
+  std::optional<PersonSegmenter> segmenter;
+  if (options.segmentation != TrackOptions::Segmentation::kNone) {
+    ICEF_ASSIGN_OR_RETURN(PersonSegmenter loaded, PersonSegmenter::Load());
+    segmenter = std::move(loaded);
   }
   ICEF_ASSIGN_OR_RETURN(std::vector<Detected> detected, DetectAll(photos, detector, mesh ? &*mesh : nullptr, executor));
 
@@ -232,7 +245,10 @@ Result<TrackResult> TrackPhotos(const std::vector<fs::path>& photos, const Track
     // Refit with the silhouettes of the masks the landmark fit gives.
     const face::FaceModel first(result.fit.shape);
     for (int i = 0; i < kept; ++i) {
-      const HeadCrop c = CropHead(first, result.fit.frames[i], result.photos[i], options, executor);
+      // GrabCut alone: the refit reads the mask's edge where skin lies just inside it (SkinEdges),
+      // which background GrabCut keeps rarely touches, and the fit proved sensitive to small changes
+      // of that edge (docs/tracking.md); the segmentation cleans the dataset's alpha only.
+      const HeadCrop c = CropHead(first, result.fit.frames[i], result.photos[i], options, nullptr, executor);
       frames[i].silhouette = SilhouettePoints(c, result.photos[i], options.resolution, options.silhouette_points,
                                               options.fit.silhouette_face_only);
       frames[i].photo = &result.photos[i].photo;
@@ -255,7 +271,7 @@ Result<TrackResult> TrackPhotos(const std::vector<fs::path>& photos, const Track
     p.test = i >= kept - options.num_test;
     p.frame_index = p.test ? i - (kept - options.num_test) : i;
     Frame frame;
-    BuildFrame(model, result.fit.frames[i], options, executor, &p, &frame);
+    BuildFrame(model, result.fit.frames[i], options, segmenter ? &*segmenter : nullptr, executor, &p, &frame);
     (p.test ? d.test : d.train).push_back(std::move(frame));
   }
   for (Frame& f : d.test) {

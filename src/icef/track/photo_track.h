@@ -1,7 +1,8 @@
 // `icef track PHOTOS... --out DATASET` (DESIGN.md §8): a dataset in the §4 format from a handful of
 // photos of one person. Per photo: exactly one face and its 68 landmarks (dlib); one joint fit of
 // the face model (track_fit.h: shared identity, per-photo head pose and expression); a square crop
-// around the fitted head resampled to the dataset's resolution; a foreground mask (head_mask.h).
+// around the fitted head resampled to the dataset's resolution; a foreground mask (head_mask.h,
+// with the person segmentation of person_segmentation.h).
 // The dataset's world frame is the fitted head frame: transform_matrix = camera-to-head,
 // expression_names = the face model's, aabb around the head.
 //
@@ -22,6 +23,7 @@
 #include "icef/io/json_util.h"
 #include "icef/landmarks/face_landmark_detector.h"
 #include "icef/track/head_mask.h"
+#include "icef/track/person_segmentation.h"
 #include "icef/track/photo_crop.h"
 #include "icef/track/track_fit.h"
 
@@ -34,6 +36,10 @@ struct TrackOptions {
   bool skip_bad = false;            // skip photos without exactly one face instead of stopping
   double crop_margin = 1.15;        // crop side / the head box's projected extent
   int silhouette_points = 200;      // refit with this many mask edge points per photo (0: landmarks only)
+  // The dataset's alpha: GrabCut alone, GrabCut with the person segmentation's confident background
+  // as sure background (default), or the person segmentation alone (PersonMask: shoulders included).
+  enum class Segmentation { kNone, kSelfie, kSelfieOnly };
+  Segmentation segmentation = Segmentation::kSelfie;
   TrackFitOptions fit;
   HeadMaskOptions mask;
 

@@ -284,6 +284,55 @@ TEST(HeadMaskTest, SkinEdgesKeepTheFaceOutlineNotHair) {
   for (bool k : SkinEdges(image, mask, points, none, 2.0)) EXPECT_TRUE(k);
 }
 
+TEST(HeadMaskTest, PersonSegmentationBackgroundIsSureBackground) {
+  // A skin-coloured disk (radius 14 about (32, 32)) on a blue background, and touching it on the
+  // right a skin-coloured bar (a door frame beside the head): GrabCut's colour models alone keep
+  // the bar with the head. The silhouette is the disk, a little smaller.
+  Image image(64, 64, 3), silhouette(64, 64, 1), person(64, 64, 1), nobody(64, 64, 1);
+  const auto in_disk = [](int x, int y, float r) {
+    const float dx = x + 0.5f - 32.f, dy = y + 0.5f - 32.f;
+    return dx * dx + dy * dy < r * r;
+  };
+  const auto in_bar = [](int x, int y) { return x >= 44 && x < 52 && y >= 14 && y < 50; };
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) {
+      const bool skin = in_disk(x, y, 14.f) || in_bar(x, y);
+      const Vec3f c = (skin ? Vec3f(0.85f, 0.62f, 0.5f) : Vec3f(0.2f, 0.3f, 0.7f)) +
+                      Vec3f::Constant(0.02f * ((x * 7 + y * 13) % 3 - 1));
+      for (int ch = 0; ch < 3; ++ch) image.At(x, y, ch) = c[ch];
+      silhouette.At(x, y, 0) = in_disk(x, y, 13.f) ? 1.f : 0.f;
+      person.At(x, y, 0) = in_disk(x, y, 15.f) ? 0.97f : 0.01f;  // the network sees the head only
+    }
+  const auto count = [&](const Image& mask, bool bar) {
+    int n = 0;
+    for (int y = 0; y < 64; ++y)
+      for (int x = 0; x < 64; ++x) n += mask.At(x, y, 0) > 0.5f && (bar ? in_bar(x, y) && !in_disk(x, y, 15.f) : in_disk(x, y, 14.f));
+    return n;
+  };
+  int disk = 0;
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) disk += in_disk(x, y, 14.f);
+  const Image alone = HeadMask(image, silhouette, Image());
+  EXPECT_GT(count(alone, true), 60);  // GrabCut alone keeps the bar within its probable band (99 pixels)
+  const Image segmented = HeadMask(image, silhouette, Image(), person);
+  EXPECT_EQ(count(segmented, true), 0);             // the segmentation's background is gone
+  EXPECT_GT(count(segmented, false), 0.95 * disk);  // the head stays
+  // A segmentation that sees nobody cannot remove the silhouette's sure core.
+  const Image blind = HeadMask(image, silhouette, Image(), nobody);
+  EXPECT_EQ(blind.At(32, 32, 0), 1.f);
+  // The person alone: the segmentation's disk, less what lies outside the photo (the left half).
+  Image outside(64, 64, 1);
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 32; ++x) outside.At(x, y, 0) = 1.f;
+  const Image alone_person = PersonMask(person, outside);
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x)
+      EXPECT_EQ(alone_person.At(x, y, 0), in_disk(x, y, 15.f) && x >= 32 ? 1.f : 0.f) << x << "," << y;
+  HeadMaskOptions bad;
+  bad.person_background = 1.5;
+  EXPECT_FALSE(bad.Validate().ok());
+}
+
 TEST(HeadMaskTest, BackgroundDifferenceMaskIsWhatStandsInFrontOfTheBackground) {
   // A striped background; the frame shows it with a disk (radius 12 about (32, 30)) in front, a
   // background-coloured hole in the disk, a lone changed pixel and a second, smaller blob.
