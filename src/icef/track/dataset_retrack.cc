@@ -267,6 +267,7 @@ Json RetrackReportJson(const RetrackResult& result) {
               {"skipped", result.skipped},
               {"landmark_rms_iod", result.fit.rms_iod},
               {"photometric_refit", result.fit.photometric},
+              {"silhouette_refit", result.fit.silhouettes},
               {"landmark_max_iod", result.fit.max_iod},
               {"iterations", result.fit.iterations},
               {"head_from_world", {{"scale", s.scale},

@@ -254,7 +254,7 @@ Result<TrackResult> TrackPhotos(const std::vector<fs::path>& photos, const Track
       frames[i].photo = &result.photos[i].photo;
     }
     ICEF_ASSIGN_OR_RETURN(result.fit, FitTrack(frames, options.fit));
-    if (log) log(result.fit.BriefReport() + " (with silhouettes)");
+    if (log) log(result.fit.BriefReport() + " (refit with the masks' outlines)");
   }
 
   Dataset& d = result.dataset;
@@ -317,6 +317,7 @@ Json TrackReportJson(const TrackResult& result) {
               {"skipped", result.skipped},
               {"landmark_rms_iod", result.fit.rms_iod},
               {"photometric_refit", result.fit.photometric},
+              {"silhouette_refit", result.fit.silhouettes},
               {"landmark_max_iod", result.fit.max_iod},
               {"iterations", result.fit.iterations},
               {"shape", shape}};

@@ -354,8 +354,8 @@ void AddLandmarkBlocks(ceres::Problem& cp, std::vector<FrameProblem>& problems, 
                           new GaussianPrior<kShape>{1.0, 1.0 / options.shape_prior_sigma}),
                       nullptr, s->shape.data());
   for (int i = 0; i < kShape; ++i) {  // keep the head buildable
-    cp.SetParameterLowerBound(s->shape.data(), i, 0.5);
-    cp.SetParameterUpperBound(s->shape.data(), i, 1.6);
+    cp.SetParameterLowerBound(s->shape.data(), i, options.shape_min);
+    cp.SetParameterUpperBound(s->shape.data(), i, options.shape_max);
   }
   if (!fit_shape) cp.SetParameterBlockConstant(s->shape.data());
 }
@@ -481,6 +481,8 @@ Vec3d TrackedFrame::YawPitchRollDeg() const {
 }
 
 Status TrackFitOptions::Validate() const {
+  if (!(shape_min > 0 && shape_min < 1 && shape_max > 1 && std::isfinite(shape_max)))
+    return Status::Error("shape bounds must satisfy 0 < shape_min < 1 < shape_max");
   if (!(shape_prior_sigma > 0) || !std::isfinite(shape_prior_sigma))
     return Status::Error("shape_prior_sigma must be a finite number > 0");
   if (!(expression_prior_sigma > 0) || !std::isfinite(expression_prior_sigma))
@@ -513,7 +515,7 @@ Status TrackFitOptions::Validate() const {
 
 std::string TrackFitOptions::ToString() const {
   std::ostringstream os;
-  os << "TrackFitOptions(shape_prior_sigma=" << shape_prior_sigma << ", expression_prior_sigma="
+  os << "TrackFitOptions(shape_prior_sigma=" << shape_prior_sigma << ", shape_min=" << shape_min << ", shape_max=" << shape_max << ", expression_prior_sigma="
      << expression_prior_sigma << ", max_expression=" << max_expression << ", jaw_line_weight=" << jaw_line_weight
      << ", max_iterations=" << max_iterations << ", outlier_iod=" << outlier_iod
      << ", dlib_convention=" << dlib_convention << ", detector=" << LandmarkDetectorName(detector) << ", landmark_sigma_iod=" << landmark_sigma_iod
@@ -534,6 +536,7 @@ std::string TrackFit::BriefReport() const {
   os.precision(3);
   os << "track fit: " << frames.size() << " images, landmark RMS " << rms_iod << " IOD (max " << max_iod << "), "
      << iterations << " iterations, photometric refit " << photometric;
+  if (silhouettes.rfind("not used", 0) == 0) os << ", silhouette refit " << silhouettes;
   return os.str();
 }
 
@@ -605,7 +608,27 @@ Result<TrackFit> FitTrack(std::span<const TrackFrame> frames, const TrackFitOpti
     const bool any = std::any_of(problems.begin(), problems.end(), [](const FrameProblem& fp) {
       return std::any_of(fp.silhouette_weight.begin(), fp.silhouette_weight.end(), [](double w) { return w > 0; });
     });
-    if (any) ICEF_RETURN_IF_ERROR(solve_all());
+    if (any) {
+      // The silhouettes can pull the fit into a degenerate head (a shape scale on its bound, the
+      // pose turned to match: docs/tracking.md); then the landmarks' fit stays.
+      const Solution landmark_fit = s;
+      ICEF_RETURN_IF_ERROR(solve_all());
+      s.silhouette_note = "used";
+      for (int i = 0; i < kShape; ++i) {
+        if (s.shape[i] > options.shape_min + 1e-3 && s.shape[i] < options.shape_max - 1e-3) continue;
+        std::ostringstream why;
+        why.precision(3);
+        why << "not used: the head's " << face::kShapeParamNames[i] << " ran to its bound " << s.shape[i]
+            << "; the landmarks' fit is kept";
+        const int iterations = s.iterations;
+        s = landmark_fit;
+        s.iterations = iterations;
+        s.silhouette_note = why.str();
+        shared.use_silhouettes = false;
+        for (FrameProblem& fp : problems) std::fill(fp.silhouette_weight.begin(), fp.silhouette_weight.end(), 0.0);
+        break;
+      }
+    }
   }
   // Then the images, when every frame has one and there are two to compare.
   const bool photos = std::all_of(frames.begin(), frames.end(), [](const TrackFrame& f) { return f.photo != nullptr; });
@@ -614,6 +637,7 @@ Result<TrackFit> FitTrack(std::span<const TrackFrame> frames, const TrackFitOpti
   TrackFit fit;
   fit.iterations = s.iterations;
   fit.photometric = s.photometric_note.empty() ? "off" : s.photometric_note;
+  fit.silhouettes = s.silhouette_note.empty() ? "off" : s.silhouette_note;
   fit.shape = face::ShapeParams::FromArray([&] {
     std::array<float, kShape> v;
     for (int i = 0; i < kShape; ++i) v[i] = static_cast<float>(s.shape[i]);

@@ -52,6 +52,11 @@ struct TrackFitOptions {
   // 0.06-0.10 IOD on the astronaut and Grace Hopper, against 0.035-0.042 at 0.05).
   double landmark_sigma_iod = 0.05;
   double shape_prior_sigma = 0.1;       // std of each shape scale around 1
+  // Bounds of every shape scale (they keep the head buildable). A silhouette refit that ends with
+  // one on a bound has degenerated (no head seen so far lies beyond 0.65-1.35): the landmarks' fit
+  // is kept (TrackFit::silhouettes).
+  double shape_min = 0.5;
+  double shape_max = 1.6;
   double expression_prior_sigma = 0.3;  // std of each expression weight around 0 (neutral)
   // A Laplace (L1) prior on the weights besides the Gaussian one, cost sum(weights) / this scale
   // (0: none): a photo shows few expressions at once, and this prior leaves the others at exactly 0.
@@ -128,6 +133,9 @@ struct TrackFit {
   // the reason (TrackFitOptions::photometric_max_rms); each frame's photometric_rms says how far
   // its colours agreed either way.
   std::string photometric = "off";
+  // The silhouette refit: "off" (no silhouette points), "used", or "not used: ..." when it drove a
+  // shape scale to its bound (a degenerate head) and the landmarks' fit was kept instead.
+  std::string silhouettes = "off";
   std::string BriefReport() const;
   std::string ToString() const { return BriefReport(); }
 };

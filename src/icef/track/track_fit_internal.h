@@ -76,6 +76,7 @@ struct Solution {
   std::vector<double> photometric_rms;  // per frame, after the photometric refit (empty: none)
   std::vector<int> photometric_used;
   std::string photometric_note;  // TrackFit::photometric
+  std::string silhouette_note;   // TrackFit::silhouettes
 };
 
 // The weights clamped to [0, max_expression], as the face model takes them.

@@ -215,6 +215,42 @@ TEST(TrackFitTest, SilhouettesSharpenThePose) {
   }
 }
 
+// A silhouette refit that drives a shape scale onto its bound has degenerated: the landmarks' fit
+// stays, and the fit says why. Here the outlines are a wider skull's than the landmarks' head, and
+// head_width may not pass 1.06.
+TEST(TrackFitTest, ASilhouetteRefitOnAShapeBoundKeepsTheLandmarkFit) {
+  const face::FaceModel head(KnownShape());
+  Truth truth = MakePhotos(head, 4, 0.3, 31);
+  TrackFitOptions o = ModelConvention();
+  o.silhouette_face_only = false;
+  o.shape_max = 1.06;
+  const Result<TrackFit> landmarks_only = FitTrack(truth.frames, o);
+  ASSERT_TRUE(landmarks_only.ok()) << landmarks_only.status().message();
+  EXPECT_EQ(landmarks_only->silhouettes, "off");
+  ASSERT_LT(landmarks_only->shape.head_width, 1.05f);
+  face::ShapeParams wide = KnownShape();
+  wide.head_width = 1.2f;
+  AddSilhouettes(face::FaceModel(wide), &truth, 200);
+  const Result<TrackFit> refit = FitTrack(truth.frames, o);
+  ASSERT_TRUE(refit.ok()) << refit.status().message();
+  EXPECT_EQ(refit->silhouettes.rfind("not used: the head's head_width ran to its bound", 0), 0u) << refit->silhouettes;
+  EXPECT_NE(refit->BriefReport().find("silhouette refit not used"), std::string::npos);
+  EXPECT_FLOAT_EQ(refit->shape.head_width, landmarks_only->shape.head_width);
+  for (size_t k = 0; k < refit->frames.size(); ++k) {
+    EXPECT_TRUE(refit->frames[k].cam_from_head.isApprox(landmarks_only->frames[k].cam_from_head, 1e-9)) << k;
+    EXPECT_EQ(refit->frames[k].silhouette_used, 0) << k;
+  }
+  // Within the usual bounds the same outlines are used.
+  o.shape_max = TrackFitOptions().shape_max;
+  const Result<TrackFit> free = FitTrack(truth.frames, o);
+  ASSERT_TRUE(free.ok()) << free.status().message();
+  EXPECT_EQ(free->silhouettes, "used");
+  EXPECT_GT(free->shape.head_width, 1.06f);
+  TrackFitOptions bad;
+  bad.shape_min = 1.2;
+  EXPECT_FALSE(bad.Validate().ok());
+}
+
 TEST(TrackFitTest, KnownCamerasGiveTheSharedSimilarity) {
   const face::FaceModel head(KnownShape());
   Truth truth = MakePhotos(head, 4, 0.3, 11);
