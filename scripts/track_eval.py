@@ -12,7 +12,9 @@ with truth/truth.json:
   along the line of sight (depth: with a known focal length, a head fitted x % too large is fitted
   x % too far, so this part carries the size error the shape prior leaves) and its part across it
   (lateral: where the head is in the image); `distance_ratio` is the tracked over the true
-  camera-to-head distance;
+  camera-to-head distance; `translation_frac_scale_aligned` is the translation error after one
+  factor per identity (`identity_scale`, least squares over its photos) takes out the head size a
+  monocular tracker cannot tell from its distance;
 - expression error: RMS over the 11 weights, and over the 10 the 68 landmarks can see (cheek_puff
   moves none of them), beside what predicting neutral would score; and the correlation of the
   tracked with the true weights over all photos;
@@ -39,6 +41,15 @@ def rotation_angle_deg(a, b):
     r = np.asarray(a)[:3, :3].T @ np.asarray(b)[:3, :3]
     c = (np.trace(r) - 1) / 2
     return math.degrees(math.acos(max(-1.0, min(1.0, c))))
+
+
+def align_scale(true_positions, tracked_positions):
+    """The scale a monocular tracker cannot see: one factor for an identity's photos (they share the
+    head), the least-squares s in true ~ s * tracked, as a scale-aligned trajectory error aligns a
+    monocular camera's. Returns s and each photo's |true - s * tracked| (what the photos decide)."""
+    tt, pt = np.asarray(true_positions, float), np.asarray(tracked_positions, float)
+    s = float((tt * pt).sum() / (pt * pt).sum())
+    return s, [float(e) for e in np.linalg.norm(tt - s * pt, axis=1)]
 
 
 def median(values):
@@ -98,7 +109,8 @@ def evaluate_seed(icef, out, seed, photos, res, extra, synth_extra, reuse=False)
         iou = float((a & b).sum() / max(1, (a | b).sum()))
         rows.append({"seed": seed, "photo": os.path.basename(p["photo"]), "rotation_deg": rot,
                      "translation_frac": trans, "depth_frac": depth, "lateral_frac": lateral,
-                     "distance_ratio": distance_ratio, "expression_rms": expr_all, "expression_rms_seen": expr_seen, "expression_rms_neutral": expr_zero,
+                     "distance_ratio": distance_ratio, "true_head_in_camera": true_t.tolist(),
+                     "tracked_head_in_camera": track_t.tolist(), "expression_rms": expr_all, "expression_rms_seen": expr_seen, "expression_rms_neutral": expr_zero,
                      "true_expression": te.tolist(), "tracked_expression": pe.tolist(),
                      "mask_iou": iou, "landmark_rms_iod": p["landmark_rms_iod"],
                      "true_pose_deg": t.get("head_pose_deg")})
@@ -107,6 +119,11 @@ def evaluate_seed(icef, out, seed, photos, res, extra, synth_extra, reuse=False)
         err = [report["shape"][k] - v for k, v in truth["shape"].items()]
         for r in rows:
             r["shape_rms"] = float(np.sqrt(np.mean(np.square(err))))
+    if rows:
+        s, errors = align_scale([r["true_head_in_camera"] for r in rows], [r["tracked_head_in_camera"] for r in rows])
+        for r, e in zip(rows, errors):
+            r["identity_scale"] = s
+            r["translation_frac_scale_aligned"] = e / HEAD_HEIGHT
     skipped = [{"seed": seed, "skipped": s} for s in report["skipped"]]
     return rows, skipped
 
@@ -130,7 +147,7 @@ def main():
                              args.synth_args.split(), args.reuse)
         rows += r
         skipped += s
-    keys = ["rotation_deg", "translation_frac", "depth_frac", "lateral_frac", "expression_rms", "expression_rms_seen", "expression_rms_neutral",
+    keys = ["rotation_deg", "translation_frac", "translation_frac_scale_aligned", "depth_frac", "lateral_frac", "expression_rms", "expression_rms_seen", "expression_rms_neutral",
             "mask_iou", "landmark_rms_iod"] + (["shape_rms"] if rows and "shape_rms" in rows[0] else [])
     summary = {k: {"median": median([r[k] for r in rows]), "max": max(r[k] for r in rows),
                    "min": min(r[k] for r in rows)} for k in keys}
@@ -141,9 +158,10 @@ def main():
     p = np.array([r["tracked_expression"] for r in rows])[:, names_seen].ravel()
     summary["expression_correlation"] = float(np.corrcoef(t, p)[0, 1]) if t.std() > 0 and p.std() > 0 else 0.0
     summary["distance_ratio_error"] = {"median": median([abs(r["distance_ratio"] - 1) for r in rows])}
-    print(f"{'seed':>4} {'photo':>14} {'rot deg':>8} {'trans':>7} {'depth':>7} {'lateral':>7} {'expr':>6} {'expr10':>6} {'IoU':>6} {'lm IOD':>7}")
+    summary["identity_scale"] = {str(r["seed"]): r["identity_scale"] for r in rows}
+    print(f"{'seed':>4} {'photo':>14} {'rot deg':>8} {'trans':>7} {'aligned':>7} {'depth':>7} {'lateral':>7} {'expr':>6} {'expr10':>6} {'IoU':>6} {'lm IOD':>7}")
     for r in rows:
-        print(f"{r['seed']:>4} {r['photo']:>14} {r['rotation_deg']:8.2f} {r['translation_frac']:7.3f} "
+        print(f"{r['seed']:>4} {r['photo']:>14} {r['rotation_deg']:8.2f} {r['translation_frac']:7.3f} {r['translation_frac_scale_aligned']:7.3f} "
               f"{r['depth_frac']:7.3f} {r['lateral_frac']:7.3f} "
               f"{r['expression_rms']:6.3f} {r['expression_rms_seen']:6.3f} {r['mask_iou']:6.3f} {r['landmark_rms_iod']:7.3f}")
     for s in skipped:

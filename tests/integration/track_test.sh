@@ -22,6 +22,22 @@ fail() { echo "FAIL: $*" >&2; exit 1; }
 /usr/bin/python3 "$HERE/../../scripts/track_eval.py" --icef "$ICEF" --out "$TMP/eval" --seeds 2 --photos 3 \
   --res 128 --check 4,0.08,0.3,0.9 || fail "track_eval bounds"
 "$ICEF" info "$TMP/eval/track_2" >/dev/null || fail "the tracked dataset does not validate"
+# The head-size alignment: a known answer, and the evaluation's own rows.
+/usr/bin/python3 - "$HERE/../../scripts/track_eval.py" "$TMP/eval/track_eval.json" <<'PY' || fail "scale alignment"
+import importlib.util, json, sys
+import numpy as np
+spec = importlib.util.spec_from_file_location("track_eval", sys.argv[1]); m = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(m)
+true = np.array([[0.1, -0.2, -2.0], [0.3, 0.1, -2.6], [-0.2, 0.0, -1.9]])
+s, e = m.align_scale(true, true / 1.02)
+assert abs(s - 1.02) < 1e-12 and max(e) < 1e-12, (s, e)
+s, e = m.align_scale(true, true * [1, 1, 0.9])  # a depth error no one factor explains
+assert 1.05 < s < 1.12 and min(e) > 0.01, (s, e)
+rows = json.load(open(sys.argv[2]))["rows"]
+sq = lambda k: sum(r[k] ** 2 for r in rows)
+assert sq("translation_frac_scale_aligned") <= sq("translation_frac") + 1e-12  # s = 1 is a candidate
+assert all(0.9 < r["identity_scale"] < 1.1 for r in rows)
+PY
 ls "$TMP/eval/track_2/track/overlay_000.png" >/dev/null || fail "no overlay"
 # The photometric refit ran on the synthetic photos (one consistently lit face).
 grep -q '"photometric_refit": "used"' "$TMP/eval/track_2/track/report.json" || fail "the photometric refit was not used"
