@@ -41,7 +41,7 @@ constexpr Run kRuns[] = {{0, 16, false},  {17, 21, false}, {22, 26, false}, {27,
 }  // namespace
 
 std::array<Vec3f, 68> FittedLandmarks(const face::FaceFit& fit, std::span<const float> beta) {
-  const face::FaceModel model(fit.shape);
+  const face::FaceModel model(fit.shape, fit.style);
   std::vector<float> b(beta.begin(), beta.end());
   for (float& v : b) v = std::isfinite(v) ? std::max(v, 0.f) : 0.f;
   std::array<Vec3f, 68> lm = model.Landmarks(model.Prepare(b));

@@ -1,5 +1,6 @@
 #include "icef/face/expression_style.h"
 
+#include <array>
 #include <cmath>
 #include <sstream>
 #include <utility>
@@ -11,27 +12,35 @@ namespace icef::face {
 
 namespace {
 
-// (name, value) of every gain and every offset, in declaration order.
+// (name, address) of every gain, then every offset, in declaration order.
+template <typename Style, typename Float>
+std::array<std::pair<const char*, Float*>, ExpressionStyle::kNumFields> FieldAddresses(Style& s) {
+  return {{{"jaw_gain", &s.jaw_gain},
+           {"smile_gain[0]", &s.smile_gain[0]},
+           {"smile_gain[1]", &s.smile_gain[1]},
+           {"smile_width", &s.smile_width},
+           {"smile_lift", &s.smile_lift},
+           {"lip_pucker_gain", &s.lip_pucker_gain},
+           {"lip_press_gain", &s.lip_press_gain},
+           {"brow_raise_gain[0]", &s.brow_raise_gain[0]},
+           {"brow_raise_gain[1]", &s.brow_raise_gain[1]},
+           {"brow_furrow_gain", &s.brow_furrow_gain},
+           {"eye_close_gain[0]", &s.eye_close_gain[0]},
+           {"eye_close_gain[1]", &s.eye_close_gain[1]},
+           {"cheek_puff_gain", &s.cheek_puff_gain},
+           {"jaw_hinge_dy", &s.jaw_hinge_dy},
+           {"jaw_hinge_dz", &s.jaw_hinge_dz},
+           {"smile_corner_shift", &s.smile_corner_shift},
+           {"brow_raise_shift", &s.brow_raise_shift}}};
+}
+
 std::vector<std::pair<std::string, float>> Gains(const ExpressionStyle& s) {
-  return {{"jaw_gain", s.jaw_gain},
-          {"smile_gain[0]", s.smile_gain[0]},
-          {"smile_gain[1]", s.smile_gain[1]},
-          {"smile_width", s.smile_width},
-          {"smile_lift", s.smile_lift},
-          {"lip_pucker_gain", s.lip_pucker_gain},
-          {"lip_press_gain", s.lip_press_gain},
-          {"brow_raise_gain[0]", s.brow_raise_gain[0]},
-          {"brow_raise_gain[1]", s.brow_raise_gain[1]},
-          {"brow_furrow_gain", s.brow_furrow_gain},
-          {"eye_close_gain[0]", s.eye_close_gain[0]},
-          {"eye_close_gain[1]", s.eye_close_gain[1]},
-          {"cheek_puff_gain", s.cheek_puff_gain}};
+  const std::vector<std::pair<std::string, float>> all = s.Fields();
+  return {all.begin(), all.begin() + ExpressionStyle::kNumGains};
 }
 std::vector<std::pair<std::string, float>> Offsets(const ExpressionStyle& s) {
-  return {{"jaw_hinge_dy", s.jaw_hinge_dy},
-          {"jaw_hinge_dz", s.jaw_hinge_dz},
-          {"smile_corner_shift", s.smile_corner_shift},
-          {"brow_raise_shift", s.brow_raise_shift}};
+  const std::vector<std::pair<std::string, float>> all = s.Fields();
+  return {all.begin() + ExpressionStyle::kNumGains, all.end()};
 }
 
 }  // namespace
@@ -75,6 +84,22 @@ Status ExpressionStyle::Validate() const {
       return Status::Error("expression style: " + name + ": expected an offset within +-" +
                            std::to_string(kMaxOffset) + " head units, got " + std::to_string(value));
   return Status::Ok();
+}
+
+std::vector<std::pair<std::string, float>> ExpressionStyle::Fields() const {
+  std::vector<std::pair<std::string, float>> out;
+  for (const auto& [name, address] : FieldAddresses<const ExpressionStyle, const float>(*this))
+    out.emplace_back(name, *address);
+  return out;
+}
+
+bool ExpressionStyle::SetField(const std::string& name, float value) {
+  for (const auto& [field, address] : FieldAddresses<ExpressionStyle, float>(*this))
+    if (name == field) {
+      *address = value;
+      return true;
+    }
+  return false;
 }
 
 std::string ExpressionStyle::ToString() const {

@@ -8,6 +8,8 @@
 
 #include <array>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "icef/core/status.h"
 
@@ -52,6 +54,13 @@ struct ExpressionStyle {
   // names the field.
   Status Validate() const;
   std::string ToString() const;
+
+  // Every field by name, the 13 gains first (declaration order; paired fields as name[0], name[1]),
+  // then the 4 offsets: the flat form a fit's parameter vector and a model's setup JSON use.
+  static constexpr int kNumGains = 13, kNumOffsets = 4, kNumFields = kNumGains + kNumOffsets;
+  std::vector<std::pair<std::string, float>> Fields() const;
+  // Sets the field called `name` (as Fields() names it); false when there is none.
+  bool SetField(const std::string& name, float value);
 
   bool operator==(const ExpressionStyle&) const = default;
 

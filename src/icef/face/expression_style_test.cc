@@ -35,6 +35,24 @@ ExpressionStyle Strong() {
   return st;
 }
 
+TEST(ExpressionStyleTest, FieldsRoundTripByName) {
+  const ExpressionStyle strong = Strong();
+  const auto fields = strong.Fields();
+  ASSERT_EQ(fields.size(), size_t(ExpressionStyle::kNumFields));
+  EXPECT_EQ(fields[0].first, "jaw_gain");
+  EXPECT_EQ(fields[ExpressionStyle::kNumGains].first, "jaw_hinge_dy");
+  ExpressionStyle copy;
+  for (const auto& [name, value] : fields) EXPECT_TRUE(copy.SetField(name, value)) << name;
+  EXPECT_EQ(copy, strong);
+  // Every field is reached: each one set alone makes the style differ from the generic one.
+  for (const auto& [name, value] : fields) {
+    ExpressionStyle one;
+    ASSERT_TRUE(one.SetField(name, value + 0.01f));
+    EXPECT_FALSE(one.IsGeneric()) << name;
+  }
+  EXPECT_FALSE(copy.SetField("jaw_gains", 1.f));
+}
+
 TEST(ExpressionStyleTest, DefaultsAreTheGenericStyle) {
   const ExpressionStyle st;
   EXPECT_EQ(st, ExpressionStyle::Generic());

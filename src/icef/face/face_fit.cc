@@ -32,27 +32,51 @@ double InterOcular2d(const std::vector<Vec2f>& lm) {
   return (a - b).norm() / 6.0;
 }
 
-// The face model's landmarks of every frame (head frame) for one shape, rebuilt only when the shape
-// changes (Ceres perturbs one parameter block at a time, so the pose's derivatives reuse it).
+// The style's parameter block: the gains as they are, then each offset + 1 (so that Ceres' relative
+// numeric-difference step, 1e-3 of the value, is about 1e-3 head units for an offset near 0 too).
+using StyleBlock = std::array<double, ExpressionStyle::kNumFields>;
+
+StyleBlock StyleToBlock(const ExpressionStyle& style) {
+  StyleBlock b;
+  const auto fields = style.Fields();
+  for (int i = 0; i < ExpressionStyle::kNumFields; ++i)
+    b[i] = fields[i].second + (i < ExpressionStyle::kNumGains ? 0.0 : 1.0);
+  return b;
+}
+
+ExpressionStyle StyleFromBlock(const double* block) {
+  ExpressionStyle style;
+  const auto fields = style.Fields();
+  for (int i = 0; i < ExpressionStyle::kNumFields; ++i)
+    style.SetField(fields[i].first, static_cast<float>(block[i] - (i < ExpressionStyle::kNumGains ? 0.0 : 1.0)));
+  return style;
+}
+
+// The face model's landmarks of every frame (head frame) for one shape and style, rebuilt only when
+// they change (Ceres perturbs one parameter block at a time, so the pose's derivatives reuse it).
 class LandmarkCache {
  public:
   explicit LandmarkCache(std::span<const FitFrame> frames) : frames_(frames) {}
-  const std::vector<std::array<Vec3f, 68>>& For(const double* shape) {
-    std::array<float, ShapeParams::kCount> values;
-    for (int i = 0; i < ShapeParams::kCount; ++i) values[i] = static_cast<float>(shape[i]);
-    if (!valid_ || values != key_) {
-      const FaceModel model(ShapeParams::FromArray(values));
+  const std::vector<std::array<Vec3f, 68>>& For(const double* shape, const double* style) {
+    Key key;
+    for (int i = 0; i < ShapeParams::kCount; ++i) key[i] = static_cast<float>(shape[i]);
+    for (int i = 0; i < ExpressionStyle::kNumFields; ++i) key[ShapeParams::kCount + i] = static_cast<float>(style[i]);
+    if (!valid_ || key != key_) {
+      std::array<float, ShapeParams::kCount> values;
+      std::copy_n(key.begin(), ShapeParams::kCount, values.begin());
+      const FaceModel model(ShapeParams::FromArray(values), StyleFromBlock(style));
       landmarks_.clear();
       for (const FitFrame& f : frames_) landmarks_.push_back(model.Landmarks(model.Prepare(f.expression)));
-      key_ = values;
+      key_ = key;
       valid_ = true;
     }
     return landmarks_;
   }
 
  private:
+  using Key = std::array<float, ShapeParams::kCount + ExpressionStyle::kNumFields>;
   std::span<const FitFrame> frames_;
-  std::array<float, ShapeParams::kCount> key_{};
+  Key key_{};
   bool valid_ = false;
   std::vector<std::array<Vec3f, 68>> landmarks_;
 };
@@ -90,8 +114,8 @@ struct Problem {
   }
 
   // Residual vector (IOD units, unweighted by sigma), weighted by the inlier mask.
-  void Residuals(const double* shape, const double* pose, double* out) const {
-    const std::vector<std::array<Vec3f, 68>>& model = cache.For(shape);
+  void Residuals(const double* shape, const double* style, const double* pose, double* out) const {
+    const std::vector<std::array<Vec3f, 68>>& model = cache.For(shape, style);
     const Similarity s = PoseToSimilarity(pose, base);
     int r = 0;
     for (size_t k = 0; k < frames.size(); ++k) {
@@ -112,12 +136,12 @@ struct Problem {
   }
 
   // Per-landmark error norms [frame][landmark] in IOD (ignoring the weights).
-  std::vector<std::vector<double>> Errors(const double* shape, const double* pose) const {
+  std::vector<std::vector<double>> Errors(const double* shape, const double* style, const double* pose) const {
     std::vector<std::vector<double>> saved = weight;
     auto* self = const_cast<Problem*>(this);
     for (auto& row : self->weight) std::fill(row.begin(), row.end(), 1.0);
     std::vector<double> res(num_residuals);
-    Residuals(shape, pose, res.data());
+    Residuals(shape, style, pose, res.data());
     self->weight = saved;
     std::vector<std::vector<double>> e;
     int r = 0;
@@ -139,7 +163,7 @@ struct LandmarkCost {
   const Problem* problem;
   double inv_sigma;
   bool operator()(double const* const* params, double* residuals) const {
-    problem->Residuals(params[0], params[1], residuals);
+    problem->Residuals(params[0], params[1], params[2], residuals);
     for (int i = 0; i < problem->num_residuals; ++i) residuals[i] *= inv_sigma;
     return true;
   }
@@ -150,6 +174,18 @@ struct ShapePriorCost {
   template <typename T>
   bool operator()(const T* shape, T* residuals) const {
     for (int i = 0; i < ShapeParams::kCount; ++i) residuals[i] = (shape[i] - T(1.0)) * T(inv_sigma);
+    return true;
+  }
+};
+
+// The style's prior: each gain's log and each offset around the generic style's 1 and 0.
+struct StylePriorCost {
+  double inv_sigma_gain, inv_sigma_offset;
+  template <typename T>
+  bool operator()(const T* style, T* residuals) const {
+    for (int i = 0; i < ExpressionStyle::kNumFields; ++i)
+      residuals[i] = i < ExpressionStyle::kNumGains ? log(style[i]) * T(inv_sigma_gain)
+                                                    : (style[i] - T(1.0)) * T(inv_sigma_offset);
     return true;
   }
 };
@@ -257,13 +293,18 @@ Status FaceFitOptions::Validate() const {
     return Status::Error("shape_prior_sigma must be a finite number > 0");
   if (max_iterations < 1) return Status::Error("max_iterations must be >= 1");
   if (!(outlier_iod > 0)) return Status::Error("outlier_iod must be > 0");
+  if (!(style_gain_sigma > 0) || !std::isfinite(style_gain_sigma))
+    return Status::Error("style_gain_sigma must be a finite number > 0");
+  if (!(style_offset_sigma > 0) || !std::isfinite(style_offset_sigma))
+    return Status::Error("style_offset_sigma must be a finite number > 0");
   return Status::Ok();
 }
 
 std::string FaceFitOptions::ToString() const {
   std::ostringstream os;
   os << "FaceFitOptions(shape_prior_sigma=" << shape_prior_sigma << ", fit_shape=" << fit_shape
-     << ", max_iterations=" << max_iterations << ", outlier_iod=" << outlier_iod << ")";
+     << ", max_iterations=" << max_iterations << ", outlier_iod=" << outlier_iod << ", fit_style=" << fit_style
+     << ", style_gain_sigma=" << style_gain_sigma << ", style_offset_sigma=" << style_offset_sigma << ")";
   return os.str();
 }
 
@@ -272,6 +313,16 @@ std::string FaceFit::BriefReport() const {
   os.precision(3);
   os << "face fit: landmark RMS " << rms_iod << " IOD (max " << max_iod << "), " << landmarks_used << "/"
      << landmarks_total << " landmarks, " << iterations << " iterations, head scale " << head_from_world.scale;
+  if (!style.IsGeneric()) {  // the fields the fit moved off the generic style
+    os << "; expression style:";
+    const auto generic = ExpressionStyle::Generic().Fields();
+    const auto fields = style.Fields();
+    int shown = 0;
+    for (size_t i = 0; i < fields.size(); ++i)
+      if (std::abs(fields[i].second - generic[i].second) >= 0.005f)
+        os << (shown++ ? ", " : " ") << fields[i].first << " " << fields[i].second;
+    if (shown == 0) os << " generic within 0.005";
+  }
   return os.str();
 }
 
@@ -291,6 +342,7 @@ Result<FaceFit> FitFaceModel(std::span<const FitFrame> frames, const FaceFitOpti
   std::array<double, ShapeParams::kCount> shape;
   shape.fill(1.0);
   std::array<double, kPoseSize> pose = {0, 0, 0, base.translation.x(), base.translation.y(), base.translation.z(), 0};
+  StyleBlock style = StyleToBlock(ExpressionStyle::Generic());
 
   FaceFit fit;
   fit.landmarks_total = kNumLandmarks * static_cast<int>(frames.size());
@@ -301,9 +353,10 @@ Result<FaceFit> FitFaceModel(std::span<const FitFrame> frames, const FaceFitOpti
     auto* cost = new ceres::DynamicNumericDiffCostFunction<LandmarkCost, ceres::CENTRAL>(
         new LandmarkCost{&problem, 1.0 / kLandmarkSigma}, ceres::TAKE_OWNERSHIP, nd);
     cost->AddParameterBlock(ShapeParams::kCount);
+    cost->AddParameterBlock(ExpressionStyle::kNumFields);
     cost->AddParameterBlock(kPoseSize);
     cost->SetNumResiduals(problem.num_residuals);
-    cp.AddResidualBlock(cost, nullptr, shape.data(), pose.data());
+    cp.AddResidualBlock(cost, nullptr, shape.data(), style.data(), pose.data());
     cp.AddResidualBlock(new ceres::AutoDiffCostFunction<ShapePriorCost, ShapeParams::kCount, ShapeParams::kCount>(
                             new ShapePriorCost{1.0 / options.shape_prior_sigma}),
                         nullptr, shape.data());
@@ -312,6 +365,22 @@ Result<FaceFit> FitFaceModel(std::span<const FitFrame> frames, const FaceFitOpti
       cp.SetParameterUpperBound(shape.data(), i, 1.6);
     }
     if (!options.fit_shape) cp.SetParameterBlockConstant(shape.data());
+    if (options.fit_style) {
+      cp.AddResidualBlock(
+          new ceres::AutoDiffCostFunction<StylePriorCost, ExpressionStyle::kNumFields, ExpressionStyle::kNumFields>(
+              new StylePriorCost{1.0 / options.style_gain_sigma, 1.0 / options.style_offset_sigma}),
+          nullptr, style.data());
+      // ExpressionStyle::Validate's ranges, less the numeric differences' step (1e-3 of the value).
+      for (int i = 0; i < ExpressionStyle::kNumFields; ++i) {
+        const bool gain = i < ExpressionStyle::kNumGains;
+        const double lo = gain ? ExpressionStyle::kMinGain : 1.0 - ExpressionStyle::kMaxOffset;
+        const double hi = gain ? ExpressionStyle::kMaxGain : 1.0 + ExpressionStyle::kMaxOffset;
+        cp.SetParameterLowerBound(style.data(), i, lo * (1.0 + 2e-3));
+        cp.SetParameterUpperBound(style.data(), i, hi * (1.0 - 2e-3));
+      }
+    } else {
+      cp.SetParameterBlockConstant(style.data());
+    }
     ceres::Solver::Options so;
     so.linear_solver_type = ceres::DENSE_QR;
     so.max_num_iterations = options.max_iterations;
@@ -323,7 +392,7 @@ Result<FaceFit> FitFaceModel(std::span<const FitFrame> frames, const FaceFitOpti
     fit.iterations += static_cast<int>(summary.iterations.size());
 
     // Outliers: farther than outlier_iod and 3x the median landmark error.
-    const std::vector<std::vector<double>> errors = problem.Errors(shape.data(), pose.data());
+    const std::vector<std::vector<double>> errors = problem.Errors(shape.data(), style.data(), pose.data());
     std::vector<double> all;
     for (const auto& row : errors) all.insert(all.end(), row.begin(), row.end());
     std::nth_element(all.begin(), all.begin() + all.size() / 2, all.end());
@@ -347,6 +416,7 @@ Result<FaceFit> FitFaceModel(std::span<const FitFrame> frames, const FaceFitOpti
   std::array<float, ShapeParams::kCount> values;
   for (int i = 0; i < ShapeParams::kCount; ++i) values[i] = static_cast<float>(shape[i]);
   fit.shape = ShapeParams::FromArray(values);
+  fit.style = StyleFromBlock(style.data());
   fit.head_from_world = PoseToSimilarity(pose.data(), base);
   return fit;
 }

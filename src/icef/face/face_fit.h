@@ -5,6 +5,9 @@
 // frame's calibrated camera. Robust nonlinear least squares (Ceres, Levenberg-Marquardt): residuals
 // in inter-ocular distances (IOD), a Gaussian plausibility prior on the shape scales around the
 // average head, and a second pass without the landmarks the first pass left far off (outliers).
+// Optionally (fit_style) the subject's expression style too (face/expression_style.h): its gains and
+// offsets, each with a prior around the generic style, read off the landmarks of the frames whose
+// expressions use them; a field no frame's expression moves keeps its generic value.
 #pragma once
 
 #include <optional>
@@ -13,6 +16,7 @@
 #include <vector>
 
 #include "icef/core/status.h"
+#include "icef/face/expression_style.h"
 #include "icef/face/shape_params.h"
 #include "icef/math/camera.h"
 #include "icef/math/types.h"
@@ -43,6 +47,9 @@ struct FaceFitOptions {
   bool fit_shape = true;            // false: the average head, similarity only
   int max_iterations = 60;          // Levenberg-Marquardt iterations per pass
   double outlier_iod = 0.08;        // second pass: drop landmarks farther than this (IOD) and 3x the median
+  bool fit_style = false;           // also fit the expression style (else the generic one)
+  double style_gain_sigma = 1.0;    // std of each style gain's log around 0 (generic: gain 1)
+  double style_offset_sigma = 0.03; // std of each style offset around 0 (head units)
 
   Status Validate() const;
   std::string ToString() const;
@@ -50,6 +57,7 @@ struct FaceFitOptions {
 
 struct FaceFit {
   ShapeParams shape;
+  ExpressionStyle style;  // generic unless FaceFitOptions::fit_style
   Similarity head_from_world;
   double rms_iod = 0;       // RMS landmark residual of the final pass (inter-ocular distances)
   double max_iod = 0;       // largest landmark residual

@@ -98,6 +98,63 @@ TEST(FaceFitTest, RecoversShapeAndSimilarityFromNoisy3dLandmarks) {
   EXPECT_LT(std::sqrt(rms / 68) / iod, 0.03);
 }
 
+// A subject with its own expression style, seen in frames that use the styled expressions (and never
+// cheek_puff).
+TEST(FaceFitTest, RecoversTheExpressionStyleOfTheExpressionsItSees) {
+  ExpressionStyle style;
+  style.jaw_gain = 0.75f;
+  style.smile_gain = {1.f, 1.2f};
+  style.brow_raise_gain = {0.8f, 1.f};
+  style.lip_press_gain = 1.25f;
+  const FaceModel truth(KnownShape(), style);
+  const Similarity s = KnownSimilarity();
+  std::vector<FitFrame> frames = Frames3d(truth, s, 5, 0.005, 3);
+  const std::vector<std::vector<float>> seen = {{0.6f, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0},
+                                                {0.25f, 0.5f, 0, 0, 0, 0, 0, 0, 0, 0, 0},
+                                                {0, 0, 0, 0, 0.5f, 0, 0.55f, 0, 0, 0, 0},
+                                                {0, 0.6f, 0, 0, 0, 0, 0, 0, 0.3f, 0, 0},
+                                                {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0}};
+  const double iod = InterOcularDistance(truth.NeutralLandmarks());
+  Rng rng(4, StreamId("fit_noise"));
+  for (size_t k = 0; k < frames.size(); ++k) {  // the same frames' landmarks at these expressions
+    frames[k].expression = seen[k];
+    const auto lm = truth.Landmarks(truth.Prepare(seen[k]));
+    for (int i = 0; i < 68; ++i)
+      (*frames[k].landmarks_3d)[i] =
+          s.ApplyInverse(lm[i].cast<double>() + 0.005 * iod * Vec3d(rng.Normal(), rng.Normal(), rng.Normal()))
+              .cast<float>();
+  }
+  FaceFitOptions options;
+  const Result<FaceFit> generic = FitFaceModel(frames, options);
+  ASSERT_TRUE(generic.ok()) << generic.status().message();
+  EXPECT_TRUE(generic->style.IsGeneric());
+  options.fit_style = true;
+  const Result<FaceFit> fit = FitFaceModel(frames, options);
+  ASSERT_TRUE(fit.ok()) << fit.status().message();
+  EXPECT_LT(fit->rms_iod, generic->rms_iod) << fit->BriefReport();
+  EXPECT_NEAR(fit->style.jaw_gain, 0.75f, 0.05f) << fit->style.ToString();
+  EXPECT_NEAR(fit->style.smile_gain[1], 1.2f, 0.1f) << fit->style.ToString();
+  // Brows and lips move fewer landmarks less far: the prior holds them back more.
+  EXPECT_NEAR(fit->style.brow_raise_gain[0], 0.8f, 0.1f) << fit->style.ToString();
+  EXPECT_NEAR(fit->style.lip_press_gain, 1.25f, 0.15f) << fit->style.ToString();
+  // No frame puffs the cheeks or smiles on the right: those fields keep the generic style's value.
+  EXPECT_NEAR(fit->style.cheek_puff_gain, 1.f, 1e-4f);
+  EXPECT_NEAR(fit->style.smile_gain[0], 1.f, 1e-4f);
+  EXPECT_NE(fit->BriefReport().find("jaw_gain"), std::string::npos) << fit->BriefReport();
+  // Far from the frames' expressions the fitted style's landmarks are nearer the truth's.
+  std::vector<float> far(kNumExpressions, 0.f);
+  far[kJawOpen] = 1.4f, far[kSmileLeft] = 1.2f, far[kBrowRaiseRight] = 1.3f;
+  const auto truth_far = truth.Landmarks(truth.Prepare(far));
+  auto rms_at_far = [&](const FaceFit& f) {
+    const FaceModel m(f.shape, f.style);
+    const auto lm = m.Landmarks(m.Prepare(far));
+    double sum = 0;
+    for (int i = 0; i < 68; ++i) sum += (lm[i] - truth_far[i]).squaredNorm();
+    return std::sqrt(sum / 68) / iod;
+  };
+  EXPECT_LT(rms_at_far(*fit), 0.5 * rms_at_far(*generic));
+}
+
 TEST(FaceFitTest, OutlierLandmarksAreDropped) {
   const FaceModel truth(KnownShape());
   const Similarity s = KnownSimilarity();

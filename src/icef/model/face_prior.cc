@@ -13,7 +13,7 @@ constexpr float kJacobianStep = 1e-3f;  // head units (the head is 0.73 tall; th
 
 class FacePrior final : public DeformationPrior {
  public:
-  explicit FacePrior(const face::FaceFit& fit) : fit_(fit), model_(fit.shape) {
+  explicit FacePrior(const face::FaceFit& fit) : fit_(fit), model_(fit.shape, fit.style) {
     const face::Similarity& s = fit.head_from_world;
     head_from_world_ = (s.scale * s.rotation).cast<float>();
     world_from_head_ = (s.rotation.transpose() / s.scale).cast<float>();
@@ -89,7 +89,7 @@ class FacePrior final : public DeformationPrior {
   int expression_dims() const override { return face::kNumExpressions; }
   std::string ToString() const override {
     std::ostringstream os;
-    os << "FacePrior(" << fit_.shape.ToString() << ", " << fit_.head_from_world.ToString() << ")";
+    os << "FacePrior(" << fit_.shape.ToString() << ", " << fit_.style.ToString() << ", " << fit_.head_from_world.ToString() << ")";
     return os.str();
   }
 

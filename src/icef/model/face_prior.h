@@ -1,7 +1,7 @@
 // The face-model prior P of DESIGN.md §2.1 as a DeformationPrior: the fitted face model's warp
 // carried into the dataset's world frame, P(x, beta) = S^-1 W(S x, beta) with S = head_from_world,
-// and its mouth cavity. The face model's expression style is the generic one: the fit sees
-// landmarks, never a subject's own style.
+// and its mouth cavity, in the fit's expression style (the generic one unless the style was fitted
+// to the training frames' landmarks: model.prior_style).
 #pragma once
 
 #include <memory>
@@ -19,7 +19,7 @@ namespace icef {
 Status CheckFaceModelExpressions(const std::vector<std::string>& expression_names, const std::string& origin);
 
 // Fits the face model to the dataset's training frames (landmarks_3d, else landmarks_2d and the
-// cameras). Errors: another expression space, frames without landmarks, a failed fit.
+// cameras); options.fit_style fits the subject's expression style too. Errors: another expression space, frames without landmarks, a failed fit.
 Result<face::FaceFit> FitFaceModelToDataset(const Dataset& dataset, const face::FaceFitOptions& options = {});
 
 // The prior of setup.face_fit. Errors: no face-model fit, another expression space.

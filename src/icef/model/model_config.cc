@@ -134,6 +134,11 @@ void ModelConfig::Bind(ConfigSchema& s) {
          "to the face model's surface (its normal there against the neutral surface's at the canonical point), "
          "under a light fitted to the training images' skin before training (field/prior_shading.h, "
          "model/prior_light.h): the shading a warp of a static field cannot show");
+  s.Bool("prior_style", &prior_style,
+         "icef-prior and warp-prior: fit the subject's expression style (each expression's gain, the jaw hinge, the "
+         "smile's corner and the brows' shift; face/expression_style.h) with its shape to the training frames' "
+         "landmarks, each field with a prior around the face model's generic style; an expression no training frame "
+         "shows keeps the generic style");
   s.Bool("bf16_inference", &bf16_inference,
          "renders, evaluation and occupancy updates multiply in BF16 with FP32 sums on CPUs with AVX512-BF16 "
          "(about "

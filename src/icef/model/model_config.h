@@ -65,6 +65,10 @@ struct ModelConfig {
   // expression brings to its surface, under a light fitted to the training images
   // (field/prior_shading.h, model/prior_light.h).
   bool prior_shading = true;
+  // The *-prior methods: fit the subject's expression style (face/expression_style.h) with its shape
+  // to the training frames' landmarks, so the prior warps as this subject performs the expressions
+  // its training frames show (model/face_prior.h).
+  bool prior_style = true;
   // Renders, eval and occupancy updates: MLP products in BF16 with FP32 sums (AVX512-BF16 CPUs).
   bool bf16_inference = StaticFieldOptions{}.bf16_inference;
   // Training passes (forward, backward, weight gradients) likewise; weights and Adam stay FP32.

@@ -51,7 +51,10 @@ Json ModelSetup::ToJson() const {
     const face::Similarity& sim = f.head_from_world;
     Json rot = Json::array();
     for (int r = 0; r < 3; ++r) rot.push_back({sim.rotation(r, 0), sim.rotation(r, 1), sim.rotation(r, 2)});
+    Json style = Json::object();
+    for (const auto& [name, value] : f.style.Fields()) style[name] = value;
     j["face_fit"] = {{"shape", shape},
+                     {"style", style},
                      {"head_from_world", {{"scale", sim.scale},
                                           {"rotation", rot},
                                           {"translation", {sim.translation.x(), sim.translation.y(), sim.translation.z()}}}},
@@ -112,6 +115,14 @@ Result<ModelSetup> ModelSetup::FromJson(const Json& json, const std::string& ori
       values[i] = static_cast<float>(x);
     }
     f.shape = face::ShapeParams::FromArray(values);
+    if (fv.Has("style")) {  // setups saved before styles were fitted have none: the generic style
+      ICEF_ASSIGN_OR_RETURN(const JsonObjectView style, fv.Object("style"));
+      for (const auto& [name, generic] : face::ExpressionStyle::Generic().Fields()) {
+        ICEF_ASSIGN_OR_RETURN(const double x, style.Number(name));
+        f.style.SetField(name, static_cast<float>(x));
+      }
+      if (Status st = f.style.Validate(); !st.ok()) return fv.Error("style", st.message());
+    }
     ICEF_ASSIGN_OR_RETURN(const JsonObjectView sim, fv.Object("head_from_world"));
     ICEF_ASSIGN_OR_RETURN(f.head_from_world.scale, sim.Number("scale"));
     if (!(f.head_from_world.scale > 0)) return sim.Error("scale", "must be > 0");

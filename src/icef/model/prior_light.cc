@@ -103,7 +103,7 @@ std::string PriorLightFit::BriefReport() const {
 
 Result<PriorLightFit> FitPriorLight(const Dataset& dataset, const face::FaceFit& fit, const Executor& executor) {
   if (dataset.train.empty()) return Status::Error(dataset.root.string() + ": no training frames to fit the light to");
-  const face::FaceModel model(fit.shape);
+  const face::FaceModel model(fit.shape, fit.style);
   std::vector<SkinPixel> pixels;
   for (const Frame& frame : dataset.train) {
     ICEF_ASSIGN_OR_RETURN(const Image image, LoadFrameImage(dataset, frame));

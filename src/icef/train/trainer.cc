@@ -85,7 +85,9 @@ Result<std::unique_ptr<Trainer>> Trainer::Create(const Dataset& dataset, const f
   ICEF_ASSIGN_OR_RETURN(TrainingData data, TrainingData::Load(dataset));
   ICEF_ASSIGN_OR_RETURN(ModelSetup setup, ModelSetup::FromDataset(dataset, executor));
   if (UsesFacePrior(config.model.ParsedMethod())) {
-    ICEF_ASSIGN_OR_RETURN(setup.face_fit, FitFaceModelToDataset(dataset));
+    face::FaceFitOptions fit_options;
+    fit_options.fit_style = config.model.prior_style;
+    ICEF_ASSIGN_OR_RETURN(setup.face_fit, FitFaceModelToDataset(dataset, fit_options));
   }
   std::string shading_note;
   if (config.model.prior_shading && setup.face_fit) {
