@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <sstream>
 
@@ -297,6 +298,7 @@ Status FaceFitOptions::Validate() const {
     return Status::Error("style_gain_sigma must be a finite number > 0");
   if (!(style_offset_sigma > 0) || !std::isfinite(style_offset_sigma))
     return Status::Error("style_offset_sigma must be a finite number > 0");
+  if (!(style_min_f >= 0) || !std::isfinite(style_min_f)) return Status::Error("style_min_f must be a finite number >= 0");
   return Status::Ok();
 }
 
@@ -304,7 +306,8 @@ std::string FaceFitOptions::ToString() const {
   std::ostringstream os;
   os << "FaceFitOptions(shape_prior_sigma=" << shape_prior_sigma << ", fit_shape=" << fit_shape
      << ", max_iterations=" << max_iterations << ", outlier_iod=" << outlier_iod << ", fit_style=" << fit_style
-     << ", style_gain_sigma=" << style_gain_sigma << ", style_offset_sigma=" << style_offset_sigma << ")";
+     << ", style_gain_sigma=" << style_gain_sigma << ", style_offset_sigma=" << style_offset_sigma
+     << ", style_min_f=" << style_min_f << ")";
   return os.str();
 }
 
@@ -313,7 +316,10 @@ std::string FaceFit::BriefReport() const {
   os.precision(3);
   os << "face fit: landmark RMS " << rms_iod << " IOD (max " << max_iod << "), " << landmarks_used << "/"
      << landmarks_total << " landmarks, " << iterations << " iterations, head scale " << head_from_world.scale;
-  if (!style.IsGeneric()) {  // the fields the fit moved off the generic style
+  if (style_rejected) {
+    os << "; expression style: generic (a fitted one explained the landmarks no better than noise: F " << style_f
+       << ")";
+  } else if (!style.IsGeneric()) {  // the fields the fit moved off the generic style
     os << "; expression style:";
     const auto generic = ExpressionStyle::Generic().Fields();
     const auto fields = style.Fields();
@@ -322,6 +328,7 @@ std::string FaceFit::BriefReport() const {
       if (std::abs(fields[i].second - generic[i].second) >= 0.005f)
         os << (shown++ ? ", " : " ") << fields[i].first << " " << fields[i].second;
     if (shown == 0) os << " generic within 0.005";
+    os << " (landmark RMS " << generic_style_rms_iod << " IOD in the generic style, F " << style_f << ")";
   }
   return os.str();
 }
@@ -331,9 +338,10 @@ double InterOcularDistance(std::span<const Vec3f> landmarks) {
   return (EyeCentre(landmarks, 36) - EyeCentre(landmarks, 42)).norm();
 }
 
-Result<FaceFit> FitFaceModel(std::span<const FitFrame> frames, const FaceFitOptions& options) {
-  ICEF_RETURN_IF_ERROR(options.Validate().WithContext("face fit options"));
-  ICEF_RETURN_IF_ERROR(CheckFrames(frames));
+namespace {
+
+// One fit, with the style fitted or held generic as options.fit_style says.
+Result<FaceFit> FitOnce(std::span<const FitFrame> frames, const FaceFitOptions& options) {
   const FaceModel average(ShapeParams::Average());
   const double iod_head = InterOcularDistance(average.NeutralLandmarks());
   ICEF_ASSIGN_OR_RETURN(const Similarity base, InitialSimilarity(frames, iod_head));
@@ -399,18 +407,20 @@ Result<FaceFit> FitFaceModel(std::span<const FitFrame> frames, const FaceFitOpti
     const double cut = std::max(options.outlier_iod, 3.0 * all[all.size() / 2]);
     int removed = 0;
     double sum2 = 0, worst = 0;
-    int used = 0;
+    int used = 0, residuals = 0;
     for (size_t k = 0; k < errors.size(); ++k)
       for (int i = 0; i < kNumLandmarks; ++i) {
         const bool inlier = errors[k][i] <= cut;
         if (!inlier && problem.weight[k][i] > 0) ++removed;
         problem.weight[k][i] = inlier ? 1.0 : 0.0;
-        if (inlier) sum2 += errors[k][i] * errors[k][i], ++used;
+        if (inlier) sum2 += errors[k][i] * errors[k][i], ++used, residuals += frames[k].landmarks_3d ? 3 : 2;
         worst = std::max(worst, errors[k][i]);
       }
     fit.rms_iod = std::sqrt(sum2 / std::max(used, 1));
     fit.max_iod = worst;
     fit.landmarks_used = used;
+    fit.sum_squares = sum2;
+    fit.residual_count = residuals;
     if (removed == 0) break;
   }
   std::array<float, ShapeParams::kCount> values;
@@ -419,6 +429,32 @@ Result<FaceFit> FitFaceModel(std::span<const FitFrame> frames, const FaceFitOpti
   fit.style = StyleFromBlock(style.data());
   fit.head_from_world = PoseToSimilarity(pose.data(), base);
   return fit;
+}
+
+}  // namespace
+
+Result<FaceFit> FitFaceModel(std::span<const FitFrame> frames, const FaceFitOptions& options) {
+  ICEF_RETURN_IF_ERROR(options.Validate().WithContext("face fit options"));
+  ICEF_RETURN_IF_ERROR(CheckFrames(frames));
+  FaceFitOptions generic_options = options;
+  generic_options.fit_style = false;
+  ICEF_ASSIGN_OR_RETURN(FaceFit generic, FitOnce(frames, generic_options));
+  if (!options.fit_style) return generic;
+  ICEF_ASSIGN_OR_RETURN(FaceFit styled, FitOnce(frames, options));
+  styled.generic_style_rms_iod = generic.rms_iod;
+  generic.generic_style_rms_iod = generic.rms_iod;
+  // 17 more parameters must earn their keep (an F test of the nested fits): landmarks the generic
+  // style explains as well, such as a tracked dataset's (the generic face model's own), hold no
+  // style, only noise the extra fields would fit.
+  const double p = ExpressionStyle::kNumFields;
+  const double dof = styled.residual_count - ShapeParams::kCount - kPoseSize - p;
+  const double gained = generic.sum_squares - styled.sum_squares;
+  styled.style_f = dof > 0 && styled.sum_squares > 0 ? (gained / p) / (styled.sum_squares / dof)
+                                                      : (gained > 0 ? std::numeric_limits<double>::infinity() : 0.0);
+  generic.style_f = styled.style_f;
+  if (styled.style_f >= options.style_min_f) return styled;
+  generic.style_rejected = true;
+  return generic;
 }
 
 }  // namespace icef::face

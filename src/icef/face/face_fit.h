@@ -7,7 +7,8 @@
 // average head, and a second pass without the landmarks the first pass left far off (outliers).
 // Optionally (fit_style) the subject's expression style too (face/expression_style.h): its gains and
 // offsets, each with a prior around the generic style, read off the landmarks of the frames whose
-// expressions use them; a field no frame's expression moves keeps its generic value.
+// expressions use them; a field no frame's expression moves keeps its generic value. The fitted
+// style is kept only where it explains the landmarks clearly better than the generic one.
 #pragma once
 
 #include <optional>
@@ -50,6 +51,10 @@ struct FaceFitOptions {
   bool fit_style = false;           // also fit the expression style (else the generic one)
   double style_gain_sigma = 1.0;    // std of each style gain's log around 0 (generic: gain 1)
   double style_offset_sigma = 0.03; // std of each style offset around 0 (head units)
+  // The fitted style is kept when it explains the landmarks better than the generic style's fit
+  // (which is fitted too) by an F statistic of at least this (its 17 fields against the noise left
+  // over; 3 is past the 0.1 % point of F(17, 300+)); else the fit keeps the generic style.
+  double style_min_f = 3.0;
 
   Status Validate() const;
   std::string ToString() const;
@@ -58,6 +63,11 @@ struct FaceFitOptions {
 struct FaceFit {
   ShapeParams shape;
   ExpressionStyle style;  // generic unless FaceFitOptions::fit_style
+  double generic_style_rms_iod = 0;  // with fit_style: the RMS of the fit in the generic style
+  double style_f = 0;                // with fit_style: the F statistic of the style's fields
+  bool style_rejected = false;       // with fit_style: F below style_min_f, the generic style kept
+  double sum_squares = 0;            // sum of the inlier landmarks' squared errors (IOD^2)
+  int residual_count = 0;            // inlier landmark coordinates (3 per 3D landmark, 2 per 2D)
   Similarity head_from_world;
   double rms_iod = 0;       // RMS landmark residual of the final pass (inter-ocular distances)
   double max_iod = 0;       // largest landmark residual

@@ -141,6 +141,8 @@ TEST(FaceFitTest, RecoversTheExpressionStyleOfTheExpressionsItSees) {
   EXPECT_NEAR(fit->style.cheek_puff_gain, 1.f, 1e-4f);
   EXPECT_NEAR(fit->style.smile_gain[0], 1.f, 1e-4f);
   EXPECT_NE(fit->BriefReport().find("jaw_gain"), std::string::npos) << fit->BriefReport();
+  EXPECT_FALSE(fit->style_rejected);
+  EXPECT_GT(fit->style_f, 3.0);
   // Far from the frames' expressions the fitted style's landmarks are nearer the truth's.
   std::vector<float> far(kNumExpressions, 0.f);
   far[kJawOpen] = 1.4f, far[kSmileLeft] = 1.2f, far[kBrowRaiseRight] = 1.3f;
@@ -153,6 +155,25 @@ TEST(FaceFitTest, RecoversTheExpressionStyleOfTheExpressionsItSees) {
     return std::sqrt(sum / 68) / iod;
   };
   EXPECT_LT(rms_at_far(*fit), 0.5 * rms_at_far(*generic));
+}
+
+// Landmarks of a head in the generic style (a tracked dataset's are the generic face model's own):
+// a fitted style explains them no better, and the fit keeps the generic style.
+TEST(FaceFitTest, KeepsTheGenericStyleWhenTheLandmarksShowNoOther) {
+  const FaceModel truth(KnownShape());
+  const std::vector<FitFrame> frames = Frames3d(truth, KnownSimilarity(), 5, 0.005, 5);
+  FaceFitOptions options;
+  options.fit_style = true;
+  const Result<FaceFit> fit = FitFaceModel(frames, options);
+  ASSERT_TRUE(fit.ok()) << fit.status().message();
+  EXPECT_TRUE(fit->style_rejected) << fit->BriefReport();
+  EXPECT_LT(fit->style_f, 3.0);
+  EXPECT_TRUE(fit->style.IsGeneric());
+  EXPECT_NE(fit->BriefReport().find("expression style: generic"), std::string::npos) << fit->BriefReport();
+  const Result<FaceFit> plain = FitFaceModel(frames);  // the same fit as without fit_style
+  ASSERT_TRUE(plain.ok());
+  EXPECT_EQ(fit->rms_iod, plain->rms_iod);
+  EXPECT_EQ(fit->shape.ToArray(), plain->shape.ToArray());
 }
 
 TEST(FaceFitTest, OutlierLandmarksAreDropped) {
