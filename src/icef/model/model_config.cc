@@ -113,7 +113,8 @@ void ModelConfig::Bind(ConfigSchema& s) {
   s.Block("sampler", [this](ConfigSchema& b) {
     b.Int("num_samples", &sampler.num_samples,
           "samples per training ray over the ray/aabb interval, one per jittered stratum (fewer, deeper strata smear "
-          "the face's colour along the training rays and blur every other view: 48 did, docs/results/sampler_samples)");
+          "the face's colour along the training rays and blur every other view: 48 did, and 96 still a little; "
+          "docs/results/sampler_samples)");
     b.Int("importance_samples", &importance.num_samples,
           "training: fine samples per ray placed by the num_samples coarse samples' compositing weights (each coarse "
           "stratum cut into as many sub-strata as its share of the weight; render/importance_sampler.h); 0 = train on "
