@@ -130,6 +130,7 @@ Status RunRetrack(const TrackAppOptions& options, std::ostream& out) {
   ro.fit = options.track.fit;
   ro.detector = options.track.fit.detector;
   ro.silhouette_points = options.track.silhouette_points;
+  ro.fit_style = options.fit_style;
   out << "icef track --keep-cameras: " << options.photos[0].string() << " (" << source.train.size() << " training, "
       << source.test.size() << " test frames, expression_dim " << source.expression_dim << ")\n";
   ICEF_ASSIGN_OR_RETURN(const track::RetrackResult result,

@@ -26,6 +26,7 @@ struct TrackAppOptions {
   // photos is one dataset directory, re-expressed with its cameras kept (track/dataset_retrack.h).
   bool keep_cameras = false;
   track::RetrackLandmarks landmarks = track::RetrackLandmarks::kDetect;  // with keep_cameras
+  bool fit_style = true;  // with keep_cameras and landmarks kDatasetModel (RetrackOptions::fit_style)
 };
 
 // The overlay of one tracked photo (see above), 384 pixels high.

@@ -52,6 +52,12 @@ CommandFn RegisterTrack(CLI::App& app) {
                  "With --keep-cameras: whose 2D landmarks to fit: detect (--detector's, in every frame; default), dlib (the "
                  "dataset's own landmarks_2d in dlib's convention, from icef landmarks), model (the dataset's own, in the face "
                  "model's convention, as icef synth writes them)");
+  auto generic_style = std::make_shared<bool>(false);
+  app.add_flag("--generic-style", *generic_style,
+               "With --keep-cameras --landmarks model: read every weight in the face model's generic expression style. "
+               "By default the subject's own style (how far the jaw opens per unit, where it hinges, how wide the "
+               "smile is, ...) is read off those exact landmarks first, the weights are read in it, and the dataset's "
+               "3D landmarks are the styled model's, so that icef train finds the style again (docs/tracking.md)");
   auto silhouette_points = std::make_shared<int>(-1);  // -1: the mode's default
   app.add_option("--silhouette-points", *silhouette_points,
                  "Refit each photo's pose, expression and the shape with this many points of its mask's edge "
@@ -95,7 +101,8 @@ CommandFn RegisterTrack(CLI::App& app) {
                "validation identities) and print the table of src/icef/track/detector_landmarks.inc (dlib) or "
                "mesh_landmarks.inc (mesh)");
   return [options, focal, calibrate, detector, landmark_sigma, landmarks, region, photometric, silhouette_points,
-          segmentation, &app]() -> Status {
+          segmentation, generic_style, &app]() -> Status {
+    options->fit_style = !*generic_style;
     options->track.fit.silhouette_face_only = *region == "face";
     options->track.segmentation = *segmentation == "none"     ? track::TrackOptions::Segmentation::kNone
                                   : *segmentation == "selfie" ? track::TrackOptions::Segmentation::kSelfie
@@ -113,6 +120,9 @@ CommandFn RegisterTrack(CLI::App& app) {
     const auto parsed = track::ParseRetrackLandmarks(*landmarks);
     if (!parsed) return Status::Error("--landmarks: expected detect, dlib or model, got \"" + *landmarks + "\"");
     options->landmarks = *parsed;
+    if (*generic_style && !(options->keep_cameras && options->landmarks == track::RetrackLandmarks::kDatasetModel))
+      return Status::Error("--generic-style: only with --keep-cameras --landmarks model (the other landmarks are always "
+                           "read in the generic style)");
     options->track.fit.detector = *detector == "mesh" ? track::LandmarkDetector::kMesh : track::LandmarkDetector::kDlib;
     if (*landmark_sigma > 0) {
       options->track.fit.landmark_sigma_iod = *landmark_sigma;

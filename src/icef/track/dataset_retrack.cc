@@ -67,7 +67,8 @@ Status RetrackOptions::Validate() const {
 std::string RetrackOptions::ToString() const {
   return "RetrackOptions(landmarks=" + std::string(RetrackLandmarksName(landmarks)) + ", skip_bad=" + std::to_string(skip_bad) +
          ", silhouette_points=" + std::to_string(silhouette_points) + ", detector=" + LandmarkDetectorName(detector) + ", predictor=" +
-         (predictor_path.empty() ? std::string("default") : predictor_path.string()) + ", " + fit.ToString() + ")";
+         (predictor_path.empty() ? std::string("default") : predictor_path.string()) + ", fit_style=" + std::to_string(fit_style) +
+         ", " + fit.ToString() + ")";
 }
 
 Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions& options, const Executor& executor,
@@ -226,6 +227,29 @@ Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions
   }
   ICEF_ASSIGN_OR_RETURN(result.fit, FitTrack(track_frames, fit_options));
   if (log) log(result.fit.BriefReport());
+  if (options.landmarks == RetrackLandmarks::kDatasetModel && options.fit_style) {
+    // The weights just read are generic-style weights. Exact landmarks show how this subject
+    // performs them (a jaw hinged elsewhere, a wider smile), which a generic weight cannot stand in
+    // for far from the frames: fit the style to the landmarks at those weights, then read the
+    // weights again in it.
+    std::vector<face::FitFrame> style_frames(track_frames.size());
+    for (size_t k = 0; k < track_frames.size(); ++k) {
+      style_frames[k].expression = result.fit.frames[k].expression;
+      style_frames[k].landmarks_2d = track_frames[k].landmarks_2d;
+      style_frames[k].camera = Camera(track_frames[k].intrinsics, *track_frames[k].world_from_cam);
+    }
+    face::FaceFitOptions style_options;
+    style_options.fit_style = true;
+    Result<face::FaceFit> style_fit = face::FitFaceModel(style_frames, style_options);
+    if (!style_fit.ok()) return style_fit.status().WithContext("expression style fit");
+    result.style_fit = *style_fit;
+    if (log) log("the subject's expression style, at the weights read: " + style_fit->BriefReport());
+    if (!style_fit->style_rejected) {
+      fit_options.style = style_fit->style;
+      ICEF_ASSIGN_OR_RETURN(result.fit, FitTrack(track_frames, fit_options));
+      if (log) log("in that style, " + result.fit.BriefReport());
+    }
+  }
   const face::Similarity& sim = *result.fit.head_from_world;
   for (size_t k = 0; k < order.size(); ++k) {
     Frame& f = *order[k];
@@ -263,8 +287,19 @@ Json RetrackReportJson(const RetrackResult& result) {
   const face::Similarity& s = *result.fit.head_from_world;
   Json rotation = Json::array();
   for (int r = 0; r < 3; ++r) rotation.push_back({s.rotation(r, 0), s.rotation(r, 1), s.rotation(r, 2)});
+  Json style = nullptr;  // null: the weights are the generic style's and no style was fitted
+  if (result.style_fit) {
+    Json fields = Json::object();
+    for (const auto& [name, value] : result.style_fit->style.Fields()) fields[name] = JsonFloat(value);
+    style = Json{{"fields", fields},
+                 {"f", result.style_fit->style_f},
+                 {"kept", !result.style_fit->style_rejected},
+                 {"landmark_rms_iod", result.style_fit->rms_iod},
+                 {"generic_landmark_rms_iod", result.style_fit->generic_style_rms_iod}};
+  }
   return Json{{"frames", frames},
               {"skipped", result.skipped},
+              {"expression_style", style},
               {"landmark_rms_iod", result.fit.rms_iod},
               {"photometric_refit", result.fit.photometric},
               {"silhouette_refit", result.fit.silhouettes},

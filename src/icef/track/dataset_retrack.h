@@ -89,6 +89,12 @@ struct RetrackOptions {
     o.landmark_sigma_iod = kRetrackLandmarkSigmaIod;
     return o;
   }();
+  // With landmarks kDatasetModel (exact): read the subject's expression style off them
+  // (face/face_fit.h, fit_style, the test that trainer's fit uses to keep it), then read the weights
+  // again in that style, and write the styled model's landmarks, so that the trainer's face-model
+  // fit finds the style again. False: every weight in the generic style (dlib's and the face mesh's
+  // landmarks always are: they are too coarse to tell a style from a weight).
+  bool fit_style = true;
   Status Validate() const;
   std::string ToString() const;
 };
@@ -100,6 +106,9 @@ struct RetrackResult {
   int outlined_frames = 0;           // frames that added their outlines
   double photometric_weight = 0;     // the refit's weight as used (0: off)
   bool similarity_held = false;      // the refit kept the similarity the outlines placed
+  // RetrackOptions::fit_style with the face model's landmarks: the style fit (its style is the one
+  // the weights were read in unless style_rejected).
+  std::optional<face::FaceFit> style_fit;
   TrackFit fit;
 };
 

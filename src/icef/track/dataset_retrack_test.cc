@@ -120,6 +120,32 @@ TEST(DatasetRetrackTest, SyntheticDatasetKeepsItsCamerasAndGetsItsExpressionsBac
     for (int e = 0; e < face::kNumExpressions; ++e)
       if (e != face::kCheekPuff) exact2 += std::pow(exact->dataset.train[i].expression[e] - source->train[i].expression[e], 2);
   EXPECT_LT(std::sqrt(exact2 / n), 0.12);
+  // Exact landmarks show this subject's own expression style: it is fitted, kept, and the weights
+  // read again in it explain the landmarks better than the generic style's.
+  ASSERT_TRUE(exact->style_fit.has_value());
+  EXPECT_FALSE(exact->style_fit->style_rejected) << exact->style_fit->BriefReport();
+  EXPECT_FALSE(exact->style_fit->style.IsGeneric());
+  EXPECT_LT(exact->style_fit->rms_iod, exact->style_fit->generic_style_rms_iod);
+  RetrackOptions own_generic = own;
+  own_generic.fit_style = false;
+  const Result<RetrackResult> generic = RetrackDataset(*source, own_generic, Executor(2));
+  ASSERT_TRUE(generic.ok()) << generic.status().message();
+  EXPECT_FALSE(generic->style_fit.has_value());
+  EXPECT_LT(exact->fit.rms_iod, generic->fit.rms_iod) << exact->fit.BriefReport() << " vs " << generic->fit.BriefReport();
+  // The landmarks written are the styled model's: the trainer's face-model fit (at the tracked
+  // weights) finds a style in them again; in the generic dataset's it finds none.
+  const auto trainer_fit = [](const Dataset& tracked) {
+    std::vector<face::FitFrame> frames;
+    for (const Frame& f : tracked.train) frames.push_back(face::FitFrame{f.expression, f.landmarks_3d, std::nullopt, std::nullopt});
+    face::FaceFitOptions o;
+    o.fit_style = true;
+    return face::FitFaceModel(frames, o);
+  };
+  const Result<face::FaceFit> refit_styled = trainer_fit(exact->dataset);
+  const Result<face::FaceFit> refit_generic = trainer_fit(generic->dataset);
+  ASSERT_TRUE(refit_styled.ok() && refit_generic.ok());
+  EXPECT_FALSE(refit_styled->style_rejected) << refit_styled->BriefReport();
+  EXPECT_TRUE(refit_generic->style_rejected) << refit_generic->BriefReport();
 
   // RGB frames in front of a background image (NerFace's kind): their outlines come from the
   // difference to it. The dataset's own landmarks keep it quick; the outlines asked for.

@@ -172,7 +172,7 @@ Status PhotometricRefit(std::vector<FrameProblem>& problems, Shared& shared, con
   const Solution landmark_fit = *s;
   std::array<float, kShape> shape;
   for (int i = 0; i < kShape; ++i) shape[i] = static_cast<float>(s->shape[i]);
-  const face::FaceModel model(face::ShapeParams::FromArray(shape));
+  const face::FaceModel model(face::ShapeParams::FromArray(shape), options.style);
   const std::vector<Vec3f> points = CanonicalFaceSamples(model, options.photometric_points);
   StateCache states(&model, options.max_expression);
   const PhotoContext ctx{&model, &states, options.photometric_sigma};

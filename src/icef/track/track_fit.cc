@@ -507,6 +507,7 @@ Status TrackFitOptions::Validate() const {
   if (!(photometric_expression_prior_sigma > 0) || !std::isfinite(photometric_expression_prior_sigma))
     return Status::Error("photometric_expression_prior_sigma must be a finite number > 0");
   if (photometric_points < 1) return Status::Error("photometric_points must be >= 1");
+  if (Status s = style.Validate(); !s.ok()) return Status::Error("style: " + s.message());
   if (!(photometric_blur_coarse_iod >= 0) || !(photometric_blur_fine_iod >= 0) ||
       !std::isfinite(photometric_blur_coarse_iod) || !std::isfinite(photometric_blur_fine_iod))
     return Status::Error("photometric_blur_coarse_iod and photometric_blur_fine_iod must be finite numbers >= 0");
@@ -527,7 +528,8 @@ std::string TrackFitOptions::ToString() const {
      << ", photometric_expression_prior_sigma=" << photometric_expression_prior_sigma
      << ", photometric_expression_prior_laplace=" << photometric_expression_prior_laplace
      << ", photometric_points=" << photometric_points << ", photometric_max_rms=" << photometric_max_rms
-     << ", photometric_blur_iod=[" << photometric_blur_coarse_iod << ", " << photometric_blur_fine_iod << "])";
+     << ", photometric_blur_iod=[" << photometric_blur_coarse_iod << ", " << photometric_blur_fine_iod
+     << "], style=" << style.ToString() << ")";
   return os.str();
 }
 
@@ -548,6 +550,7 @@ Result<TrackFit> FitTrack(std::span<const TrackFrame> frames, const TrackFitOpti
   const double iod_head = face::InterOcularDistance(average.NeutralLandmarks());
 
   Shared shared;
+  shared.cache.SetStyle(options.style);
   shared.max_expression = options.max_expression;
   shared.known_cameras = frames[0].world_from_cam.has_value();
   shared.dlib_convention = options.dlib_convention;

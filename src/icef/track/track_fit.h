@@ -94,6 +94,9 @@ struct TrackFitOptions {
   // stands: the photos then do not show one consistently lit face (synthetic photos: medians
   // 0.01-0.02; the two webcam frames of opencv-doc, lit differently and drawn on: 0.09).
   double photometric_max_rms = 0.06;
+  // The subject's expression style (face/expression_style.h) the weights are read in: generic for
+  // photos; `--keep-cameras` with the face model's own landmarks fits it (track/dataset_retrack.h).
+  face::ExpressionStyle style = face::ExpressionStyle::Generic();
 
   Status Validate() const;
   std::string ToString() const;

@@ -32,17 +32,23 @@ inline constexpr int kSharedPose = 7;  // angle-axis on top of the initial rotat
 // cache of recent shapes saves rebuilding the head (its landmarks come from marching its SDF).
 class ModelCache {
  public:
+  // Every model of the cache has this expression style (TrackFitOptions::style); set it before use.
+  void SetStyle(const face::ExpressionStyle& style) {
+    style_ = style;
+    entries_.clear();
+  }
   const face::FaceModel& For(const double* shape) {
     std::array<float, kShape> key;
     for (int i = 0; i < kShape; ++i) key[i] = static_cast<float>(shape[i]);
     for (const auto& [k, model] : entries_)
       if (k == key) return *model;
     if (entries_.size() >= 64) entries_.pop_front();
-    entries_.emplace_back(key, std::make_unique<face::FaceModel>(face::ShapeParams::FromArray(key)));
+    entries_.emplace_back(key, std::make_unique<face::FaceModel>(face::ShapeParams::FromArray(key), style_));
     return *entries_.back().second;
   }
 
  private:
+  face::ExpressionStyle style_;
   std::deque<std::pair<std::array<float, kShape>, std::unique_ptr<face::FaceModel>>> entries_;
 };
 
