@@ -58,9 +58,14 @@ double RetrackPhotometricWeight(RetrackLandmarks landmarks) {
 
 int RetrackSilhouettePoints(RetrackLandmarks landmarks) { return landmarks == RetrackLandmarks::kDatasetModel ? 0 : 200; }
 
+double RetrackLandmarkSigma(RetrackLandmarks landmarks) {
+  return landmarks == RetrackLandmarks::kDatasetModel ? 0.02 : kRetrackLandmarkSigmaIod;
+}
+
 Status RetrackOptions::Validate() const {
   TrackFitOptions resolved = fit;
   if (resolved.photometric_weight < 0) resolved.photometric_weight = RetrackPhotometricWeight(landmarks);
+  if (resolved.landmark_sigma_iod < 0) resolved.landmark_sigma_iod = RetrackLandmarkSigma(landmarks);
   return resolved.Validate();
 }
 
@@ -127,6 +132,7 @@ Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions
   TrackFitOptions fit_options = options.fit;
   const bool default_weight = fit_options.photometric_weight < 0;
   if (default_weight) fit_options.photometric_weight = RetrackPhotometricWeight(options.landmarks);
+  if (fit_options.landmark_sigma_iod < 0) fit_options.landmark_sigma_iod = RetrackLandmarkSigma(options.landmarks);
   const int silhouette_points =
       options.silhouette_points < 0 ? RetrackSilhouettePoints(options.landmarks) : options.silhouette_points;
   // The images: for the photometric refit (track_fit.h), composited over the dataset's background;
@@ -220,7 +226,6 @@ Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions
     // The face model's own landmarks, as exact as the data that carries them: the priors of a
     // sub-pixel source (track_fit_test's), not those balanced against dlib's scatter.
     fit_options.dlib_convention = false;
-    fit_options.landmark_sigma_iod = 0.02;
     fit_options.shape_prior_sigma = 0.15;
     fit_options.expression_prior_sigma = 0.6;
     fit_options.photometric_expression_prior_sigma = 0.6;

@@ -66,6 +66,9 @@ int RetrackSilhouettePoints(RetrackLandmarks landmarks);
 // observed / near / moderate / far: 30.87 / 30.94 / 30.84 / 29.99 dB at 0.05, 31.23 / 31.21 /
 // 31.19 / 30.30 at 0.1 (docs/results/track_roundtrip/mesh.json).
 constexpr double kRetrackLandmarkSigmaIod = 0.1;
+// The landmark noise a landmark source's fit assumes: kRetrackLandmarkSigmaIod for a detector's,
+// 0.02 IOD for the face model's own (exact, sub-pixel: track_fit_test's priors).
+double RetrackLandmarkSigma(RetrackLandmarks landmarks);
 
 struct RetrackOptions {
   RetrackLandmarks landmarks = RetrackLandmarks::kDetect;
@@ -82,11 +85,12 @@ struct RetrackOptions {
   // dlib's face); the fit uses that detector's offsets (fit.detector is set to match).
   LandmarkDetector detector = LandmarkDetector::kMesh;
   // fit.photometric_weight < 0 (the default): the landmark source's default,
-  // RetrackPhotometricWeight(landmarks). fit.landmark_sigma_iod: kRetrackLandmarkSigmaIod.
+  // RetrackPhotometricWeight(landmarks). fit.landmark_sigma_iod < 0 (the default): the landmark
+  // source's default, RetrackLandmarkSigma(landmarks).
   TrackFitOptions fit = [] {
     TrackFitOptions o;
     o.photometric_weight = -1;
-    o.landmark_sigma_iod = kRetrackLandmarkSigmaIod;
+    o.landmark_sigma_iod = -1;
     return o;
   }();
   // With landmarks kDatasetModel (exact): read the subject's expression style off them

@@ -146,6 +146,23 @@ TEST(DatasetRetrackTest, SyntheticDatasetKeepsItsCamerasAndGetsItsExpressionsBac
   ASSERT_TRUE(refit_styled.ok() && refit_generic.ok());
   EXPECT_FALSE(refit_styled->style_rejected) << refit_styled->BriefReport();
   EXPECT_TRUE(refit_generic->style_rejected) << refit_generic->BriefReport();
+  // The landmark noise: each source's own unless given (icef track --landmark-sigma), then that.
+  EXPECT_LT(RetrackOptions().fit.landmark_sigma_iod, 0);
+  EXPECT_EQ(RetrackLandmarkSigma(RetrackLandmarks::kDatasetModel), 0.02);
+  EXPECT_EQ(RetrackLandmarkSigma(RetrackLandmarks::kDetect), kRetrackLandmarkSigmaIod);
+  RetrackOptions own_sigma = own_generic;
+  own_sigma.fit.landmark_sigma_iod = RetrackLandmarkSigma(RetrackLandmarks::kDatasetModel);
+  const Result<RetrackResult> same = RetrackDataset(*source, own_sigma, Executor(2));
+  own_sigma.fit.landmark_sigma_iod = 0.3;  // the priors pull harder: weights nearer neutral
+  const Result<RetrackResult> loose = RetrackDataset(*source, own_sigma, Executor(2));
+  ASSERT_TRUE(same.ok() && loose.ok());
+  double generic_sum = 0, loose_sum = 0;
+  for (size_t k = 0; k < generic->fit.frames.size(); ++k) {
+    EXPECT_EQ(same->fit.frames[k].expression, generic->fit.frames[k].expression);
+    for (int e = 0; e < face::kNumExpressions; ++e)
+      generic_sum += generic->fit.frames[k].expression[e], loose_sum += loose->fit.frames[k].expression[e];
+  }
+  EXPECT_LT(loose_sum, generic_sum - 0.1);
 
   // RGB frames in front of a background image (NerFace's kind): their outlines come from the
   // difference to it. The dataset's own landmarks keep it quick; the outlines asked for.
