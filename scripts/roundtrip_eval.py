@@ -18,15 +18,19 @@ ones, per split and per weight:
 With --train-steps S it then trains `icef-prior` (S steps, one thread) on the original and on the
 tracked dataset and evaluates both on their test frames (`icef eval --threads 1`): PSNR and
 `expr_gain` per tier, the criterion of the tracker issue being the tracked dataset within 1 dB and
-0.1 of the original.
+0.1 of the original. --train-seeds 0,1,2 trains each dataset once per training seed
+(`train.seed`; 0 is the default) and compares the means over them, each seed's scores kept in the
+JSON (`original_runs`, `tracked_runs`): a near tier of six frames moves by a few hundredths from one
+training seed to the next. --jobs N runs N trainings at once (each still on one thread).
 
 Usage: scripts/roundtrip_eval.py --icef build/icef --out DIR [--seeds 101,102,103] [--res 128]
-       [--track-args="--landmarks model"] [--train-steps 1000] [--reuse]
+       [--track-args="--landmarks model"] [--train-steps 1000] [--train-seeds 0] [--jobs 1] [--reuse]
 (--reuse: evaluate DIR's datasets as they are, without running icef synth/track again)
 Writes DIR/roundtrip_eval.json and prints a table.
 Tune on validation identities (seeds >= 101); the test identities are 1, 2, 3.
 """
 import argparse
+import concurrent.futures
 import json
 import math
 import os
@@ -104,16 +108,32 @@ def similarity_error(orig, tracked):
             "rotation_deg": rotation_angle_deg(np.asarray(sim["rotation"], dtype=float))}
 
 
-def train_and_eval(icef, dataset, work, steps):
+def train_and_eval(icef, dataset, work, steps, train_seed=0):
+    # Seed 0 keeps the directory names of runs made before --train-seeds, so --reuse finds them.
+    if train_seed != 0:
+        work = f"{work}_seed{train_seed}"
     model, evaluation = work + "_model", work + "_eval"
     if not os.path.exists(os.path.join(evaluation, "metrics.json")):
         subprocess.run(["rm", "-rf", model, evaluation], check=True)
         run([icef, "train", dataset, "--out", model, "--method", "icef-prior", "--steps", str(steps),
-             "--time-budget", "0", "--threads", "1"], work + "_train.log")
+             "--time-budget", "0", "--threads", "1", "--set", f"train.seed={train_seed}"], work + "_train.log")
         run([icef, "eval", model, dataset, "--out", evaluation, "--threads", "1"], work + "_eval.log")
     metrics = json.load(open(os.path.join(evaluation, "metrics.json")))
     tiers = metrics["tiers"]
     return {t: {"psnr": tiers[t]["psnr"], "expr_gain": tiers[t].get("expr_gain")} for t in TIERS if t in tiers}
+
+
+def mean_scores(runs):
+    """Per tier, the mean PSNR and expr_gain over training runs."""
+    out = {}
+    for t in TIERS:
+        have = [r[t] for r in runs if t in r]
+        if not have:
+            continue
+        gains = [h["expr_gain"] for h in have if h["expr_gain"] is not None]
+        out[t] = {"psnr": float(np.mean([h["psnr"] for h in have])),
+                  "expr_gain": float(np.mean(gains)) if gains else None}
+    return out
 
 
 def main():
@@ -124,6 +144,8 @@ def main():
     p.add_argument("--res", type=int, default=128)
     p.add_argument("--track-args", default="", help="extra arguments for icef track (one string)")
     p.add_argument("--train-steps", type=int, default=0, help="also train icef-prior on both datasets and compare")
+    p.add_argument("--train-seeds", default="0", help="training seeds (train.seed) per dataset; the means are compared")
+    p.add_argument("--jobs", type=int, default=1, help="trainings run at once (one thread each)")
     p.add_argument("--reuse", action="store_true")
     args = p.parse_args()
     os.makedirs(args.out, exist_ok=True)
@@ -146,16 +168,32 @@ def main():
         row = {"seed": seed, "role": "validation" if seed >= 101 else "test",
                "similarity": similarity_error(orig, tracked),
                "expressions": {s: compare_split(orig, tracked, s, gains) for s in ("train", "test")}}
-        if args.train_steps > 0:
-            row["original"] = train_and_eval(args.icef, orig, orig, args.train_steps)
-            row["tracked"] = train_and_eval(args.icef, tracked, tracked, args.train_steps)
         rows.append(row)
+
+    if args.train_steps > 0:
+        train_seeds = [int(s) for s in args.train_seeds.split(",")]
+        jobs = {}
+        with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
+            for row in rows:
+                for label, name in (("original", "orig"), ("tracked", "track")):
+                    path = os.path.join(args.out, f"{name}_{row['seed']}")
+                    for ts in train_seeds:
+                        jobs[(row["seed"], label, ts)] = pool.submit(train_and_eval, args.icef, path, path,
+                                                                      args.train_steps, ts)
+        for row in rows:
+            for label in ("original", "tracked"):
+                runs = {ts: jobs[(row["seed"], label, ts)].result() for ts in train_seeds}
+                row[label] = mean_scores(list(runs.values()))
+                if len(train_seeds) > 1:
+                    row[f"{label}_runs"] = {str(ts): r for ts, r in runs.items()}
+            row["train_seeds"] = train_seeds
 
     summary = {}
     for split in ("train", "test"):
         summary[f"{split}_rms_mean"] = float(np.mean([r["expressions"][split]["rms"] for r in rows]))
         summary[f"{split}_rms_vs_styled_mean"] = float(np.mean([r["expressions"][split]["rms_vs_styled"] for r in rows]))
     doc = {"seeds": seeds, "res": args.res, "track_args": args.track_args, "train_steps": args.train_steps,
+           "train_seeds": [int(s) for s in args.train_seeds.split(",")] if args.train_steps > 0 else [],
            "summary": summary, "rows": rows}
     path = os.path.join(args.out, "roundtrip_eval.json")
     with open(path + ".tmp", "w") as f:
@@ -171,7 +209,12 @@ def main():
             for label in ("original", "tracked"):
                 t = r[label]
                 print(f"      {label:>9} PSNR " + " / ".join(f"{t[k]['psnr']:.2f}" for k in TIERS if k in t) +
-                      "   expr_gain " + " / ".join(f"{t[k]['expr_gain']:.2f}" for k in TIERS if k in t))
+                      "   expr_gain " + " / ".join(f"{t[k]['expr_gain']:.3f}" for k in TIERS if k in t))
+            o, t = r["original"], r["tracked"]
+            both = [k for k in TIERS if k in o and k in t]
+            print(f"      {'difference':>9} PSNR " + " / ".join(f"{t[k]['psnr'] - o[k]['psnr']:+.2f}" for k in both) +
+                  "   expr_gain " + " / ".join(f"{t[k]['expr_gain'] - o[k]['expr_gain']:+.3f}" for k in both) +
+                  f"   (mean over training seeds {r['train_seeds']})")
     names = list(rows[0]["expressions"]["train"]["per_weight"].keys())
     print("per weight, RMS over all seeds' train / test frames:")
     for n in names:

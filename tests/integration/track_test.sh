@@ -157,5 +157,18 @@ exact=$(roundtrip "$TMP/syn_model") || fail "roundtrip_eval.json"
 detected=$(roundtrip "$TMP/syn_tracked") || fail "roundtrip_eval.json"
 awk -v e="$exact" -v d="$detected" 'BEGIN { exit !(e <= 0.15 && d <= 0.35 && e < d) }' \
   || fail "expression RMS $exact (exact landmarks), $detected (detected)"
+# --train-seeds: the scores of each training seed's evaluation (here written by hand, so nothing is
+# trained: a finished evaluation is reused) and their means, tracked against original.
+for run in orig_3_eval:0.5:30 orig_3_seed1_eval:0.7:32 track_3_eval:0.4:29 track_3_seed1_eval:0.5:30; do
+  IFS=: read -r dir gain psnr <<< "$run"
+  mkdir -p "$TMP/rt/$dir"
+  echo "{\"tiers\": {\"near\": {\"psnr\": $psnr, \"expr_gain\": $gain}}}" > "$TMP/rt/$dir/metrics.json"
+done
+/usr/bin/python3 "$HERE/../../scripts/roundtrip_eval.py" --icef "$ICEF" --out "$TMP/rt" --seeds 3 --reuse \
+  --train-steps 1 --train-seeds 0,1 --jobs 2 >/dev/null || fail "roundtrip_eval.py --train-seeds"
+/usr/bin/python3 -c 'import json,sys; r=json.load(open(sys.argv[1]))["rows"][0]
+assert abs(r["original"]["near"]["expr_gain"] - 0.6) < 1e-9 and abs(r["tracked"]["near"]["psnr"] - 29.5) < 1e-9, r
+assert r["original_runs"]["1"]["near"]["expr_gain"] == 0.7 and r["train_seeds"] == [0, 1], r' \
+  "$TMP/rt/roundtrip_eval.json" || fail "roundtrip_eval.py --train-seeds: wrong means"
 expect_error "--landmarks: expected detect, dlib or model" "$TMP/syn" --keep-cameras --landmarks mediapipe --out "$TMP/bad5"
 echo "track_test: OK"
