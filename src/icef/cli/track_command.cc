@@ -93,7 +93,7 @@ CommandFn RegisterTrack(CLI::App& app) {
   auto landmark_sigma = std::make_shared<double>(-1);
   app.add_option("--landmark-sigma", *landmark_sigma,
                  "The landmarks' noise in inter-ocular distances, which the priors are balanced against (default: "
-                 "0.05; with --keep-cameras 0.1, and 0.02 for --landmarks model, which are exact; docs/tracking.md)")
+                 "0.05; with --keep-cameras 0.1, and 0.002 for --landmarks model, which are exact; docs/tracking.md)")
       ->check(CLI::PositiveNumber);
   auto calibrate = std::make_shared<bool>(false);
   app.add_flag("--calibrate-detector", *calibrate,

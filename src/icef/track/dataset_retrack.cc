@@ -59,7 +59,7 @@ double RetrackPhotometricWeight(RetrackLandmarks landmarks) {
 int RetrackSilhouettePoints(RetrackLandmarks landmarks) { return landmarks == RetrackLandmarks::kDatasetModel ? 0 : 200; }
 
 double RetrackLandmarkSigma(RetrackLandmarks landmarks) {
-  return landmarks == RetrackLandmarks::kDatasetModel ? 0.02 : kRetrackLandmarkSigmaIod;
+  return landmarks == RetrackLandmarks::kDatasetModel ? kRetrackModelLandmarkSigmaIod : kRetrackLandmarkSigmaIod;
 }
 
 Status RetrackOptions::Validate() const {

@@ -66,8 +66,16 @@ int RetrackSilhouettePoints(RetrackLandmarks landmarks);
 // observed / near / moderate / far: 30.87 / 30.94 / 30.84 / 29.99 dB at 0.05, 31.23 / 31.21 /
 // 31.19 / 30.30 at 0.1 (docs/results/track_roundtrip/mesh.json).
 constexpr double kRetrackLandmarkSigmaIod = 0.1;
+// The face model's own landmarks' noise (IOD): they are exact, and the subject's fitted style
+// matches them to 0.0013-0.0015 IOD, so the priors need only break ties. Round trips of
+// validation identities 101 and 102 (icef-prior trained on the result), expression RMS of the
+// training / test frames: 0.060 / 0.158 and 0.079 / 0.156 at 0.02 (the value before 2026-11-28),
+// 0.025 / 0.131 and 0.052 / 0.094 at 0.005, 0.021 / 0.127 and 0.047 / 0.088 at 0.002; the
+// trained models' expr_gain within 0.023 of the originals' in every tier at 0.002
+// (docs/results/track_roundtrip/landmark_sigma.json).
+constexpr double kRetrackModelLandmarkSigmaIod = 0.002;
 // The landmark noise a landmark source's fit assumes: kRetrackLandmarkSigmaIod for a detector's,
-// 0.02 IOD for the face model's own (exact, sub-pixel: track_fit_test's priors).
+// kRetrackModelLandmarkSigmaIod for the face model's own.
 double RetrackLandmarkSigma(RetrackLandmarks landmarks);
 
 struct RetrackOptions {
