@@ -6,16 +6,16 @@
 # of Laplacian RMS inside the landmark hull; docs/evaluation.md), and the same for the held-out view
 # at the training expressions (tiers.observed.face_detail):
 #   - training views at least 0.92, held-out views at least 0.76: the face is not blurred away.
-#     With the defaults of 2026-11-25 (96 samples per training ray) this subject scores 0.97 and
-#     0.87. With 48 samples per training ray (model.sampler.num_samples, the default until that
+#     With today's defaults (144 samples per training ray, since 2026-11-27) this subject scores
+#     0.98 and 0.87 (measured 2026-11-28); with those of 2026-11-25 (96 samples) 0.97 and 0.87. With 48 samples per training ray (model.sampler.num_samples, the default until that
 #     evening) a sample may fall anywhere in a stratum about five pixels deep and still must carry
 #     its pixel's colour, which smears the face along the training rays: 0.88 and 0.82, which
 #     fails. Training rays jittered inside their pixel (train.pixel_jitter=true, the default until
 #     that morning) learn each pixel's average and render it averaged a second time: 0.75 and
 #     0.69 (with 48 samples), which fails;
 #   - at most 1.25: no more edges than the truth (grid-aligned blocks or noise would add them);
-#   - the training views' face region fits to at least 33 dB (39.0 with the defaults, 35.8 with 48
-#     samples per ray, 34.5 with jitter).
+#   - the training views' face region fits to at least 33 dB (40.5 with today's defaults, 39.0 with
+#     96 samples per ray, 35.8 with 48, 34.5 with jitter).
 set -euo pipefail
 ICEF="$1"
 WORK="$(mktemp -d)"
