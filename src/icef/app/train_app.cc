@@ -91,6 +91,7 @@ Result<TrainSummary> RunTrain(const TrainAppOptions& o, std::ostream& out) {
     if (const std::optional<Vec3f>& light = trainer->model().prior_light())
       out << "prior shading: light [" << light->x() << ", " << light->y() << ", " << light->z() << "] (strength "
           << light->norm() << ", fitted to the training images' skin)\n";
+    if (!trainer->density_start_note().empty()) out << trainer->density_start_note() << "\n";
     if (!trainer->prior_shading_note().empty())
       out << "prior shading: off, no light fitted (" << trainer->prior_shading_note() << ")\n";
     if (fit->Poor())

@@ -43,6 +43,14 @@ void TrainConfig::Bind(ConfigSchema& s) {
   s.Int("grid_anneal_steps", &grid_anneal_steps,
         "coarse-to-fine hash grid: levels beyond the 4 coarsest switch on over these steps (0 = off)");
   s.Int("anneal_steps", &anneal_steps, "coarse-to-fine: deformation frequencies switch on over these steps (0 = off)");
+  s.Int("density_start_steps", &density_start_steps,
+        "steps of a start that fits the static field's density to the fitted face model's neutral head before "
+        "training (icef-prior, warp-prior; 0 = the uniform start)");
+  s.Number("density_start_erosion", &density_start_erosion,
+           "head units the density start's head lies inside the fitted face model's surface (the fit's jaw and "
+           "neck are not the subject's: density seeded outside the subject stays as a shell held-out views see)");
+  s.Number("density_start_log_density", &density_start_log_density,
+           "log-density the density start gives the inside of the head (the empty field's is model.static_field.density_bias)");
   s.Int("occupancy_warmup", &occupancy_warmup, "steps before the occupancy grid starts skipping empty space");
   s.Int("occupancy_every", &occupancy_every, "steps between occupancy grid updates");
   s.Int("checkpoint_every", &checkpoint_every, "steps between checkpoints (0 = only at the end)");
@@ -91,10 +99,12 @@ Status TrainConfig::Validate() const {
   if (!non_negative(symmetry_colour)) return Status::Error("train.symmetry_colour must be a finite number >= 0");
   if (symmetry_max_samples < 1) return Status::Error("train.symmetry_max_samples must be >= 1");
   if (!positive(smooth_epsilon)) return Status::Error("train.smooth_epsilon must be positive");
+  if (!non_negative(density_start_erosion)) return Status::Error("train.density_start_erosion must be a finite number >= 0");
+  if (!std::isfinite(density_start_log_density)) return Status::Error("train.density_start_log_density must be finite");
   if (smooth_max_samples < 1) return Status::Error("train.smooth_max_samples must be >= 1");
-  if (anneal_steps < 0 || grid_anneal_steps < 0 || occupancy_warmup < 0 || occupancy_every < 1 || checkpoint_every < 0 || log_every < 1 ||
+  if (anneal_steps < 0 || grid_anneal_steps < 0 || density_start_steps < 0 || occupancy_warmup < 0 || occupancy_every < 1 || checkpoint_every < 0 || log_every < 1 ||
       eval_every < 0)
-    return Status::Error("train: anneal_steps, occupancy_warmup, checkpoint_every, eval_every must be >= 0 and "
+    return Status::Error("train: anneal_steps, grid_anneal_steps, density_start_steps, occupancy_warmup, checkpoint_every, eval_every must be >= 0 and "
                          "occupancy_every, log_every >= 1");
   if (threads < 0) return Status::Error("train.threads must be >= 0");
   if (on_nonfinite != "stop" && on_nonfinite != "skip")

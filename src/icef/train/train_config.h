@@ -47,6 +47,11 @@ struct TrainConfig {
   bool random_background = true;     // train over random background colours (images with alpha only)
   int grid_anneal_steps = kDefaultGridAnnealSteps;  // coarse-to-fine hash grid: levels beyond the 4 coarsest switch on over these steps (0 = off)
   int anneal_steps = kDefaultAnnealSteps;  // coarse-to-fine: deformation frequencies are switched on over these steps (0 = off)
+  // Steps of a start that fits the static field's density to the fitted face model's neutral head
+  // before training (methods on the face-model prior; 0 = the uniform start; train/density_start.h).
+  int density_start_steps = 0;
+  double density_start_erosion = 0.04;  // head units the seeded head lies inside the fitted surface
+  double density_start_log_density = 3.0;  // log-density the density start gives the inside of the head
   int occupancy_warmup = 256;        // steps before the occupancy grid starts skipping empty space
   int occupancy_every = 16;          // steps between occupancy grid updates
   int checkpoint_every = 500;        // steps between checkpoints (0 = only at the end)

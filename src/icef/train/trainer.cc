@@ -10,6 +10,7 @@
 #include "icef/model/face_prior.h"
 #include "icef/model/prior_light.h"
 #include "icef/model/render_image.h"
+#include "icef/train/density_start.h"
 #include "icef/train/visual_hull.h"
 
 namespace icef {
@@ -111,6 +112,20 @@ Result<std::unique_ptr<Trainer>> Trainer::Create(const Dataset& dataset, const f
     ICEF_RETURN_IF_ERROR(model->occupancy().SetAllowed(VisualHullCells(
         setup.aabb, config.model.occupancy.resolution, data.cameras(), alphas, hull, executor)));
   }
+  std::string density_start_note;
+  if (config.train.density_start_steps > 0 && model->setup().face_fit) {
+    DensityStartOptions start;
+    start.steps = config.train.density_start_steps;
+    start.erosion = static_cast<float>(config.train.density_start_erosion);
+    start.inside_log_density = static_cast<float>(config.train.density_start_log_density);
+    ICEF_ASSIGN_OR_RETURN(const double mse, SeedDensityFromFaceModel(*model->setup().face_fit, start,
+                                                                      static_cast<uint64_t>(config.train.seed),
+                                                                      model.get(), executor));
+    std::ostringstream os;
+    os.precision(3);
+    os << "density start: " << start.steps << " steps on the fitted head, log-density RMS error " << std::sqrt(mse);
+    density_start_note = os.str();
+  }
   // Only now that the data and the model are good is anything written.
   std::error_code ec;
   fs::create_directories(model_dir, ec);
@@ -118,6 +133,7 @@ Result<std::unique_ptr<Trainer>> Trainer::Create(const Dataset& dataset, const f
   ICEF_RETURN_IF_ERROR(WriteFileAtomic(model_dir / "config.json", FormatJson(config.ToJson())));
   std::unique_ptr<Trainer> trainer(new Trainer(dataset, model_dir, config, std::move(data), std::move(model)));
   trainer->prior_shading_note_ = std::move(shading_note);
+  trainer->density_start_note_ = std::move(density_start_note);
   return trainer;
 }
 

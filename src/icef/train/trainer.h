@@ -86,6 +86,8 @@ class Trainer {
   // Why a model that would use the prior shading trains without it (its light could not be fitted:
   // too few training pixels show the face model's skin); empty otherwise.
   const std::string& prior_shading_note() const { return prior_shading_note_; }
+  // What the density start did ("" when train.density_start_steps is 0 or the method has no prior).
+  const std::string& density_start_note() const { return density_start_note_; }
   const RunConfig& config() const { return config_; }
   int64_t step() const { return state_.step; }
 
@@ -105,6 +107,7 @@ class Trainer {
   TrainingData data_;
   std::unique_ptr<AvatarModel> model_;
   std::string prior_shading_note_;
+  std::string density_start_note_;
   std::unique_ptr<nn::Adam> adam_;
   Executor executor_;  // a copy: a thread count
   TrainerState state_;

@@ -246,6 +246,36 @@ TEST(TrainerTest, PriorShadingFitsTheLightOrSaysWhyNot) {
   EXPECT_TRUE((*small)->Run(nullptr, nullptr).ok());
 }
 
+// train.density_start_steps seeds the fitted head's density before the first step on the
+// face-model prior's methods, and says so; with 0 or without the prior the start is the uniform one.
+TEST(TrainerTest, DensityStartSeedsTheFittedHeadOnThePriorOnly) {
+  auto density_params = [](Trainer& t) {
+    std::vector<float> v;
+    for (int b = 0; b < t.model().store().num_blocks(); ++b) {
+      const nn::ParamBlock& block = t.model().store().block(b);
+      if (block.name.find("density") == std::string::npos && block.name.find("grid") == std::string::npos) continue;
+      v.insert(v.end(), t.model().store().params() + block.offset, t.model().store().params() + block.offset + block.size);
+    }
+    return v;
+  };
+  for (const std::string method : {"icef-prior", "icef"}) {
+    RunConfig config = SmallConfig(method);
+    auto plain = Trainer::Create(TinySubject(), testing::MakeTempDir("trainer_density_start_off"), config);
+    ASSERT_TRUE(plain.ok()) << plain.status().message();
+    EXPECT_TRUE((*plain)->density_start_note().empty());
+    config.train.density_start_steps = 3;
+    auto seeded = Trainer::Create(TinySubject(), testing::MakeTempDir("trainer_density_start_on"), config);
+    ASSERT_TRUE(seeded.ok()) << seeded.status().message();
+    const bool prior = method == "icef-prior";
+    EXPECT_EQ((*seeded)->density_start_note().find("density start: 3 steps") == 0, prior) << method;
+    EXPECT_EQ(density_params(**seeded) != density_params(**plain), prior) << method;
+    EXPECT_FALSE(density_params(**plain).empty());
+  }
+  RunConfig bad = SmallConfig("icef-prior");
+  bad.train.density_start_erosion = -1;
+  EXPECT_FALSE(bad.Validate().ok());
+}
+
 TEST(RunConfigTest, ParentsOverridesAndStrictKeys) {
   const fs::path dir = testing::MakeTempDir("run_config");
   std::ofstream(dir / "base.json")
