@@ -86,6 +86,7 @@ Result<TrainSummary> RunTrain(const TrainAppOptions& o, std::ostream& out) {
       << " training frames), " << config.train.steps << " steps";
   if (config.train.time_budget_seconds > 0) out << " or " << config.train.time_budget_seconds << " s";
   out << (o.resume ? ", resuming at step " + std::to_string(trainer->step()) : "") << "\n";
+  if (!trainer->start_trials_note().empty()) out << trainer->start_trials_note() << "\n";
   if (const std::optional<face::FaceFit>& fit = trainer->model().setup().face_fit) {
     out << fit->BriefReport() << "\n";
     if (const std::optional<Vec3f>& light = trainer->model().prior_light())

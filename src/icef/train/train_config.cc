@@ -51,6 +51,10 @@ void TrainConfig::Bind(ConfigSchema& s) {
            "neck are not the subject's: density seeded outside the subject stays as a shell held-out views see)");
   s.Number("density_start_log_density", &density_start_log_density,
            "log-density the density start gives the inside of the head (the empty field's is model.static_field.density_bias)");
+  s.Int("start_trials", &start_trials,
+        "initialisations tried before training (1 = the seed's alone): each trains start_trial_steps steps and "
+        "the one with the lowest batch loss over the last quarter of them is trained from the start");
+  s.Int("start_trial_steps", &start_trial_steps, "steps each of the start_trials initialisations trains");
   s.Int("occupancy_warmup", &occupancy_warmup, "steps before the occupancy grid starts skipping empty space");
   s.Int("occupancy_every", &occupancy_every, "steps between occupancy grid updates");
   s.Int("checkpoint_every", &checkpoint_every, "steps between checkpoints (0 = only at the end)");
@@ -101,6 +105,8 @@ Status TrainConfig::Validate() const {
   if (!positive(smooth_epsilon)) return Status::Error("train.smooth_epsilon must be positive");
   if (!non_negative(density_start_erosion)) return Status::Error("train.density_start_erosion must be a finite number >= 0");
   if (!std::isfinite(density_start_log_density)) return Status::Error("train.density_start_log_density must be finite");
+  if (start_trials < 1 || start_trial_steps < 4)
+    return Status::Error("train.start_trials must be >= 1 and train.start_trial_steps >= 4");
   if (smooth_max_samples < 1) return Status::Error("train.smooth_max_samples must be >= 1");
   if (anneal_steps < 0 || grid_anneal_steps < 0 || density_start_steps < 0 || occupancy_warmup < 0 || occupancy_every < 1 || checkpoint_every < 0 || log_every < 1 ||
       eval_every < 0)

@@ -52,6 +52,11 @@ struct TrainConfig {
   int density_start_steps = 0;
   double density_start_erosion = 0.04;  // head units the seeded head lies inside the fitted surface
   double density_start_log_density = 3.0;  // log-density the density start gives the inside of the head
+  // Initialisations tried before training (1 = the seed's alone): each trains start_trial_steps
+  // steps and the one with the lowest batch loss over the last quarter of them is trained from the
+  // start (a field that is still transparent at step 100 can carve the face; docs/results/start_trials/).
+  int start_trials = 1;
+  int start_trial_steps = 100;
   int occupancy_warmup = 256;        // steps before the occupancy grid starts skipping empty space
   int occupancy_every = 16;          // steps between occupancy grid updates
   int checkpoint_every = 500;        // steps between checkpoints (0 = only at the end)

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "icef/io/atomic_file.h"
+#include "icef/core/rng.h"
 #include "icef/model/face_prior.h"
 #include "icef/model/prior_light.h"
 #include "icef/model/render_image.h"
@@ -100,8 +101,7 @@ Result<std::unique_ptr<Trainer>> Trainer::Create(const Dataset& dataset, const f
       shading_note = light.status().message();
     }
   }
-  ICEF_ASSIGN_OR_RETURN(std::unique_ptr<AvatarModel> model, AvatarModel::Create(config.model, setup, executor));
-  model->Initialize(static_cast<uint64_t>(config.train.seed));
+  std::vector<uint8_t> hull_cells;
   if (config.model.visual_hull.enabled && data.has_alpha()) {
     std::vector<Image> alphas;
     for (int k = 0; k < data.num_frames(); ++k) alphas.push_back(data.Alpha(k));
@@ -109,9 +109,54 @@ Result<std::unique_ptr<Trainer>> Trainer::Create(const Dataset& dataset, const f
     hull.margin_px = config.model.visual_hull.margin_px;
     const int min_views = config.model.visual_hull.min_views;
     hull.min_views = min_views > 0 ? min_views : (data.num_frames() + 1) / 2;
-    ICEF_RETURN_IF_ERROR(model->occupancy().SetAllowed(VisualHullCells(
-        setup.aabb, config.model.occupancy.resolution, data.cameras(), alphas, hull, executor)));
+    hull_cells = VisualHullCells(setup.aabb, config.model.occupancy.resolution, data.cameras(), alphas, hull, executor);
   }
+  // A model initialised from `init_seed`, its occupancy carved by the visual hull.
+  auto make_model = [&](uint64_t init_seed) -> Result<std::unique_ptr<AvatarModel>> {
+    ICEF_ASSIGN_OR_RETURN(std::unique_ptr<AvatarModel> m, AvatarModel::Create(config.model, setup, executor));
+    m->Initialize(init_seed);
+    if (!hull_cells.empty()) ICEF_RETURN_IF_ERROR(m->occupancy().SetAllowed(hull_cells));
+    return m;
+  };
+  // train.start_trials: trial t's initialisation seed (trial 0's is the run's seed), and the
+  // trial whose batch loss over the last quarter of its steps is lowest.
+  auto trial_seed = [&](int t) {
+    return t == 0 ? static_cast<uint64_t>(config.train.seed)
+                  : Mix64(static_cast<uint64_t>(config.train.seed) ^ Mix64(StreamId("start_trial") + uint64_t(t)));
+  };
+  std::string start_trials_note;
+  int best_trial = 0;
+  if (config.train.start_trials > 1) {
+    RunConfig trial_config = config;
+    trial_config.train.density_start_steps = 0;
+    const int steps = config.train.start_trial_steps;
+    double best_loss = 0;
+    std::ostringstream os;
+    os.precision(4);
+    os << "start trials: batch loss over steps " << steps - steps / 4 << "-" << steps << " of";
+    for (int t = 0; t < config.train.start_trials; ++t) {
+      ICEF_ASSIGN_OR_RETURN(std::unique_ptr<AvatarModel> m, make_model(trial_seed(t)));
+      Trainer trial(dataset, model_dir, trial_config, data, std::move(m));
+      double sum = 0;
+      int counted = 0;
+      for (int step = 0; step < steps; ++step) {
+        ICEF_ASSIGN_OR_RETURN(const LossTerms terms, trial.Step());
+        if (step >= steps - steps / 4) {
+          sum += terms.total;
+          ++counted;
+        }
+      }
+      const double loss = counted > 0 ? sum / counted : 0;
+      os << (t ? ", " : " ") << "trial " << t << " " << loss;
+      if (t == 0 || loss < best_loss) {
+        best_loss = loss;
+        best_trial = t;
+      }
+    }
+    os << "; training starts from trial " << best_trial << "'s initialisation";
+    start_trials_note = os.str();
+  }
+  ICEF_ASSIGN_OR_RETURN(std::unique_ptr<AvatarModel> model, make_model(trial_seed(best_trial)));
   std::string density_start_note;
   if (config.train.density_start_steps > 0 && model->setup().face_fit) {
     DensityStartOptions start;
@@ -134,6 +179,7 @@ Result<std::unique_ptr<Trainer>> Trainer::Create(const Dataset& dataset, const f
   std::unique_ptr<Trainer> trainer(new Trainer(dataset, model_dir, config, std::move(data), std::move(model)));
   trainer->prior_shading_note_ = std::move(shading_note);
   trainer->density_start_note_ = std::move(density_start_note);
+  trainer->start_trials_note_ = std::move(start_trials_note);
   return trainer;
 }
 

@@ -88,6 +88,8 @@ class Trainer {
   const std::string& prior_shading_note() const { return prior_shading_note_; }
   // What the density start did ("" when train.density_start_steps is 0 or the method has no prior).
   const std::string& density_start_note() const { return density_start_note_; }
+  // Which initialisation train.start_trials kept and why ("" when start_trials is 1).
+  const std::string& start_trials_note() const { return start_trials_note_; }
   const RunConfig& config() const { return config_; }
   int64_t step() const { return state_.step; }
 
@@ -108,6 +110,7 @@ class Trainer {
   std::unique_ptr<AvatarModel> model_;
   std::string prior_shading_note_;
   std::string density_start_note_;
+  std::string start_trials_note_;
   std::unique_ptr<nn::Adam> adam_;
   Executor executor_;  // a copy: a thread count
   TrainerState state_;

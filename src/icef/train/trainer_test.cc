@@ -276,6 +276,39 @@ TEST(TrainerTest, DensityStartSeedsTheFittedHeadOnThePriorOnly) {
   EXPECT_FALSE(bad.Validate().ok());
 }
 
+// train.start_trials tries that many initialisations for start_trial_steps steps and trains the
+// one with the lowest late batch loss from the start: the same choice every time, and trial 0 is
+// the run's own initialisation.
+TEST(TrainerTest, StartTrialsKeepTheBestInitialisationDeterministically) {
+  RunConfig config = SmallConfig("icef");
+  auto plain = Trainer::Create(TinySubject(), testing::MakeTempDir("trainer_trials_plain"), config);
+  ASSERT_TRUE(plain.ok()) << plain.status().message();
+  EXPECT_TRUE((*plain)->start_trials_note().empty());
+  const std::string plain_params = ParamBytes((*plain)->model());
+  config.train.start_trials = 3;
+  config.train.start_trial_steps = 8;
+  auto a = Trainer::Create(TinySubject(), testing::MakeTempDir("trainer_trials_a"), config);
+  auto b = Trainer::Create(TinySubject(), testing::MakeTempDir("trainer_trials_b"), config);
+  ASSERT_TRUE(a.ok() && b.ok());
+  const std::string& note = (*a)->start_trials_note();
+  EXPECT_EQ(note, (*b)->start_trials_note());
+  for (const char* part : {"start trials: batch loss over steps 6-8 of trial 0 ", ", trial 1 ", ", trial 2 "})
+    EXPECT_NE(note.find(part), std::string::npos) << note;
+  EXPECT_EQ((*a)->step(), 0);  // the trials' steps are not the run's
+  EXPECT_TRUE(ParamBytes((*a)->model()) == ParamBytes((*b)->model()));
+  // The kept trial is the one with the lowest loss in the note; trial 0 is the plain initialisation.
+  std::vector<double> losses;
+  for (int t = 0; t < 3; ++t) {
+    const std::string key = "trial " + std::to_string(t) + " ";
+    losses.push_back(std::stod(note.substr(note.find(key) + key.size())));
+  }
+  const int best = int(std::min_element(losses.begin(), losses.end()) - losses.begin());
+  EXPECT_NE(note.find("training starts from trial " + std::to_string(best) + "'s"), std::string::npos) << note;
+  EXPECT_EQ(ParamBytes((*a)->model()) == plain_params, best == 0) << note;
+  config.train.start_trials = 0;
+  EXPECT_FALSE(config.Validate().ok());
+}
+
 TEST(RunConfigTest, ParentsOverridesAndStrictKeys) {
   const fs::path dir = testing::MakeTempDir("run_config");
   std::ofstream(dir / "base.json")
