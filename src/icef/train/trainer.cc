@@ -6,8 +6,8 @@
 #include <cmath>
 #include <sstream>
 
-#include "icef/io/atomic_file.h"
 #include "icef/core/rng.h"
+#include "icef/io/atomic_file.h"
 #include "icef/model/face_prior.h"
 #include "icef/model/prior_light.h"
 #include "icef/model/render_image.h"
@@ -140,9 +140,10 @@ Result<std::unique_ptr<Trainer>> Trainer::Create(const Dataset& dataset, const f
       double sum = 0;
       int counted = 0;
       for (int step = 0; step < steps; ++step) {
-        ICEF_ASSIGN_OR_RETURN(const LossTerms terms, trial.Step());
+        Result<LossTerms> terms = trial.Step();
+        if (!terms.ok()) return terms.status().WithContext("start trial " + std::to_string(t));
         if (step >= steps - steps / 4) {
-          sum += terms.total;
+          sum += terms->total;
           ++counted;
         }
       }
