@@ -168,6 +168,45 @@ TEST(ExpressionStyleTest, GainsScaleTheirOwnExpressionOnly) {
   EXPECT_GT(rs[48].y(), gs[48].y() + 1e-3f);
 }
 
+// A gain acts only through the product of weight and gain: a subject with gain g at weight w and
+// one with gain 1 at weight g w have the same geometry, hence the same landmarks, outlines and
+// images. No tracker can tell the two apart from what it sees, so a tracked weight equals the
+// true one only up to the subject's gain (docs/tracking.md, "What the images cannot tell").
+TEST(ExpressionStyleTest, AGainAndItsWeightAreIndistinguishable) {
+  const ShapeParams shape = SomeShape();
+  const ExpressionStyle strong = Strong();
+  ExpressionStyle unit_gains = strong;  // the same hinge, smile shape and offsets, every gain 1
+  unit_gains.jaw_gain = unit_gains.lip_pucker_gain = unit_gains.lip_press_gain = unit_gains.brow_furrow_gain =
+      unit_gains.cheek_puff_gain = 1.f;
+  unit_gains.smile_gain = unit_gains.brow_raise_gain = unit_gains.eye_close_gain = {1.f, 1.f};
+  const FaceModel a(shape, strong), b(shape, unit_gains);
+  Rng rng(9, StreamId("gain_weight_test"));
+  for (int trial = 0; trial < 5; ++trial) {
+    std::vector<float> w(kNumExpressions), wg(kNumExpressions);
+    for (int e = 0; e < kNumExpressions; ++e) {
+      w[e] = rng.UniformDouble() < 0.5 ? static_cast<float>(rng.Uniform(0.1, 1.0)) : 0.f;
+      wg[e] = w[e] * strong.WeightGain(e);
+    }
+    const ExpressionState sa = a.Prepare(w), sb = b.Prepare(wg);
+    EXPECT_EQ(a.Landmarks(sa), b.Landmarks(sb)) << "trial " << trial;
+    for (int i = 0; i < 200; ++i) {
+      const Vec3f x(static_cast<float>(rng.Uniform(-0.3, 0.3)), static_cast<float>(rng.Uniform(-0.45, 0.35)),
+                    static_cast<float>(rng.Uniform(-0.2, 0.35)));
+      EXPECT_EQ(a.Distance(x, sa), b.Distance(x, sb)) << "trial " << trial << " point " << i;
+      EXPECT_EQ(a.Warp(x, sa), b.Warp(x, sb)) << "trial " << trial << " point " << i;
+    }
+  }
+  // The other fields of the style do show: the same weights with the generic style's hinge, smile
+  // shape and offsets move the landmarks elsewhere.
+  const FaceModel generic(shape);
+  std::vector<float> smile_jaw(kNumExpressions, 0.f);
+  smile_jaw[kJawOpen] = 0.8f, smile_jaw[kSmileLeft] = 0.8f;
+  const auto lb = b.Landmarks(b.Prepare(smile_jaw)), lg = generic.Landmarks(generic.Prepare(smile_jaw));
+  float diff = 0.f;
+  for (int i = 0; i < 68; ++i) diff = std::max(diff, (lb[i] - lg[i]).norm());
+  EXPECT_GT(diff, 0.003f);
+}
+
 TEST(ExpressionStyleTest, OffsetsMoveTheWarpCentres) {
   const ShapeParams shape = SomeShape();
   const FaceModel generic(shape);
