@@ -12,28 +12,42 @@
 namespace icef {
 
 namespace {
-// The face model's open-mouth interior (DESIGN.md §2.1): an absorbing dark volume. Its density
-// makes a cavity sample opaque within about a hundredth of the aabb; its colour is a dark red-brown
-// mouth interior. Neither is learned: no training frame needs to show an open mouth.
+// The face model's open-mouth interior (DESIGN.md §2.1): an absorbing volume. Its density makes a
+// cavity sample opaque within about a hundredth of the aabb. Its colour is learned, three values
+// through a sigmoid, from the open mouths the training frames show (a frame that shows none passes
+// it no gradient, and the colour keeps its start, a dark red-brown mouth interior).
 constexpr float kCavityDensity = 400.f;
-constexpr float kCavityColor[3] = {0.12f, 0.04f, 0.04f};
+constexpr float kCavityColorStart[3] = {0.12f, 0.04f, 0.04f};
 // Density (1/world units) below which a sample is left unshaded by the prior shading.
 constexpr float kShadeMinDensity = 0.05f;
 
-// Samples inside the cavity take its density and colour; their gradients are dropped (the static
-// field did not produce them).
-void ApplyCavity(int64_t n, const uint8_t* inside, float* sigma, float* rgb) {
+float Sigmoid(float v) { return 1.f / (1.f + std::exp(-v)); }
+
+// Samples inside the cavity take its density and colour.
+void ApplyCavity(int64_t n, const uint8_t* inside, const float colour[3], float* sigma, float* rgb) {
   for (int64_t i = 0; i < n; ++i) {
     if (!inside[i]) continue;
     sigma[i] = kCavityDensity;
-    for (int a = 0; a < 3; ++a) rgb[3 * i + a] = kCavityColor[a];
+    for (int a = 0; a < 3; ++a) rgb[3 * i + a] = colour[a];
   }
 }
-void DropCavityGradients(int64_t n, const uint8_t* inside, float* d_sigma, float* d_rgb) {
+// The cavity samples' colour gradients, summed (in sample order, in double) onto the cavity colour's
+// logits (d rgb / d logit = rgb (1 - rgb)); then both their gradients are dropped (the static field
+// did not produce them).
+void CavityBackward(int64_t n, const uint8_t* inside, std::span<const float> logits, float* d_sigma, float* d_rgb,
+                    std::span<float> d_logits) {
+  double sum[3] = {0, 0, 0};
   for (int64_t i = 0; i < n; ++i) {
     if (!inside[i]) continue;
     d_sigma[i] = 0.f;
-    for (int a = 0; a < 3; ++a) d_rgb[3 * i + a] = 0.f;
+    for (int a = 0; a < 3; ++a) {
+      sum[a] += d_rgb[3 * i + a];
+      d_rgb[3 * i + a] = 0.f;
+    }
+  }
+  for (int a = 0; a < 3; ++a) {
+    const double c = Sigmoid(logits[a]);
+    d_logits[a] += static_cast<float>(sum[a] * c * (1.0 - c));
   }
 }
 }  // namespace
@@ -88,16 +102,26 @@ Result<std::unique_ptr<AvatarModel>> AvatarModel::Create(const ModelConfig& conf
                                                  &model->confidence_, model->traits_.confidence);
   }
   if (model->prior_ && config.prior_shading) model->light_ = setup.prior_light;
+  if (model->prior_) model->cavity_block_ = model->store_.Register("cavity/colour", 3, kGridGroup);
   return model;
 }
 
 void AvatarModel::Initialize(uint64_t seed) {
   static_field_->Initialize(Mix64(seed ^ StreamId("static_field")));
   if (residual_field_) residual_field_->Initialize(Mix64(seed ^ StreamId("deformation_field")));
+  if (cavity_block_ >= 0) {
+    const std::span<float> logits = store_.params(cavity_block_);
+    for (int a = 0; a < 3; ++a) logits[a] = std::log(kCavityColorStart[a] / (1.f - kCavityColorStart[a]));
+  }
   occupancy_.Fill(true);
 }
 
 NearestExpression AvatarModel::Nearest(std::span<const float> beta) const { return confidence_.Nearest(beta); }
+
+float AvatarModel::CavityColour(int channel) const {
+  ICEF_CHECK(cavity_block_ >= 0, "no mouth cavity without a prior");
+  return Sigmoid(store_.params(cavity_block_)[channel]);
+}
 
 void AvatarModel::QueryStatic(const Executor& executor, int64_t n, const float* canonical, const float* directions,
                             const float* condition, float* sigma, float* rgb) const {
@@ -174,7 +198,8 @@ void AvatarModel::FieldForward(ModelWorkspace& ws, int64_t n, const float* posit
   if (warp_ && warp_->has_prior()) {
     Fit(ws.cavity, n);
     warp_->Cavity(executor, n, positions, ws.betas.data(), ws.cavity.data());
-    ApplyCavity(n, ws.cavity.data(), ws.sigma.data(), ws.rgb.data());
+    const float colour[3] = {CavityColour(0), CavityColour(1), CavityColour(2)};
+    ApplyCavity(n, ws.cavity.data(), colour, ws.sigma.data(), ws.rgb.data());
   }
 }
 
@@ -296,7 +321,9 @@ LossTerms AvatarModel::TrainForwardBackward(const TrainRays& batch, const LossWe
   CompositeOutputGradients<float> grads{ws.d_color, ws.d_opacity, {}, ws.d_weights};
   CompositeBackward(in, ws.composite, grads, executor, &ws.d_sigma, &ws.d_rgb);
   RunLosses(LossStage::kSamples, ctx, &terms);
-  if (warp_ && warp_->has_prior()) DropCavityGradients(n, ws.cavity.data(), ws.d_sigma.data(), ws.d_rgb.data());
+  if (warp_ && warp_->has_prior())
+    CavityBackward(n, ws.cavity.data(), store_.params(cavity_block_), ws.d_sigma.data(), ws.d_rgb.data(),
+                   store_.grads(cavity_block_));
   if (warp_) Fit(ws.d_canonical, 3 * n);
   const bool shaded = !ws.shade.empty();
   if (shaded)  // d rgb_unshaded = s d rgb

@@ -89,6 +89,10 @@ class AvatarModel {
   // beta_n, delta, kappa for an expression.
   NearestExpression Nearest(std::span<const float> beta) const;
 
+  // The face model's mouth cavity (the *-prior methods) and its learned colour (channel 0-2).
+  bool has_mouth_cavity() const { return cavity_block_ >= 0; }
+  float CavityColour(int channel) const;
+
   // Canonical-space query of the static field (tests and tools): sigma [n], rgb [n, 3].
   void QueryStatic(const Executor& executor, int64_t n, const float* canonical, const float* directions,
                    const float* condition, float* sigma, float* rgb) const;
@@ -153,6 +157,7 @@ class AvatarModel {
   std::unique_ptr<DeformationPrior> prior_;
   std::unique_ptr<Deformation> warp_;
   std::optional<Vec3f> light_;
+  int cavity_block_ = -1;  // the mouth cavity's colour logits (*-prior methods), else -1
   RegionMask mask_;
   ExpressionConfidence confidence_;
   OccupancyGrid occupancy_;

@@ -194,6 +194,47 @@ TEST(PriorGuidedTest, MouthCavityRendersDark) {
   EXPECT_GT(closed.color[0], 0.2f);  // no cavity at neutral: whatever the static field holds
 }
 
+// The cavity's colour is learned: a render of the open mouth shows it, rays through the cavity pull
+// it towards their targets (a darker target: positive gradients on all three logits, so a descent
+// step darkens it), and rays that miss the cavity leave it alone (no gradient at all).
+TEST(PriorGuidedTest, MouthCavityColourIsLearned) {
+  auto model = MakePriorModel("icef-prior", 0.01f);
+  nn::ParameterStore& store = model->store();
+  const int block = store.FindBlock("cavity/colour");
+  ASSERT_GE(block, 0);
+  EXPECT_NEAR(model->CavityColour(0), 0.12f, 1e-6f);  // the start: dark red-brown
+  const float want[3] = {0.5f, 0.2f, 0.1f};
+  for (int a = 0; a < 3; ++a) store.params(block)[a] = std::log(want[a] / (1.f - want[a]));
+  RenderOutput open;
+  model->Render(std::vector<Ray>{Ray{Vec3f(0.f, -0.2f, 2.f), Vec3f(0, 0, -1)}}, std::vector<float>{1.5f, 0.f, 0.f},
+                Vec3f::Ones(), Executor(1), &open);
+  ASSERT_GT(open.opacity[0], 0.99f);
+  for (int a = 0; a < 3; ++a) EXPECT_NEAR(open.color[a], want[a], 0.03f) << a;
+
+  TrainRays through, past;
+  for (float dx : {-0.02f, 0.02f}) {
+    through.rays.push_back(Ray{Vec3f(dx, -0.2f, 2.f), Vec3f(0, 0, -1)});
+    past.rays.push_back(Ray{Vec3f(dx + 0.3f, 0.1f, 2.f), Vec3f(0, 0, -1)});
+    for (TrainRays* b : {&through, &past}) {
+      b->frame.push_back(0);  // beta_0 = 0.5: a cavity of radius 0.05
+      for (int a = 0; a < 3; ++a) b->target_rgb.push_back(0.02f);
+      b->target_alpha.push_back(1.f);
+    }
+  }
+  const Executor ex(1);
+  store.ZeroGrads();
+  model->TrainForwardBackward(through, LossWeights{}, 3, 0, ex);
+  for (int a = 0; a < 3; ++a) EXPECT_GT(store.grads(block)[a], 1e-4f) << a;
+  store.ZeroGrads();
+  model->TrainForwardBackward(past, LossWeights{}, 3, 0, ex);
+  for (int a = 0; a < 3; ++a) EXPECT_EQ(store.grads(block)[a], 0.f) << a;
+  // Without a prior there is no cavity and no block for it.
+  ModelConfig plain = TinyModelConfig("icef");
+  auto icef = AvatarModel::Create(plain, TinySetup(), Executor(1));
+  ASSERT_TRUE(icef.ok());
+  EXPECT_LT((*icef)->store().FindBlock("cavity/colour"), 0);
+}
+
 // The prior shading: colour times s = (1 + max(0, n_obs . v)) / (1 + max(0, n_can . v)) at every
 // sample, from the prior's normals; at beta = 0 (equal normals) the render is the unshaded one, and
 // model.prior_shading = false or a setup without a light turns it off.
@@ -234,7 +275,15 @@ TEST(PriorGuidedTest, PriorShadingScalesTheColourByTheLightOnTheTurnedSurface) {
 // prior shading on every sample).
 TEST(PriorGuidedTest, TrainLossGradientMatchesFiniteDifferences) {
   auto model = MakePriorModel("icef-prior", 0.05f, true, -1.f);  // dense enough to be shaded
-  const TrainRays batch = Batch(24, 5);
+  TrainRays batch = Batch(24, 5);
+  for (float dx : {-0.02f, 0.02f}) {  // through the cavity of frame 0 (beta_0 = 0.5: radius 0.05)
+    for (float dy : {-0.02f, 0.02f}) {
+      batch.rays.push_back(Ray{Vec3f(dx, -0.2f + dy, 2.f), Vec3f(0, 0, -1)});
+      batch.frame.push_back(0);
+      for (float v : {0.02f, 0.3f, 0.9f}) batch.target_rgb.push_back(v);
+      batch.target_alpha.push_back(1.f);
+    }
+  }
   LossWeights w;
   w.lambda_id_prior = 0.5;
   w.lambda_smooth = 0.3;
@@ -270,6 +319,15 @@ TEST(PriorGuidedTest, TrainLossGradientMatchesFiniteDifferences) {
   std::partial_sort(colour.begin(), colour.begin() + 6, colour.end(),
                     [&](int64_t a, int64_t b) { return std::abs(grads[a]) > std::abs(grads[b]); });
   check.insert(check.end(), colour.begin(), colour.begin() + 6);
+  // And the mouth cavity's learned colour (its three logits), which the cavity rays see.
+  const int cavity = store.FindBlock("cavity/colour");
+  ASSERT_GE(cavity, 0);
+  ASSERT_EQ(store.block(cavity).size, 3);
+  for (int64_t a = 0; a < 3; ++a) {
+    const int64_t i = store.block(cavity).offset + a;
+    EXPECT_GT(std::abs(grads[i]), 1e-6) << "cavity colour " << a;
+    check.push_back(i);
+  }
   for (int64_t i : check) {
     const float saved = store.params()[i];
     const float h = std::max(3e-3f, 3e-3f * std::abs(saved));

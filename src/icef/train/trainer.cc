@@ -31,6 +31,9 @@ Json TrainSummary::ToJson() const {
   j["skipped_steps"] = skipped_steps;
   j["interrupted"] = interrupted;
   j["stop_reason"] = stop_reason;
+  j["mouth_cavity_colour"] =
+      mouth_cavity_colour ? Json::array({(*mouth_cavity_colour)[0], (*mouth_cavity_colour)[1], (*mouth_cavity_colour)[2]})
+                          : Json(nullptr);
   return j;
 }
 
@@ -41,6 +44,11 @@ std::string TrainSummary::BriefReport() const {
      << final_loss << ", batch PSNR " << final_batch_psnr << " dB";
   if (skipped_steps > 0) os << ", steps skipped for a non-finite loss or gradient: " << skipped_steps;
   if (psnr_observed) os << ", held-out PSNR (observed tier, " << observed_frames << " frames) " << *psnr_observed << " dB";
+  if (mouth_cavity_colour) {
+    os.precision(3);
+    os << ", mouth cavity colour (" << (*mouth_cavity_colour)[0] << ", " << (*mouth_cavity_colour)[1] << ", "
+       << (*mouth_cavity_colour)[2] << ")";
+  }
   return os.str();
 }
 
@@ -356,6 +364,8 @@ Result<TrainSummary> Trainer::Run(const ProgressFn& progress, const std::atomic<
   summary.final_loss = last_terms_.total;
   summary.final_batch_psnr = last_terms_.psnr();
   summary.samples_per_second = run_seconds > 0 ? samples / run_seconds : 0;
+  if (model_->has_mouth_cavity())
+    summary.mouth_cavity_colour = {model_->CavityColour(0), model_->CavityColour(1), model_->CavityColour(2)};
   if (!summary.interrupted)
     summary.psnr_observed = MeanTierPsnr(*model_, dataset_, Tier::kObserved, executor_, &summary.observed_frames);
   ICEF_RETURN_IF_ERROR(WriteFileAtomic(model_dir_ / "summary.json", FormatJson(summary.ToJson())));

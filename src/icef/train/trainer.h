@@ -5,6 +5,8 @@
 // images or draws progress bars: callers observe it through the progress callback.
 #pragma once
 
+#include <array>
+
 #include <atomic>
 #include <filesystem>
 #include <functional>
@@ -31,6 +33,8 @@ struct TrainSummary {
   int64_t skipped_steps = 0;          // steps skipped for a non-finite loss or gradient (all resumed runs)
   bool interrupted = false;           // stopped by a signal before the end
   std::string stop_reason;            // "steps", "time budget" or "interrupted"
+  // The learned colour of the face model's mouth cavity (*-prior methods; model/avatar_model.h).
+  std::optional<std::array<double, 3>> mouth_cavity_colour;
 
   Json ToJson() const;
   std::string BriefReport() const;

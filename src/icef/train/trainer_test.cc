@@ -191,6 +191,10 @@ TEST(TrainerTest, EveryMethodTrainsAndWritesItsModelDirectory) {
     ASSERT_TRUE(s.ok()) << s.status().message();
     for (const char* f : {"checkpoint.icef", "config.json", "summary.json", "train_log.jsonl"})
       EXPECT_TRUE(fs::exists(dir / f)) << MethodName(m) << " " << f;
+    // The methods on the face model learn their mouth cavity's colour and report it.
+    EXPECT_EQ(s->mouth_cavity_colour.has_value(), TraitsOf(m).prior) << MethodName(m);
+    if (s->mouth_cavity_colour)
+      for (double c : *s->mouth_cavity_colour) EXPECT_TRUE(c > 0.0 && c < 1.0) << MethodName(m);
     auto loaded = LoadModel(dir, Executor(1));
     ASSERT_TRUE(loaded.ok()) << loaded.status().message();
     EXPECT_EQ(loaded->model->method(), m);
