@@ -101,26 +101,34 @@ Status ParameterStore::Read(std::istream& in) {
                          " (expected " + std::to_string(kVersion) + ")");
   }
   if (!Get(in, &count)) return Status::Error("parameters: truncated header (block count)");
-  if (count != blocks_.size()) {
-    return Status::Error("parameters: file has " + std::to_string(count) + " blocks, model has " +
-                         std::to_string(blocks_.size()));
-  }
-  for (const ParamBlock& b : blocks_) {
+  if (count > (1u << 16)) return Status::Error("parameters: implausible block count " + std::to_string(count));
+  // The file's block headers first, so that a mismatch names the block that differs.
+  struct FileBlock {
+    std::string name;
+    int64_t size = 0;
+  };
+  std::vector<FileBlock> file(count);
+  for (uint32_t k = 0; k < count; ++k) {
     uint32_t len = 0;
     if (!Get(in, &len) || len > (1u << 16)) return Status::Error("parameters: truncated block name");
-    std::string name(len, '\0');
-    in.read(name.data(), len);
-    int64_t size = 0;
+    file[k].name.assign(len, '\0');
+    in.read(file[k].name.data(), len);
     int32_t group = 0;
-    if (!in || !Get(in, &size) || !Get(in, &group)) {
-      return Status::Error("parameters: truncated header of block '" + b.name + "'");
+    if (!in || !Get(in, &file[k].size) || !Get(in, &group)) {
+      return Status::Error("parameters: truncated header of block " + std::to_string(k));
     }
-    if (name != b.name) {
-      return Status::Error("parameters: block '" + name + "' in file where model expects '" +
-                           b.name + "'");
+  }
+  const std::string counts = " (the file has " + std::to_string(count) + " blocks, the model " +
+                             std::to_string(blocks_.size()) + ": written by another version or for another method?)";
+  for (size_t k = 0; k < std::max<size_t>(file.size(), blocks_.size()); ++k) {
+    if (k >= file.size()) return Status::Error("parameters: the model's block '" + blocks_[k].name + "' is not in the file" + counts);
+    if (k >= blocks_.size()) return Status::Error("parameters: block '" + file[k].name + "' in file is not in the model" + counts);
+    const ParamBlock& b = blocks_[k];
+    if (file[k].name != b.name) {
+      return Status::Error("parameters: block '" + file[k].name + "' in file where model expects '" + b.name + "'");
     }
-    if (size != b.size) {
-      return Status::Error("parameters: block '" + b.name + "' has " + std::to_string(size) +
+    if (file[k].size != b.size) {
+      return Status::Error("parameters: block '" + b.name + "' has " + std::to_string(file[k].size) +
                            " floats in file, model expects " + std::to_string(b.size));
     }
   }

@@ -55,6 +55,22 @@ TEST(ParameterStoreTest, RoundTripAndMismatchErrorsNameTheBlock) {
   ASSERT_FALSE(st.ok());
   EXPECT_NE(st.message().find("'mlp' has 10"), std::string::npos) << st.message();
 
+  // A model with a block more (or less) than the file: the error names it.
+  ParameterStore larger;
+  larger.Register("mlp", 10);
+  larger.Register("grid", 33, 1);
+  larger.Register("cavity/colour", 3);
+  std::istringstream in5(bytes);
+  st = larger.Read(in5);
+  ASSERT_FALSE(st.ok());
+  EXPECT_NE(st.message().find("'cavity/colour' is not in the file"), std::string::npos) << st.message();
+  ParameterStore smaller;
+  smaller.Register("mlp", 10);
+  std::istringstream in6(bytes);
+  st = smaller.Read(in6);
+  ASSERT_FALSE(st.ok());
+  EXPECT_NE(st.message().find("'grid' in file is not in the model"), std::string::npos) << st.message();
+
   std::istringstream truncated(bytes.substr(0, bytes.size() - 8));
   st = same.Read(truncated);
   ASSERT_FALSE(st.ok());
