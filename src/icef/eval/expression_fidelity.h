@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "icef/core/status.h"
+#include "icef/data/landmark_region.h"
 #include "icef/io/image.h"
 #include "icef/math/types.h"
 
@@ -31,25 +32,18 @@ namespace icef::eval {
 // RMS (per RGB value, [0, 1] units) below which a frame's true change counts as negligible.
 constexpr double kNegligibleExpressionRms = 0.004;
 
-// The iBUG-68 indices of brows, eyes and mouth.
-const std::vector<int>& ExpressionLandmarkIndices();
-
-// Default dilation of the region in pixels for an image `width` wide: 3 px at 128, scaled.
-int DefaultRegionDilation(int width);
+// The region geometry lives in data/landmark_region.h (training draws rays from the same region).
+using ::icef::DefaultRegionDilation;
+using ::icef::ExpressionLandmarkIndices;
+using ::icef::ExpressionRegion;
 
 // Default Gaussian sigma (pixels) of expr_gain_coarse for an image `width` wide: 2 px at 128, scaled.
 double DefaultCoarseSigma(int width);
 
-// 1-channel mask (1 inside, 0 outside) of the expression region. `neutral` may be empty (the
-// frame's hull alone). Landmarks are in pixel coordinates (pixel centres at +0.5).
-Image ExpressionRegion(int width, int height, const std::vector<Vec2f>& frame_landmarks,
-                       const std::vector<Vec2f>& neutral_landmarks, int dilation);
-
 // 1-channel mask (1 inside, 0 outside) of the face region: the pixels whose centres (+0.5) lie in
 // or on the filled 2D convex hull of all finite landmarks (the 68 points, jaw line included;
-// visibility flags are not consulted: an occluded point still projects onto the face). Points
-// outside the image still shape the hull, which the image then clips. Fewer than three
-// non-collinear points: an empty mask.
+// visibility flags are not consulted: an occluded point still projects onto the face):
+// LandmarkHullRegion.
 Image FaceRegion(int width, int height, const std::vector<Vec2f>& landmarks);
 
 struct ExpressionFidelity {

@@ -40,6 +40,10 @@ void TrainConfig::Bind(ConfigSchema& s) {
          "cast each training ray through a random point of its pixel instead of its centre (off: the field "
          "then learns each pixel's average over the whole pixel, and a render at the centre averages the "
          "truth's pixel a second time: softer faces, -0.28 dB held-out on the validation identities)");
+  s.Number("region_rays", &region_rays,
+           "share of each step's rays drawn from the training frames' expression regions (brows, eyes and mouth "
+           "by their 2D landmarks, the region icef eval scores expressions in; frames without landmarks add none); "
+           "the rest over all pixels (0 = all uniform)");
   s.Int("grid_anneal_steps", &grid_anneal_steps,
         "coarse-to-fine hash grid: levels beyond the 4 coarsest switch on over these steps (0 = off)");
   s.Int("anneal_steps", &anneal_steps, "coarse-to-fine: deformation frequencies switch on over these steps (0 = off)");
@@ -90,6 +94,7 @@ Status TrainConfig::Validate() const {
   if (steps < 1) return Status::Error("train.steps must be >= 1");
   if (!non_negative(time_budget_seconds)) return Status::Error("train.time_budget_seconds must be >= 0");
   if (batch_rays < 1) return Status::Error("train.batch_rays must be >= 1");
+  if (!(region_rays >= 0 && region_rays <= 1)) return Status::Error("train.region_rays must be in [0, 1]");
   if (!positive(lr_grid) || !positive(lr_mlp) || !positive(lr_deform))
     return Status::Error("train.lr_grid, lr_mlp and lr_deform must be positive");
   if (!positive(lr_final_factor) || lr_final_factor > 1) return Status::Error("train.lr_final_factor must be in (0, 1]");

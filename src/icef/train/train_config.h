@@ -44,6 +44,11 @@ struct TrainConfig {
   // the centre shows the truth's pixel averaged a second time, and the face comes out soft;
   // docs/results/priors_validation.md, 2026-11-25).
   bool pixel_jitter = false;
+  // The share of each step's rays drawn from the training frames' expression regions (brows, eyes
+  // and mouth by their 2D landmarks, the region icef eval scores expressions in); the rest are
+  // drawn over all pixels. Frames without landmarks contribute no region. Validation 101-104, two
+  // training seeds: docs/results/region_rays.
+  double region_rays = 0.15;
   bool random_background = true;     // train over random background colours (images with alpha only)
   int grid_anneal_steps = kDefaultGridAnnealSteps;  // coarse-to-fine hash grid: levels beyond the 4 coarsest switch on over these steps (0 = off)
   int anneal_steps = kDefaultAnnealSteps;  // coarse-to-fine: deformation frequencies are switched on over these steps (0 = off)

@@ -237,7 +237,11 @@ Result<LossTerms> Trainer::Step() {
   ApplySchedules();
   if (state_.step >= t.occupancy_warmup && state_.step % t.occupancy_every == 0)
     model_->UpdateOccupancy(seed, state_.step, executor_);
-  data_.SampleBatch(t.batch_rays, seed, state_.step, t.random_background, t.pixel_jitter, &batch_, executor_);
+  RaySampling how;
+  how.random_background = t.random_background;
+  how.jitter = t.pixel_jitter;
+  how.region_fraction = t.region_rays;
+  data_.SampleBatch(t.batch_rays, seed, state_.step, how, &batch_, executor_);
   const LossWeights w = t.Losses(data_.has_alpha());
   const LossTerms terms = model_->TrainForwardBackward(batch_, w, seed, state_.step, executor_);
   // What is non-finite this step ("" when nothing is).

@@ -2,9 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
+#include <cmath>
 #include <fstream>
 #include <iostream>
 
+#include "icef/data/landmark_region.h"
 #include "icef/model/render_image.h"
 #include "icef/synth/synthesize.h"
 #include "icef/testing/tiny_dataset.h"
@@ -59,9 +62,11 @@ TEST(TrainingDataTest, JitteredRaysStayInsideTheirPixelAndAreDeterministic) {
   auto data = TrainingData::Load(TinySubject());
   ASSERT_TRUE(data.ok()) << data.status().message();
   TrainRays centre, jittered, again;
-  data->SampleBatch(256, 9, 4, false, false, &centre, Executor(2));
-  data->SampleBatch(256, 9, 4, false, true, &jittered, Executor(2));
-  data->SampleBatch(256, 9, 4, false, true, &again, Executor(1));  // any thread count: the same rays
+  RaySampling at_centre, jitter;
+  jitter.jitter = true;
+  data->SampleBatch(256, 9, 4, at_centre, &centre, Executor(2));
+  data->SampleBatch(256, 9, 4, jitter, &jittered, Executor(2));
+  data->SampleBatch(256, 9, 4, jitter, &again, Executor(1));  // any thread count: the same rays
   int off_centre = 0;
   for (int r = 0; r < 256; ++r) {
     ASSERT_EQ(centre.frame[r], jittered.frame[r]);  // same pixels and targets, only the ray moves
@@ -80,6 +85,65 @@ TEST(TrainingDataTest, JitteredRaysStayInsideTheirPixelAndAreDeterministic) {
     EXPECT_EQ(jittered.rays[r].direction, again.rays[r].direction);
   }
   EXPECT_GT(off_centre, 128);
+}
+
+// The pixel a centre ray of `batch` passes through, as (frame, x, y).
+std::array<int, 3> RayPixel(const TrainingData& data, const TrainRays& batch, int r) {
+  const Camera& cam = data.camera(batch.frame[r]);
+  const auto uv = cam.Project((batch.rays[r].origin + 3.f * batch.rays[r].direction).cast<double>());
+  ICEF_CHECK(uv.has_value());
+  return {batch.frame[r], static_cast<int>(std::floor(uv->uv.x())), static_cast<int>(std::floor(uv->uv.y()))};
+}
+
+TEST(TrainingDataTest, RegionRaysComeFromEachFramesExpressionRegion) {
+  const Dataset& dataset = TinySubject();
+  auto data = TrainingData::Load(dataset);
+  ASSERT_TRUE(data.ok()) << data.status().message();
+  // The region pixels are exactly each frame's expression region (its own landmarks, eval's dilation).
+  std::vector<Image> regions;
+  size_t expected = 0;
+  for (const Frame& f : dataset.train) {
+    ASSERT_TRUE(f.landmarks_2d.has_value());
+    const int w = f.camera.width(), h = f.camera.height();
+    regions.push_back(ExpressionRegion(w, h, *f.landmarks_2d, {}, DefaultRegionDilation(w)));
+    for (float v : regions.back().pixels) expected += v > 0.f;
+  }
+  ASSERT_GT(expected, 0u);
+  EXPECT_EQ(data->region_pixels().size(), expected);
+  const int64_t all = data->PixelIndex(data->num_frames() - 1, 0, 0) + 32 * 32;
+  EXPECT_LT(expected, size_t(all / 4));  // the region is a small part of the images
+
+  RaySampling quarter;
+  quarter.region_fraction = 0.25;
+  TrainRays batch, again, uniform;
+  data->SampleBatch(400, 5, 7, quarter, &batch, Executor(2));
+  data->SampleBatch(400, 5, 7, quarter, &again, Executor(1));
+  data->SampleBatch(400, 5, 7, RaySampling{}, &uniform, Executor(2));
+  int in_region = 0, uniform_in_region = 0;
+  for (int r = 0; r < 400; ++r) {
+    const auto [k, x, y] = RayPixel(*data, batch, r);
+    const bool inside = regions[k].At(x, y, 0) > 0.f;
+    if (r < 100) {
+      EXPECT_TRUE(inside) << "ray " << r << ": frame " << k << " pixel " << x << "," << y;
+    }
+    in_region += inside;
+    const auto [ku, xu, yu] = RayPixel(*data, uniform, r);
+    uniform_in_region += regions[ku].At(xu, yu, 0) > 0.f;
+    EXPECT_EQ(batch.rays[r].direction, again.rays[r].direction);  // any thread count: the same rays
+    EXPECT_EQ(batch.target_rgb[3 * r + 1], again.target_rgb[3 * r + 1]);
+  }
+  EXPECT_GE(in_region, 100);
+  EXPECT_LT(uniform_in_region, 100);  // drawn over all pixels, far fewer land in the region
+
+  // A dataset without landmarks has no region: every ray is drawn over all pixels.
+  Dataset bare = dataset;
+  for (Frame& f : bare.train) f.landmarks_2d.reset();
+  auto bare_data = TrainingData::Load(bare);
+  ASSERT_TRUE(bare_data.ok()) << bare_data.status().message();
+  EXPECT_TRUE(bare_data->region_pixels().empty());
+  TrainRays bare_batch;
+  bare_data->SampleBatch(400, 5, 7, quarter, &bare_batch, Executor(2));
+  for (int r = 0; r < 400; ++r) EXPECT_EQ(bare_batch.rays[r].direction, uniform.rays[r].direction);
 }
 
 TEST(TrainerTest, TrainingLowersLossAndRaisesPsnr) {
@@ -193,8 +257,9 @@ TEST(TrainerTest, EveryMethodTrainsAndWritesItsModelDirectory) {
       EXPECT_TRUE(fs::exists(dir / f)) << MethodName(m) << " " << f;
     // The methods on the face model learn their mouth cavity's colour and report it.
     EXPECT_EQ(s->mouth_cavity_colour.has_value(), TraitsOf(m).prior) << MethodName(m);
-    if (s->mouth_cavity_colour)
+    if (s->mouth_cavity_colour) {
       for (double c : *s->mouth_cavity_colour) EXPECT_TRUE(c > 0.0 && c < 1.0) << MethodName(m);
+    }
     auto loaded = LoadModel(dir, Executor(1));
     ASSERT_TRUE(loaded.ok()) << loaded.status().message();
     EXPECT_EQ(loaded->model->method(), m);

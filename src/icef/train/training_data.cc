@@ -1,5 +1,10 @@
 #include "icef/train/training_data.h"
 
+#include <algorithm>
+#include <cmath>
+
+#include "icef/data/landmark_region.h"
+
 namespace icef {
 
 Result<TrainingData> TrainingData::Load(const Dataset& dataset) {
@@ -37,6 +42,13 @@ Result<TrainingData> TrainingData::Load(const Dataset& dataset) {
         if (data.has_alpha_) data.alpha_.push_back(a);
       }
     }
+    if (dataset.train[k].landmarks_2d) {
+      const Image region = ExpressionRegion(img.width, img.height, *dataset.train[k].landmarks_2d, {},
+                                            DefaultRegionDilation(img.width));
+      for (int y = 0; y < img.height; ++y)
+        for (int x = 0; x < img.width; ++x)
+          if (region.At(x, y, 0) > 0.f) data.region_pixels_.push_back(data.PixelIndex(static_cast<int>(k), x, y));
+    }
   }
   return data;
 }
@@ -49,14 +61,15 @@ Image TrainingData::Alpha(int k) const {
   return out;
 }
 
-void TrainingData::SampleBatch(int num_rays, uint64_t seed, int64_t step, bool random_background, bool jitter,
-                               TrainRays* batch, const Executor& executor) const {
+void TrainingData::SampleBatch(int num_rays, uint64_t seed, int64_t step, const RaySampling& how, TrainRays* batch,
+                               const Executor& executor) const {
   batch->rays.resize(num_rays);
   batch->frame.resize(num_rays);
   batch->target_rgb.resize(3 * size_t(num_rays));
   batch->target_alpha.resize(has_alpha_ ? num_rays : 0);
   batch->background.resize(3 * size_t(num_rays));
-  const bool random = random_background && has_alpha_;
+  const bool random = how.random_background && has_alpha_;
+  const bool jitter = how.jitter;
   // The draws in ray order on the caller (three streams, each consumed in order), then the rays and
   // targets in parallel: the same batch for any thread count.
   Rng rng(seed, StreamId("ray_batch"), uint64_t(step));
@@ -68,9 +81,11 @@ void TrainingData::SampleBatch(int num_rays, uint64_t seed, int64_t step, bool r
     double ju, jv;
   };
   std::vector<PixelDraw> draws(num_rays);
+  const int from_region =
+      region_pixels_.empty() ? 0 : static_cast<int>(std::lround(std::clamp(how.region_fraction, 0.0, 1.0) * num_rays));
   for (int r = 0; r < num_rays; ++r) {
     PixelDraw& d = draws[r];
-    d.pixel = rng.Below(total);
+    d.pixel = r < from_region ? uint64_t(region_pixels_[rng.Below(region_pixels_.size())]) : rng.Below(total);
     d.ju = jitter ? jitter_rng.Uniform() : 0.5;
     d.jv = jitter ? jitter_rng.Uniform() : 0.5;
     for (int a = 0; a < 3 && random; ++a) batch->background[3 * r + a] = static_cast<float>(bg_rng.Uniform());

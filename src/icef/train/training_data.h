@@ -10,6 +10,19 @@
 
 namespace icef {
 
+// How SampleBatch draws a step's rays.
+struct RaySampling {
+  // Each ray's target over a random colour that the model also renders over (images with alpha).
+  bool random_background = false;
+  // Each ray through a uniformly random point of its pixel (the target is the pixel's average),
+  // else through the pixel centre.
+  bool jitter = false;
+  // The share of the rays drawn uniformly from the training frames' expression regions (brows,
+  // eyes and mouth by their 2D landmarks: data/landmark_region.h); the rest uniformly over all
+  // pixels. 0 with no frame with landmarks.
+  double region_fraction = 0;
+};
+
 class TrainingData {
  public:
   // Loads every training image; errors name the image file.
@@ -23,14 +36,21 @@ class TrainingData {
   // Frame k's alpha as a 1-channel image (all ones without alpha).
   Image Alpha(int k) const;
 
-  // Fills `batch` with `num_rays` rays drawn uniformly over all training pixels, from
-  // Rng(seed, "ray_batch", step): deterministic for (seed, step). With random_background (and
+  // Pixels (global indices, frame by frame) in the training frames' expression regions: each
+  // frame's ExpressionRegion of its own 2D landmarks, dilated by DefaultRegionDilation. Empty
+  // when no frame has landmarks.
+  const std::vector<int64_t>& region_pixels() const { return region_pixels_; }
+  // The global pixel index of (frame k, x, y).
+  int64_t PixelIndex(int k, int x, int y) const { return frame_offset_[k] + int64_t(y) * cameras_[k].width() + x; }
+
+  // Fills `batch` with `num_rays` rays from Rng(seed, "ray_batch", step): deterministic for
+  // (seed, step). The first round(region_fraction * num_rays) are drawn uniformly from
+  // region_pixels(), the rest uniformly over all training pixels. With random_background (and
   // alpha), each ray's target is its foreground composited over a random colour that the model
   // also renders over, so the field cannot fake the background with haze (instant-ngp's trick).
-  // With jitter, each ray passes through a uniformly random point of its pixel (the target is the
-  // pixel's average), else through the pixel centre. The same batch for any executor.
-  void SampleBatch(int num_rays, uint64_t seed, int64_t step, bool random_background, bool jitter,
-                   TrainRays* batch, const Executor& executor) const;
+  // The same batch for any executor.
+  void SampleBatch(int num_rays, uint64_t seed, int64_t step, const RaySampling& how, TrainRays* batch,
+                   const Executor& executor) const;
 
  private:
   std::vector<Camera> cameras_;
@@ -41,6 +61,7 @@ class TrainingData {
   std::vector<float> background_;           // [P, 3] the dataset's background behind each pixel
   std::vector<float> alpha_;                // [P] or empty
   bool has_alpha_ = false;
+  std::vector<int64_t> region_pixels_;     // see region_pixels()
 };
 
 }  // namespace icef
