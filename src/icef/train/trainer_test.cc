@@ -400,6 +400,13 @@ TEST(RunConfigTest, ParentsOverridesAndStrictKeys) {
   EXPECT_FALSE(c->ApplyOverride("model.method=icef2").ok());
   EXPECT_FALSE(c->ApplyOverride("train.lambda_id=-1").ok());
   EXPECT_EQ(c->train.lambda_id, 0.5);  // a rejected override changes nothing
+  for (const char* share : {"train.region_rays=1.5", "train.region_rays=-0.1"}) {
+    auto out_of_range = c->ApplyOverride(share);
+    ASSERT_FALSE(out_of_range.ok()) << share;
+    EXPECT_NE(out_of_range.message().find("region_rays"), std::string::npos) << out_of_range.message();
+  }
+  ASSERT_TRUE(c->ApplyOverride("train.region_rays=0").ok());
+  EXPECT_EQ(c->train.region_rays, 0.0);
   std::ofstream(dir / "typo.json") << R"({"trian": {}})";
   EXPECT_FALSE(RunConfig::FromFile(dir / "typo.json").ok());
   std::ofstream(dir / "nan.json") << R"({"train": {"lambda_id": NaN}})";
