@@ -61,7 +61,7 @@ CommandFn RegisterBench(CLI::App& app) {
   app.add_option("--lpips-weights", o.lpips_weights, "LPIPS weights file (without it LPIPS is null)");
   app.add_flag("--keep-models", o.keep_models, "Keep each run's trained model under runs/<name>/model/");
   app.add_option("--merge", args->merge, "Merge these bench directories into --out instead of running");
-  CLI::App* merge = app.add_subcommand("merge", "Build one report from several bench directories (shards, or the same bench over other identity seeds)");
+  CLI::App* merge = app.add_subcommand("merge", "Build one report from several bench directories (shards, or parts of the same bench over other identity seeds, methods or Ks)");
   merge->add_option("dirs", args->merge_inputs, "Bench directories")->required();
   merge->add_option("--out,-o", args->merge_out, "Output directory")->required();
   CLI::App* self = &app;

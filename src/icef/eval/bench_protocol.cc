@@ -1,5 +1,6 @@
 #include "icef/eval/bench_protocol.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <map>
@@ -377,20 +378,35 @@ Status MergeBench(const std::vector<fs::path>& inputs, const fs::path& out_dir, 
   fs::create_directories(out_dir / "runs", ec);
   if (ec) return Status::Error((out_dir / "runs").string() + ": cannot create directory: " + ec.message());
   std::optional<Json> settings;
+  Json union_parts = Json::object();  // "ks", "methods": every value any input ran, in first-seen order
   std::map<std::string, std::pair<std::string, fs::path>> merged;  // run name -> (metrics.json text, source)
   for (const fs::path& in : inputs) {
     if (!fs::is_directory(in / "runs", ec)) return Status::Error(in.string() + ": not a bench directory (no runs/)");
     if (fs::exists(in / "bench.json", ec)) {
       ICEF_ASSIGN_OR_RETURN(Json s, ReadJsonFile(in / "bench.json"));
-      // Which shard, which identities or how many training replicates a directory ran does not make
-      // it another bench: benches of the same protocol over other identity seeds merge like shards.
-      if (s.is_object())
-        for (const char* key : {"shard", "identities", "first_identity_seed", "replicates"}) s.erase(key);
+      // Which shard, which identities, which methods and Ks or how many training replicates a
+      // directory ran does not make it another bench: benches of the same protocol over other
+      // identity seeds, methods or frame counts merge like shards; the merged bench.json lists
+      // every method and K of its inputs.
+      Json parts = Json::object();
+      if (s.is_object()) {
+        for (const char* key : {"ks", "methods"})
+          if (s.contains(key)) parts[key] = s[key];
+        for (const char* key : {"shard", "identities", "first_identity_seed", "replicates", "ks", "methods"})
+          s.erase(key);
+      }
       if (!settings) {
         settings = s;
       } else if (*settings != s) {
         return Status::Error((in / "bench.json").string() + ": settings differ from " +
                              (inputs.front() / "bench.json").string() + " (shards of different benches?)");
+      }
+      for (const auto& [key, values] : parts.items()) {
+        if (!values.is_array()) continue;
+        Json& all = union_parts[key];
+        if (!all.is_array()) all = Json::array();
+        for (const Json& v : values)
+          if (std::find(all.begin(), all.end(), v) == all.end()) all.push_back(v);
       }
     }
     ICEF_ASSIGN_OR_RETURN(const std::vector<RunRecord> records, ReadRunRecords(in));
@@ -415,6 +431,7 @@ Status MergeBench(const std::vector<fs::path>& inputs, const fs::path& out_dir, 
   ICEF_ASSIGN_OR_RETURN(const std::vector<RunRecord> records, ReadRunRecords(out_dir));
   ReportContext context;
   if (settings) {
+    for (const auto& [key, values] : union_parts.items()) (*settings)[key] = values;
     context.settings = *settings;
     ICEF_RETURN_IF_ERROR(WriteFileAtomic(out_dir / "bench.json", FormatJson(*settings)));
     BenchOptions role;

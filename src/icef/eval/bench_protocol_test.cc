@@ -192,6 +192,16 @@ TEST(BenchProtocolTest, MergesShardDirectories) {
   // Other identity seeds of the same protocol merge too.
   ASSERT_TRUE(WriteFileAtomic(dir / "b" / "bench.json", R"({"steps": 10, "identities": 3, "first_identity_seed": 104})").ok());
   EXPECT_TRUE(MergeBench({dir / "a", dir / "b"}, dir / "merged6", log).ok());
+  // So do parts of one bench run by method or by K; the merged bench.json lists all of them.
+  ASSERT_TRUE(WriteFileAtomic(dir / "a" / "bench.json", R"({"steps": 10, "ks": [3, 5], "methods": ["icef"]})").ok());
+  ASSERT_TRUE(WriteFileAtomic(dir / "b" / "bench.json", R"({"steps": 10, "ks": [5], "methods": ["warp", "icef"]})").ok());
+  ASSERT_TRUE(MergeBench({dir / "a", dir / "b"}, dir / "merged7", log).ok()) << log.str();
+  const Result<Json> parts = ReadJsonFile(dir / "merged7" / "bench.json");
+  ASSERT_TRUE(parts.ok());
+  EXPECT_EQ((*parts)["ks"], Json::parse("[3, 5]"));
+  EXPECT_EQ((*parts)["methods"], Json::parse(R"(["icef", "warp"])"));
+  EXPECT_EQ((*parts)["steps"], 10);
+  ASSERT_TRUE(WriteFileAtomic(dir / "a" / "bench.json", R"({"steps": 10, "shard": "0/2"})").ok());
   ASSERT_TRUE(WriteFileAtomic(dir / "b" / "bench.json", R"({"steps": 20, "shard": "1/2"})").ok());
   const Status differ = MergeBench({dir / "a", dir / "b"}, dir / "merged5", log);
   ASSERT_FALSE(differ.ok());
