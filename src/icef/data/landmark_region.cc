@@ -53,23 +53,15 @@ bool InDilatedHull(const std::vector<Vec2d>& hull, const Vec2d& p, double dilati
   return d <= dilation;
 }
 
-// The convex hull of the finite landmarks among `indices`.
-std::vector<Vec2d> HullOf(const std::vector<Vec2f>& landmarks, const std::vector<int>& indices) {
+std::vector<Vec2d> RegionHull(const std::vector<Vec2f>& landmarks) {
   std::vector<Vec2d> points;
-  for (int i : indices) {
+  if (landmarks.empty()) return points;
+  for (int i : ExpressionLandmarkIndices()) {
     if (i >= static_cast<int>(landmarks.size())) continue;
     const Vec2f& l = landmarks[i];
     if (std::isfinite(l.x()) && std::isfinite(l.y())) points.emplace_back(l.x(), l.y());
   }
   return ConvexHull(std::move(points));
-}
-
-std::vector<Vec2d> RegionHull(const std::vector<Vec2f>& landmarks) { return HullOf(landmarks, ExpressionLandmarkIndices()); }
-
-std::vector<int> Range(int first, int last) {
-  std::vector<int> v;
-  for (int i = first; i <= last; ++i) v.push_back(i);
-  return v;
 }
 
 }  // namespace
@@ -95,24 +87,6 @@ Image ExpressionRegion(int width, int height, const std::vector<Vec2f>& frame_la
     for (int x = 0; x < width; ++x) {
       const Vec2d p(x + 0.5, y + 0.5);
       if (InDilatedHull(a, p, dilation) || InDilatedHull(b, p, dilation)) region.At(x, y, 0) = 1.f;
-    }
-  return region;
-}
-
-Image FeatureRegion(int width, int height, const std::vector<Vec2f>& landmarks, int dilation) {
-  static const std::vector<std::vector<int>> kFeatures = {Range(17, 21), Range(22, 26), Range(36, 41), Range(42, 47),
-                                                          Range(48, 67)};
-  std::vector<std::vector<Vec2d>> hulls;
-  for (const std::vector<int>& feature : kFeatures) hulls.push_back(HullOf(landmarks, feature));
-  Image region(width, height, 1, 0.f);
-  for (int y = 0; y < height; ++y)
-    for (int x = 0; x < width; ++x) {
-      const Vec2d p(x + 0.5, y + 0.5);
-      for (const std::vector<Vec2d>& hull : hulls)
-        if (InDilatedHull(hull, p, dilation)) {
-          region.At(x, y, 0) = 1.f;
-          break;
-        }
     }
   return region;
 }

@@ -22,12 +22,6 @@ int DefaultRegionDilation(int width);
 Image ExpressionRegion(int width, int height, const std::vector<Vec2f>& frame_landmarks,
                        const std::vector<Vec2f>& neutral_landmarks, int dilation);
 
-// 1-channel mask (1 inside, 0 outside): the pixels whose centres lie within `dilation` pixels of
-// the 2D convex hull of one of the features: each brow (17-21, 22-26), each eye (36-41, 42-47) and
-// the mouth (48-67). A subset of ExpressionRegion without its neutral: the features alone, without
-// the nose and cheeks between them. Non-finite landmarks are skipped.
-Image FeatureRegion(int width, int height, const std::vector<Vec2f>& landmarks, int dilation);
-
 // 1-channel mask of the pixels whose centres lie in or on the filled 2D convex hull of all finite
 // landmarks. Points outside the image still shape the hull, which the image then clips. Fewer
 // than three non-collinear points: an empty mask.

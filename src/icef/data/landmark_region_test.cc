@@ -48,56 +48,6 @@ int Count(const Image& mask) {
   return n;
 }
 
-// 68 landmarks: each brow, each eye and the mouth a small square of its own, the rest (jaw, nose)
-// at the centre between them.
-std::vector<Vec2f> FeatureSquares() {
-  std::vector<Vec2f> l(68, Vec2f(20, 24));
-  auto square = [&](int first, int last, float x0, float y0) {
-    const Vec2f corners[4] = {{x0, y0}, {x0 + 4, y0}, {x0 + 4, y0 + 4}, {x0, y0 + 4}};
-    for (int i = first; i <= last; ++i) l[i] = corners[(i - first) % 4];
-  };
-  square(17, 21, 4, 4);    // right brow
-  square(22, 26, 32, 4);   // left brow
-  square(36, 41, 4, 14);   // right eye
-  square(42, 47, 32, 14);  // left eye
-  square(48, 67, 18, 34);  // mouth
-  return l;
-}
-
-TEST(LandmarkRegionTest, FeatureRegionIsEachFeaturesOwnHull) {
-  const std::vector<Vec2f> l = FeatureSquares();
-  const Image features = FeatureRegion(40, 40, l, 1);
-  const Image hull = ExpressionRegion(40, 40, l, {}, 1);
-  for (auto [x, y] : {std::pair{5, 5}, {33, 5}, {5, 15}, {33, 15}, {19, 35}}) {
-    EXPECT_EQ(features.At(x, y, 0), 1.f) << x << "," << y;  // inside each feature
-    EXPECT_EQ(hull.At(x, y, 0), 1.f) << x << "," << y;
-  }
-  EXPECT_EQ(features.At(8, 5, 0), 1.f);   // centre 8.5 is 0.5 px beyond the brow: within the dilation
-  EXPECT_EQ(features.At(10, 5, 0), 0.f);  // 2.5 px beyond
-  // The nose and cheeks between the features lie in the hull over them, not in a feature.
-  EXPECT_EQ(features.At(20, 24, 0), 0.f);
-  EXPECT_EQ(hull.At(20, 24, 0), 1.f);
-  EXPECT_EQ(features.At(12, 26, 0), 0.f);
-  EXPECT_EQ(hull.At(12, 26, 0), 1.f);
-  int in_features = 0, in_hull = 0;
-  for (size_t i = 0; i < features.pixels.size(); ++i) {
-    in_features += features.pixels[i] > 0.5f;
-    in_hull += hull.pixels[i] > 0.5f;
-    if (features.pixels[i] > 0.5f) EXPECT_EQ(hull.pixels[i], 1.f) << "pixel " << i << " is a feature's, not the hull's";
-  }
-  // Five 4x4 squares grown by about a pixel on each side, 16 to 36 pixel centres each.
-  EXPECT_GE(in_features, 5 * 16);
-  EXPECT_LE(in_features, 5 * 36);
-  EXPECT_GT(in_hull, 3 * in_features);
-  // A missing feature (non-finite landmarks) adds nothing; the others stay.
-  std::vector<Vec2f> no_mouth = l;
-  for (int i = 48; i < 68; ++i) no_mouth[i] = Vec2f(std::nanf(""), 0);
-  const Image without = FeatureRegion(40, 40, no_mouth, 1);
-  EXPECT_EQ(without.At(19, 35, 0), 0.f);
-  EXPECT_EQ(without.At(5, 15, 0), 1.f);
-  EXPECT_EQ(Count(FeatureRegion(40, 40, {}, 1)), 0);
-}
-
 TEST(LandmarkRegionTest, HullRegionIsTheFilledLandmarkHull) {
   // A square [2, 10]^2 of landmarks (corners, edge midpoints, the centre), plus unusable points.
   const float nan = std::nanf("");

@@ -44,9 +44,6 @@ void TrainConfig::Bind(ConfigSchema& s) {
            "share of each step's rays drawn from the training frames' expression regions (brows, eyes and mouth "
            "by their 2D landmarks, the region icef eval scores expressions in; frames without landmarks add none); "
            "the rest over all pixels (0 = all uniform)");
-  s.String("region_rays_area", &region_rays_area,
-           "where the region rays come from: \"hull\", the convex hull over brows, eyes and mouth (nose and cheeks "
-           "between them included), or \"features\", each brow, eye and the mouth by its own hull");
   s.Int("grid_anneal_steps", &grid_anneal_steps,
         "coarse-to-fine hash grid: levels beyond the 4 coarsest switch on over these steps (0 = off)");
   s.Int("anneal_steps", &anneal_steps, "coarse-to-fine: deformation frequencies switch on over these steps (0 = off)");
@@ -98,8 +95,6 @@ Status TrainConfig::Validate() const {
   if (!non_negative(time_budget_seconds)) return Status::Error("train.time_budget_seconds must be >= 0");
   if (batch_rays < 1) return Status::Error("train.batch_rays must be >= 1");
   if (!(region_rays >= 0 && region_rays <= 1)) return Status::Error("train.region_rays must be in [0, 1]");
-  if (region_rays_area != "hull" && region_rays_area != "features")
-    return Status::Error("train.region_rays_area must be \"hull\" or \"features\", got \"" + region_rays_area + "\"");
   if (!positive(lr_grid) || !positive(lr_mlp) || !positive(lr_deform))
     return Status::Error("train.lr_grid, lr_mlp and lr_deform must be positive");
   if (!positive(lr_final_factor) || lr_final_factor > 1) return Status::Error("train.lr_final_factor must be in (0, 1]");

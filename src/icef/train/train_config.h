@@ -49,9 +49,6 @@ struct TrainConfig {
   // drawn over all pixels. Frames without landmarks contribute no region. Validation 101-104, two
   // training seeds: docs/results/region_rays.
   double region_rays = 0.15;
-  // Where those rays come from: "hull", the convex hull over brows, eyes and mouth (nose and
-  // cheeks between them included), or "features", each feature's own hull (data/landmark_region.h).
-  std::string region_rays_area = "hull";
   bool random_background = true;     // train over random background colours (images with alpha only)
   int grid_anneal_steps = kDefaultGridAnnealSteps;  // coarse-to-fine hash grid: levels beyond the 4 coarsest switch on over these steps (0 = off)
   int anneal_steps = kDefaultAnnealSteps;  // coarse-to-fine: deformation frequencies are switched on over these steps (0 = off)

@@ -241,7 +241,6 @@ Result<LossTerms> Trainer::Step() {
   how.random_background = t.random_background;
   how.jitter = t.pixel_jitter;
   how.region_fraction = t.region_rays;
-  how.features_only = t.region_rays_area == "features";
   data_.SampleBatch(t.batch_rays, seed, state_.step, how, &batch_, executor_);
   const LossWeights w = t.Losses(data_.has_alpha());
   const LossTerms terms = model_->TrainForwardBackward(batch_, w, seed, state_.step, executor_);

@@ -6,7 +6,6 @@
 #include <cmath>
 #include <fstream>
 #include <iostream>
-#include <set>
 
 #include "icef/data/landmark_region.h"
 #include "icef/model/render_image.h"
@@ -145,40 +144,6 @@ TEST(TrainingDataTest, RegionRaysComeFromEachFramesExpressionRegion) {
   TrainRays bare_batch;
   bare_data->SampleBatch(400, 5, 7, quarter, &bare_batch, Executor(2));
   for (int r = 0; r < 400; ++r) EXPECT_EQ(bare_batch.rays[r].direction, uniform.rays[r].direction);
-}
-
-TEST(TrainingDataTest, FeatureRaysComeFromEachFramesFeatures) {
-  const Dataset& dataset = TinySubject();
-  auto data = TrainingData::Load(dataset);
-  ASSERT_TRUE(data.ok()) << data.status().message();
-  std::vector<Image> features;
-  size_t expected = 0;
-  for (const Frame& f : dataset.train) {
-    const int w = f.camera.width(), h = f.camera.height();
-    features.push_back(FeatureRegion(w, h, *f.landmarks_2d, DefaultRegionDilation(w)));
-    for (float v : features.back().pixels) expected += v > 0.f;
-  }
-  ASSERT_GT(expected, 0u);
-  EXPECT_EQ(data->feature_pixels().size(), expected);
-  EXPECT_LT(expected, data->region_pixels().size());  // the features without the face between them
-  const std::set<int64_t> region(data->region_pixels().begin(), data->region_pixels().end());
-  for (int64_t p : data->feature_pixels()) EXPECT_TRUE(region.count(p)) << "feature pixel " << p << " outside the region";
-
-  RaySampling quarter;
-  quarter.region_fraction = 0.25;
-  quarter.features_only = true;
-  TrainRays batch, hull;
-  data->SampleBatch(400, 5, 7, quarter, &batch, Executor(2));
-  quarter.features_only = false;
-  data->SampleBatch(400, 5, 7, quarter, &hull, Executor(2));
-  int hull_outside_features = 0;
-  for (int r = 0; r < 100; ++r) {
-    const auto [k, x, y] = RayPixel(*data, batch, r);
-    EXPECT_EQ(features[k].At(x, y, 0), 1.f) << "ray " << r << ": frame " << k << " pixel " << x << "," << y;
-    const auto [kh, xh, yh] = RayPixel(*data, hull, r);
-    hull_outside_features += features[kh].At(xh, yh, 0) == 0.f;
-  }
-  EXPECT_GT(hull_outside_features, 10);  // the hull's rays land between the features too
 }
 
 TEST(TrainerTest, TrainingLowersLossAndRaisesPsnr) {
@@ -440,11 +405,6 @@ TEST(RunConfigTest, ParentsOverridesAndStrictKeys) {
     ASSERT_FALSE(out_of_range.ok()) << share;
     EXPECT_NE(out_of_range.message().find("region_rays"), std::string::npos) << out_of_range.message();
   }
-  auto area = c->ApplyOverride("train.region_rays_area=eyes");
-  ASSERT_FALSE(area.ok());
-  EXPECT_NE(area.message().find("region_rays_area"), std::string::npos) << area.message();
-  ASSERT_TRUE(c->ApplyOverride("train.region_rays_area=features").ok());
-  EXPECT_EQ(c->train.region_rays_area, "features");
   ASSERT_TRUE(c->ApplyOverride("train.region_rays=0").ok());
   EXPECT_EQ(c->train.region_rays, 0.0);
   std::ofstream(dir / "typo.json") << R"({"trian": {}})";

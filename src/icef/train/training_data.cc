@@ -43,15 +43,11 @@ Result<TrainingData> TrainingData::Load(const Dataset& dataset) {
       }
     }
     if (dataset.train[k].landmarks_2d) {
-      const int dilation = DefaultRegionDilation(img.width);
-      const Image region = ExpressionRegion(img.width, img.height, *dataset.train[k].landmarks_2d, {}, dilation);
-      const Image features = FeatureRegion(img.width, img.height, *dataset.train[k].landmarks_2d, dilation);
+      const Image region = ExpressionRegion(img.width, img.height, *dataset.train[k].landmarks_2d, {},
+                                            DefaultRegionDilation(img.width));
       for (int y = 0; y < img.height; ++y)
-        for (int x = 0; x < img.width; ++x) {
-          const int64_t pixel = data.PixelIndex(static_cast<int>(k), x, y);
-          if (region.At(x, y, 0) > 0.f) data.region_pixels_.push_back(pixel);
-          if (features.At(x, y, 0) > 0.f) data.feature_pixels_.push_back(pixel);
-        }
+        for (int x = 0; x < img.width; ++x)
+          if (region.At(x, y, 0) > 0.f) data.region_pixels_.push_back(data.PixelIndex(static_cast<int>(k), x, y));
     }
   }
   return data;
@@ -85,12 +81,11 @@ void TrainingData::SampleBatch(int num_rays, uint64_t seed, int64_t step, const 
     double ju, jv;
   };
   std::vector<PixelDraw> draws(num_rays);
-  const std::vector<int64_t>& region = how.features_only ? feature_pixels_ : region_pixels_;
   const int from_region =
-      region.empty() ? 0 : static_cast<int>(std::lround(std::clamp(how.region_fraction, 0.0, 1.0) * num_rays));
+      region_pixels_.empty() ? 0 : static_cast<int>(std::lround(std::clamp(how.region_fraction, 0.0, 1.0) * num_rays));
   for (int r = 0; r < num_rays; ++r) {
     PixelDraw& d = draws[r];
-    d.pixel = r < from_region ? uint64_t(region[rng.Below(region.size())]) : rng.Below(total);
+    d.pixel = r < from_region ? uint64_t(region_pixels_[rng.Below(region_pixels_.size())]) : rng.Below(total);
     d.ju = jitter ? jitter_rng.Uniform() : 0.5;
     d.jv = jitter ? jitter_rng.Uniform() : 0.5;
     for (int a = 0; a < 3 && random; ++a) batch->background[3 * r + a] = static_cast<float>(bg_rng.Uniform());

@@ -21,9 +21,6 @@ struct RaySampling {
   // eyes and mouth by their 2D landmarks: data/landmark_region.h); the rest uniformly over all
   // pixels. 0 with no frame with landmarks.
   double region_fraction = 0;
-  // Those rays from the features alone (brows, eyes, mouth: feature_pixels()) instead of the hull
-  // over them (region_pixels()).
-  bool features_only = false;
 };
 
 class TrainingData {
@@ -43,15 +40,12 @@ class TrainingData {
   // frame's ExpressionRegion of its own 2D landmarks, dilated by DefaultRegionDilation. Empty
   // when no frame has landmarks.
   const std::vector<int64_t>& region_pixels() const { return region_pixels_; }
-  // Pixels in the training frames' features: each frame's FeatureRegion of its own 2D landmarks,
-  // dilated by DefaultRegionDilation (a subset of region_pixels()).
-  const std::vector<int64_t>& feature_pixels() const { return feature_pixels_; }
   // The global pixel index of (frame k, x, y).
   int64_t PixelIndex(int k, int x, int y) const { return frame_offset_[k] + int64_t(y) * cameras_[k].width() + x; }
 
   // Fills `batch` with `num_rays` rays from Rng(seed, "ray_batch", step): deterministic for
   // (seed, step). The first round(region_fraction * num_rays) are drawn uniformly from
-  // region_pixels() (feature_pixels() with features_only), the rest uniformly over all training pixels. With random_background (and
+  // region_pixels(), the rest uniformly over all training pixels. With random_background (and
   // alpha), each ray's target is its foreground composited over a random colour that the model
   // also renders over, so the field cannot fake the background with haze (instant-ngp's trick).
   // The same batch for any executor.
@@ -68,7 +62,6 @@ class TrainingData {
   std::vector<float> alpha_;                // [P] or empty
   bool has_alpha_ = false;
   std::vector<int64_t> region_pixels_;     // see region_pixels()
-  std::vector<int64_t> feature_pixels_;    // see feature_pixels()
 };
 
 }  // namespace icef
