@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # icef synth end to end: a tiny dataset, read back by `icef info`, rendered twice to the same
 # bytes, the expression style (style.json, --generic-style), the face model fitted to it (icef
-# mask), a contact sheet from `icef sheet`, and a bad option rejected with exit code 1.
+# mask), a contact sheet from `icef sheet`, the drawn resolution's cap (--max-res), and a bad
+# option rejected with exit code 1.
 set -euo pipefail
 ICEF="$1"
 WORK="$(mktemp -d)"
@@ -45,6 +46,22 @@ awk -v r="$rms" 'BEGIN { exit !(r < 0.1) }' || { echo "face fit RMS $rms IOD (st
 
 "$ICEF" sheet "$WORK/a" --out "$WORK/sheet.png" --tile 32 > /dev/null
 test -s "$WORK/sheet.png"
+
+# --diverse --max-res: the drawn resolution stays within the cap (icef bench --validation draws up
+# to 256); a cap of 128 leaves 128 alone; a cap below 128 is refused.
+drawn_res() {
+  "$ICEF" synth --out "$WORK/$1" --diverse --identity-seed 102 --max-res "$2" --k 3 --test-views 1 --novel-per-tier 1 \
+    --supersample 1 --threads 2 > /dev/null
+  sed -n 's/^ *"resolution": \([0-9]*\),*$/\1/p' "$WORK/$1/scene.json"
+}
+r=$(drawn_res d256 256)
+case "$r" in 128|160|192|256) ;; *) echo "--max-res 256 drew resolution '$r'" >&2; exit 1 ;; esac
+r=$(drawn_res d128 128)
+test "$r" = 128 || { echo "--max-res 128 drew resolution '$r'" >&2; exit 1; }
+if "$ICEF" synth --out "$WORK/d100" --diverse --max-res 100 2> /dev/null; then
+  echo "--max-res 100 was accepted" >&2
+  exit 1
+fi
 
 set +e
 "$ICEF" synth --out "$WORK/c" --near 0.9 --far 0.5 2> "$WORK/err.txt"

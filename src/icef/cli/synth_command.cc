@@ -1,5 +1,5 @@
 // icef synth --out DIR [--identity-seed N --generic-style --k K --res R --test-views V
-//   --novel-per-tier N --near T0 --far T1 --diverse --vary AXES --pin AXES --threads T
+//   --novel-per-tier N --near T0 --far T1 --diverse --max-res R --vary AXES --pin AXES --threads T
 //   --contact-sheet FILE.png]
 // icef synth --photos N --out DIR [--identity-seed N --generic-style --res-photo WxH
 //   --background-seed S --supersample S --threads T]
@@ -52,6 +52,11 @@ CommandFn RegisterSynth(CLI::App& app) {
   app.add_flag("--diverse", *diverse,
                "Draw every scene axis per identity seed (skin, lighting, placement, camera, views, resolution, "
                "detail; see scene.json) instead of the classic studio scene; --res pins the resolution");
+  app.add_option("--max-res", o.max_drawn_resolution,
+                 "Largest resolution the drawn resolution axis picks (from 128, 160, 192, 256, 320, 384, 448, 512; "
+                 "icef bench --validation draws up to 256: --max-res 256 makes its datasets)")
+      ->capture_default_str()
+      ->check(CLI::Range(128, 4096));
   app.add_option("--vary", *vary, "Draw these scene axes per identity seed (comma-separated axis names)")
       ->delimiter(',');
   app.add_option("--pin", *pin, "Keep these scene axes at the classic values (with --diverse)")->delimiter(',');
@@ -70,7 +75,7 @@ CommandFn RegisterSynth(CLI::App& app) {
                  "Photo-set mode: seed of the procedural backgrounds (0: derived from the identity seed)")
       ->capture_default_str()
       ->needs(photos);
-  for (const char* dataset_only : {"--k", "--res", "--test-views", "--novel-per-tier", "--near", "--far"})
+  for (const char* dataset_only : {"--k", "--res", "--max-res", "--test-views", "--novel-per-tier", "--near", "--far"})
     photos->excludes(app.get_option(dataset_only));
   photos->excludes(contact);
   for (const char* scene : {"--diverse", "--vary", "--pin"}) photos->excludes(app.get_option(scene));
