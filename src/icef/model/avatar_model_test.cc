@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "icef/core/rng.h"
 #include "icef/model/identity_losses.h"
@@ -387,11 +388,18 @@ TEST(AvatarModelTest, TrainLossGradientMatchesFiniteDifferences) {
   for (const char* method : {"icef", "nerface"}) {
     auto model = MakeModel(method, 0.05f);
     model->static_field().SetLevelWeights({1.f, 0.8f, 0.4f, 0.1f});  // coarse-to-fine scaling too
-    const TrainRays batch = testing_model::RandomBatch(24, 5);
+    TrainRays batch = testing_model::RandomBatch(24, 5);
+    // L_depth on every other ray (NaN: no target), beside L_dist on the same sample weights; its
+    // weight is large enough that a wrong sign of its gradient fails the check.
+    Rng depth_rng(5, StreamId("depth_target"));
+    for (int r = 0; r < 24; ++r)
+      batch.depth_target.push_back(r % 2 ? std::numeric_limits<float>::quiet_NaN()
+                                         : static_cast<float>(depth_rng.Uniform(1.5, 2.5)));
     LossWeights w;
     w.lambda_id = 0.5;
     w.lambda_mask = 0.2;
     w.lambda_distortion = 0.01 * std::sqrt(3.0);  // distances in aabb diagonals (sqrt 3 here)
+    w.lambda_depth_prior = 300.0;
     w.lambda_symmetry = 0.3;  // mirrored samples through the warp and both fields
     w.symmetry_colour = 0.0;  // its colour weight is a stop-gradient (symmetry_loss_test checks that part)
     w.symmetry_max_samples = 64;

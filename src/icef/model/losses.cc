@@ -8,6 +8,7 @@
 #include "icef/model/identity_losses.h"
 #include "icef/model/model_workspace.h"
 #include "icef/model/symmetry_loss.h"
+#include "icef/render/depth_loss.h"
 #include "icef/render/distortion_loss.h"
 #include "icef/render/occlusion_loss.h"
 
@@ -113,7 +114,7 @@ class DistortionTerm final : public Loss {
     ModelWorkspace& ws = ctx.ws;
     const int64_t num_rays = static_cast<int64_t>(ctx.batch.rays.size());
     const double inv_r = InvRays(ctx), inv_diag = 1.0 / ctx.setup.aabb.Extent().norm();
-    Fit(ws.d_weights, ws.samples.size());  // the only term on the sample weights: it overwrites them
+    Fit(ws.d_weights, ws.samples.size());  // the first term on the sample weights: it overwrites them
     double dist = 0;
     for (int64_t r = 0; r < num_rays; ++r) {
       const int64_t off = ws.samples.ray_offset[r], cnt = ws.samples.ray_count[r];
@@ -123,6 +124,36 @@ class DistortionTerm final : public Loss {
                                        static_cast<float>(weight * inv_r * inv_diag), &ws.d_weights[off]);
     }
     return dist * inv_r * inv_diag;
+  }
+};
+
+// L_depth: a ray's compositing-weighted depth against the fitted face model's depth on it
+// (TrainRays::depth_target, NaN = none; render/depth_loss.h), distances in aabb diagonals:
+//   E_r = sum_i w_i (t_i - t*_r) / diag,   L_depth = mean over the batch's rays of E_r^2
+// (rays without a target count 0). The first moment only: opacity is left to L_photo and L_mask.
+class DepthPriorTerm final : public Loss {
+ public:
+  std::string_view name() const override { return "depth"; }
+  LossStage stage() const override { return LossStage::kRays; }
+  double Weight(const LossContext& ctx) const override {
+    return ctx.batch.depth_target.empty() ? 0.0 : ctx.weights.lambda_depth_prior;
+  }
+  double Evaluate(LossContext& ctx, double weight) override {
+    ModelWorkspace& ws = ctx.ws;
+    const int64_t num_rays = static_cast<int64_t>(ctx.batch.rays.size());
+    ICEF_CHECK(int64_t(ctx.batch.depth_target.size()) == num_rays, "depth_target size");
+    const double inv_r = InvRays(ctx), inv_diag = 1.0 / ctx.setup.aabb.Extent().norm();
+    if (ws.d_weights.size() != ws.samples.size()) ws.d_weights.assign(ws.samples.size(), 0.f);
+    const float scale = static_cast<float>(weight * inv_r * inv_diag * inv_diag);
+    double loss = 0;
+    for (int64_t r = 0; r < num_rays; ++r) {
+      const float target = ctx.batch.depth_target[r];
+      const int64_t off = ws.samples.ray_offset[r], cnt = ws.samples.ray_count[r];
+      if (!std::isfinite(target) || cnt == 0) continue;
+      loss += DepthMomentLossRay<float>(static_cast<int>(cnt), &ws.composite.weights[off], &ws.samples.t[off], target,
+                                        scale, &ws.d_weights[off]) * inv_diag * inv_diag;
+    }
+    return loss * inv_r;
   }
 };
 
@@ -302,6 +333,7 @@ std::vector<std::unique_ptr<Loss>> MakeLosses() {
   losses.push_back(std::make_unique<PhotoTerm>());
   losses.push_back(std::make_unique<MaskTerm>());
   losses.push_back(std::make_unique<DistortionTerm>());
+  losses.push_back(std::make_unique<DepthPriorTerm>());  // after DistortionTerm, which overwrites d_weights
   losses.push_back(std::make_unique<OcclusionTerm>());
   losses.push_back(std::make_unique<SymmetryTerm>());
   losses.push_back(std::make_unique<IdTerm>());

@@ -1,6 +1,7 @@
 // The training objective as a list of loss terms (DESIGN.md §2):
 //   L = L_photo + lambda_mask L_mask + lambda_id L_id + lambda_smooth L_smooth
-//       + lambda_distortion L_dist + lambda_occlusion L_occ + lambda_symmetry L_sym.
+//       + lambda_distortion L_dist + lambda_occlusion L_occ + lambda_symmetry L_sym
+//       + lambda_depth_prior L_depth.
 // Each term is a small type behind one interface (name, weight, value, gradient). AvatarModel's
 // training step runs them in stages along its backward pass, and everything that reports losses
 // (the trainer's log, its NaN guard, the summary) loops over the list they produce.
@@ -37,6 +38,7 @@ struct LossWeights {
   double lambda_distortion = 0.0;
   double lambda_occlusion = 0.0;
   double lambda_symmetry = 0.0;
+  double lambda_depth_prior = 0.0;   // L_depth: rays with a face-model depth (TrainRays::depth_target)
   double symmetry_colour = 0.0;      // weight of the colour part of L_sym (model/symmetry_loss.h)
   int symmetry_max_samples = 4096;   // cap on the samples mirrored by L_sym per batch
   double smooth_epsilon = 0.01;      // finite-difference offset of L_smooth, in half-extent units of the aabb
@@ -45,7 +47,7 @@ struct LossWeights {
 
 // One term's share of a batch's loss.
 struct LossValue {
-  std::string name;   // "photo", "mask", "id", "smooth", "distortion", "occlusion", "symmetry"
+  std::string name;   // "photo", "mask", "id", "smooth", "distortion", "occlusion", "symmetry", "depth"
   double weight = 0;  // the weight it entered L with (0: not evaluated, value 0)
   double value = 0;   // the term itself (mean over the batch's rays or samples)
 };
@@ -73,6 +75,8 @@ struct TrainRays {
   std::vector<float> target_alpha;    // [R] foreground mask, or empty when the images have no alpha
   std::vector<float> background;      // [R, 3] per-ray background the targets are composited over, or
                                       // empty for setup.background
+  std::vector<float> depth_target;    // [R] ray parameter t where the fitted face model's surface is
+                                      // hit (train.lambda_depth_prior), NaN where there is none; or empty
 };
 
 struct ModelWorkspace;  // model/model_workspace.h

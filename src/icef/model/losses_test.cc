@@ -18,7 +18,7 @@ namespace {
 using testing_model::TinyModelConfig;
 using testing_model::TinySetup;
 
-const std::vector<std::string> kTerms = {"photo", "mask", "distortion", "occlusion", "symmetry", "id", "smooth"};
+const std::vector<std::string> kTerms = {"photo", "mask", "distortion", "depth", "occlusion", "symmetry", "id", "smooth"};
 
 // coarse: a coarse grid, visible opacities and a field with structure (random offsets on every
 // parameter), as the finite-difference checks need (see symmetry_loss_test.cc).
@@ -43,7 +43,16 @@ std::unique_ptr<AvatarModel> MakeModel(const std::string& method, bool coarse = 
   return std::move(model).value();
 }
 
-TrainRays Batch(bool alpha) { return testing_model::RandomBatch(24, 5, alpha); }
+// depth: a face-model depth on every other ray (L_depth), NaN on the rest.
+TrainRays Batch(bool alpha, bool depth = true) {
+  TrainRays batch = testing_model::RandomBatch(24, 5, alpha);
+  if (depth) {
+    Rng rng(5, StreamId("depth_target"));
+    for (int r = 0; r < 24; ++r)
+      batch.depth_target.push_back(r % 2 ? NAN : static_cast<float>(rng.Uniform(1.5, 2.5)));
+  }
+  return batch;
+}
 
 LossWeights AllOn() {
   LossWeights w;
@@ -51,6 +60,7 @@ LossWeights AllOn() {
   w.lambda_smooth = 0.01;
   w.lambda_mask = 0.2;
   w.lambda_distortion = 0.02;
+  w.lambda_depth_prior = 30.0;
   w.lambda_occlusion = 0.1;
   w.lambda_symmetry = 0.3;
   w.symmetry_max_samples = 64;
@@ -80,21 +90,25 @@ TEST(LossesTest, EveryTermListedOnceAndTheTotalIsTheirWeightedSum) {
     EXPECT_GT(t.samples, 0);
     EXPECT_TRUE(t.AllFinite());
     const bool identity = method == "icef";
-    EXPECT_EQ(t.terms[5].weight, identity ? w.lambda_id : 0.0) << method;
-    EXPECT_EQ(t.terms[6].weight, identity ? w.lambda_smooth : 0.0) << method;
+    EXPECT_EQ(t.terms[3].weight, w.lambda_depth_prior) << method;
+    EXPECT_GT(t.Get("depth"), 0.0) << method;
+    EXPECT_EQ(t.terms[6].weight, identity ? w.lambda_id : 0.0) << method;
+    EXPECT_EQ(t.terms[7].weight, identity ? w.lambda_smooth : 0.0) << method;
     if (identity) {
       EXPECT_GT(t.Get("id"), 0.0);
     } else {
       EXPECT_EQ(t.Get("id"), 0.0) << method;
     }
     // nerface has no canonical space: no symmetry prior.
-    EXPECT_EQ(t.terms[4].weight, method == "nerface" ? 0.0 : w.lambda_symmetry) << method;
+    EXPECT_EQ(t.terms[5].weight, method == "nerface" ? 0.0 : w.lambda_symmetry) << method;
   }
-  // Without alpha the mask term has nothing to act on.
+  // Without alpha the mask term has nothing to act on, without depth targets the depth term.
   auto model = MakeModel("icef");
-  const LossTerms t = model->TrainForwardBackward(Batch(false), AllOn(), 3, 0, Executor(1));
+  const LossTerms t = model->TrainForwardBackward(Batch(false, false), AllOn(), 3, 0, Executor(1));
   EXPECT_EQ(t.terms[1].weight, 0.0);
   EXPECT_EQ(t.Get("mask"), 0.0);
+  EXPECT_EQ(t.terms[3].weight, 0.0);
+  EXPECT_EQ(t.Get("depth"), 0.0);
 }
 
 TEST(LossesTest, FirstNonFiniteNamesTheTerm) {
@@ -125,6 +139,7 @@ TEST(LossesTest, EachTermsGradientIsItsWeightTimesItsDerivative) {
   };
   const std::vector<Case> cases = {{"mask", &LossWeights::lambda_mask},
                                    {"distortion", &LossWeights::lambda_distortion},
+                                   {"depth", &LossWeights::lambda_depth_prior},
                                    {"symmetry", &LossWeights::lambda_symmetry},
                                    {"id", &LossWeights::lambda_id},
                                    {"smooth", &LossWeights::lambda_smooth}};

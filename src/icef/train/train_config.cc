@@ -29,6 +29,10 @@ void TrainConfig::Bind(ConfigSchema& s) {
   s.Number("lambda_symmetry", &lambda_symmetry,
            "weight of the left-right symmetry prior: opacity (and colour) of canonical samples against their "
            "mirror images across the face's landmark symmetry plane (few-shot prior; 0 = off)");
+  s.Number("lambda_depth_prior", &lambda_depth_prior,
+           "weight of L_depth: each training ray through the expression regions (brows, eyes, mouth) pulled to "
+           "the depth at which it meets the fitted face model at its frame's expression, distances in aabb "
+           "diagonals (icef-prior, warp-prior; 0 = off)");
   s.Number("symmetry_colour", &symmetry_colour,
            "weight of the symmetry prior's colour part relative to its opacity part (0 = geometry only)");
   s.Int("symmetry_max_samples", &symmetry_max_samples, "samples per step mirrored by the symmetry prior");
@@ -79,6 +83,7 @@ LossWeights TrainConfig::Losses(bool has_alpha) const {
   w.lambda_smooth = lambda_smooth;
   w.lambda_mask = has_alpha ? lambda_mask : 0.0;
   w.lambda_distortion = lambda_distortion;
+  w.lambda_depth_prior = lambda_depth_prior;
   w.lambda_occlusion = lambda_occlusion;
   w.lambda_symmetry = lambda_symmetry;
   w.symmetry_colour = symmetry_colour;
@@ -103,6 +108,7 @@ Status TrainConfig::Validate() const {
   if (!non_negative(lambda_smooth)) return Status::Error("train.lambda_smooth must be a finite number >= 0");
   if (!non_negative(lambda_mask)) return Status::Error("train.lambda_mask must be a finite number >= 0");
   if (!non_negative(lambda_distortion)) return Status::Error("train.lambda_distortion must be a finite number >= 0");
+  if (!non_negative(lambda_depth_prior)) return Status::Error("train.lambda_depth_prior must be a finite number >= 0");
   if (!non_negative(lambda_occlusion)) return Status::Error("train.lambda_occlusion must be a finite number >= 0");
   if (!non_negative(lambda_symmetry)) return Status::Error("train.lambda_symmetry must be a finite number >= 0");
   if (!non_negative(symmetry_colour)) return Status::Error("train.symmetry_colour must be a finite number >= 0");

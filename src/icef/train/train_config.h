@@ -37,6 +37,9 @@ struct TrainConfig {
   int smooth_max_samples = LossWeights{}.smooth_max_samples;  // boundary samples per step used by L_smooth
   double lambda_occlusion = 1e-4;    // weight of the occlusion sparsity prior (0 = off)
   double lambda_symmetry = 0.1;      // weight of the left-right symmetry prior L_sym (0 = off)
+  // Weight of L_depth: the expression regions' training rays pulled to the fitted face model's depth
+  // (methods on the face-model prior; 0 = off; train/face_depth.h).
+  double lambda_depth_prior = 0.0;
   double symmetry_colour = LossWeights{}.symmetry_colour;  // weight of L_sym's colour part relative to its opacity part
   int symmetry_max_samples = LossWeights{}.symmetry_max_samples;  // samples per step mirrored by L_sym
   // Training rays through random points of their pixels (true) or through the centres (false, the

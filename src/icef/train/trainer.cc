@@ -12,6 +12,7 @@
 #include "icef/model/prior_light.h"
 #include "icef/model/render_image.h"
 #include "icef/train/density_start.h"
+#include "icef/train/face_depth.h"
 #include "icef/train/visual_hull.h"
 
 namespace icef {
@@ -60,6 +61,10 @@ Trainer::Trainer(const Dataset& dataset, fs::path model_dir, RunConfig config, T
       data_(std::move(data)),
       model_(std::move(model)),
       executor_(config_.train.threads) {
+  // L_depth's targets: a function of the data and the fit alone, so a resumed run recomputes them.
+  if (config_.train.lambda_depth_prior > 0 && model_->setup().face_fit)
+    data_.SetDepthTargets(FaceModelDepthTargets(*model_->setup().face_fit, data_, model_->setup().training_expressions,
+                                                executor_));
   adam_ = std::make_unique<nn::Adam>(MakeAdamOptions(), &model_->store());
   ApplySchedules();
 }

@@ -345,6 +345,37 @@ TEST(TrainerTest, DensityStartSeedsTheFittedHeadOnThePriorOnly) {
   EXPECT_FALSE(bad.Validate().ok());
 }
 
+// train.lambda_depth_prior: L_depth enters the loss on the face-model prior only (the icef method
+// has no fitted face model to take depths from), and resuming keeps it.
+TEST(TrainerTest, DepthPriorActsOnThePriorOnly) {
+  for (const std::string method : {"icef-prior", "icef"}) {
+    RunConfig config = SmallConfig(method);
+    config.train.lambda_depth_prior = 10;
+    config.train.checkpoint_every = 0;
+    config.train.steps = 3;
+    config.train.region_rays = 0.5;  // the targets lie in the expression regions
+    const fs::path dir = testing::MakeTempDir("trainer_depth_prior_" + method);
+    auto trainer = Trainer::Create(TinySubject(), dir, config);
+    ASSERT_TRUE(trainer.ok()) << trainer.status().message();
+    const bool prior = method == "icef-prior";
+    for (int step = 0; step < 2; ++step) {
+      Result<LossTerms> terms = (*trainer)->Step();
+      ASSERT_TRUE(terms.ok()) << terms.status().message();
+      EXPECT_EQ(terms->Get("depth") > 0, prior) << method;
+    }
+    if (!prior) continue;
+    ASSERT_TRUE((*trainer)->SaveCheckpoint().ok());
+    auto resumed = Trainer::Resume(TinySubject(), dir, std::nullopt, std::nullopt, std::nullopt);
+    ASSERT_TRUE(resumed.ok()) << resumed.status().message();
+    Result<LossTerms> terms = (*resumed)->Step();
+    ASSERT_TRUE(terms.ok()) << terms.status().message();
+    EXPECT_GT(terms->Get("depth"), 0);
+  }
+  RunConfig bad = SmallConfig("icef-prior");
+  bad.train.lambda_depth_prior = -1;
+  EXPECT_FALSE(bad.Validate().ok());
+}
+
 // train.start_trials tries that many initialisations for start_trial_steps steps and trains the
 // one with the lowest late batch loss from the start: the same choice every time, and trial 0 is
 // the run's own initialisation.

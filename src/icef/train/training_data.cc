@@ -61,6 +61,11 @@ Image TrainingData::Alpha(int k) const {
   return out;
 }
 
+void TrainingData::SetDepthTargets(std::vector<float> depth) {
+  ICEF_CHECK(depth.empty() || depth.size() == frame_of_pixel_.size(), "depth targets: one per training pixel");
+  depth_ = std::move(depth);
+}
+
 void TrainingData::SampleBatch(int num_rays, uint64_t seed, int64_t step, const RaySampling& how, TrainRays* batch,
                                const Executor& executor) const {
   batch->rays.resize(num_rays);
@@ -68,6 +73,7 @@ void TrainingData::SampleBatch(int num_rays, uint64_t seed, int64_t step, const 
   batch->target_rgb.resize(3 * size_t(num_rays));
   batch->target_alpha.resize(has_alpha_ ? num_rays : 0);
   batch->background.resize(3 * size_t(num_rays));
+  batch->depth_target.resize(depth_.empty() ? 0 : num_rays);
   const bool random = how.random_background && has_alpha_;
   const bool jitter = how.jitter;
   // The draws in ray order on the caller (three streams, each consumed in order), then the rays and
@@ -105,6 +111,8 @@ void TrainingData::SampleBatch(int num_rays, uint64_t seed, int64_t step, const 
         batch->target_rgb[3 * r + a] = premultiplied_[3 * p + a] + (1.f - alpha) * bg;
       }
       if (has_alpha_) batch->target_alpha[r] = alpha;
+      // The target is the centre ray's depth; a jittered ray is within a pixel of it.
+      if (!depth_.empty()) batch->depth_target[r] = depth_[p];
     }
   });
 }

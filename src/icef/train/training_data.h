@@ -40,6 +40,13 @@ class TrainingData {
   // frame's ExpressionRegion of its own 2D landmarks, dilated by DefaultRegionDilation. Empty
   // when no frame has landmarks.
   const std::vector<int64_t>& region_pixels() const { return region_pixels_; }
+  // The frame of global pixel p and the ray through its centre.
+  int frame_of_pixel(int64_t p) const { return frame_of_pixel_[p]; }
+  Ray PixelCentreRay(int64_t p) const { return cameras_[frame_of_pixel_[p]].PixelRay(pixel_x_[p], pixel_y_[p]); }
+  // Per-pixel depth targets [num_pixels()] (ray parameter t of the pixel-centre ray, NaN = none) that
+  // SampleBatch copies into TrainRays::depth_target; empty (the default) leaves it empty.
+  void SetDepthTargets(std::vector<float> depth);
+  const std::vector<float>& depth_targets() const { return depth_; }
   // The global pixel index of (frame k, x, y).
   int64_t PixelIndex(int k, int x, int y) const { return frame_offset_[k] + int64_t(y) * cameras_[k].width() + x; }
 
@@ -62,6 +69,7 @@ class TrainingData {
   std::vector<float> alpha_;                // [P] or empty
   bool has_alpha_ = false;
   std::vector<int64_t> region_pixels_;     // see region_pixels()
+  std::vector<float> depth_;               // see SetDepthTargets()
 };
 
 }  // namespace icef

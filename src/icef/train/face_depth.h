@@ -1,0 +1,24 @@
+// Depth targets from the fitted face model (train.lambda_depth_prior): for each training pixel of
+// the expression regions (brows, eyes and mouth by the frame's 2D landmarks: TrainingData's region
+// pixels), where the centre ray through it meets the fitted face model's surface at that frame's
+// expression (the fit's shape and expression style, head_from_world carrying the ray into the head
+// frame). The loss (model/losses.h, L_depth) pulls each such ray's compositing-weighted depth
+// towards it: five views pin the depth of a one-pixel feature (the lid margin on the eyeball)
+// down poorly, and the face model knows where the lid and the eyeball are.
+#pragma once
+
+#include <vector>
+
+#include "icef/core/parallel.h"
+#include "icef/face/face_fit.h"
+#include "icef/train/training_data.h"
+
+namespace icef {
+
+// [data.num_pixels()] ray parameters t (world units along the pixel-centre ray), NaN outside the
+// region pixels and where the ray misses the fitted surface. expressions[k] is frame k's weights in
+// the face model's order (negative values act as 0). Deterministic for any executor.
+std::vector<float> FaceModelDepthTargets(const face::FaceFit& fit, const TrainingData& data,
+                                         const std::vector<std::vector<float>>& expressions, const Executor& executor);
+
+}  // namespace icef
