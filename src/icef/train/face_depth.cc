@@ -4,12 +4,14 @@
 #include <cmath>
 #include <limits>
 
+#include "icef/data/landmark_region.h"
 #include "icef/face/face_model.h"
 
 namespace icef {
 
 std::vector<float> FaceModelDepthTargets(const face::FaceFit& fit, const TrainingData& data,
-                                         const std::vector<std::vector<float>>& expressions, const Executor& executor) {
+                                         const std::vector<std::vector<float>>& expressions,
+                                         const std::vector<int64_t>& pixels, const Executor& executor) {
   ICEF_CHECK(int(expressions.size()) == data.num_frames(), "depth targets: one expression per training frame");
   const face::FaceModel head(fit.shape, fit.style);
   std::vector<face::ExpressionState> states;
@@ -24,7 +26,6 @@ std::vector<float> FaceModelDepthTargets(const face::FaceFit& fit, const Trainin
   const Mat3f rotation = s.rotation.cast<float>();
   const float scale = static_cast<float>(s.scale);
   std::vector<float> depth(size_t(data.num_pixels()), std::numeric_limits<float>::quiet_NaN());
-  const std::vector<int64_t>& pixels = data.region_pixels();
   ParallelFor(executor, int64_t(pixels.size()), [&](int64_t i0, int64_t i1, int) {
     for (int64_t i = i0; i < i1; ++i) {
       const int64_t p = pixels[i];
@@ -41,6 +42,29 @@ std::vector<float> FaceModelDepthTargets(const face::FaceFit& fit, const Trainin
     }
   });
   return depth;
+}
+
+std::vector<int64_t> EyePixels(const Dataset& dataset, const TrainingData& data) {
+  std::vector<int64_t> pixels;
+  for (int k = 0; k < data.num_frames() && k < int(dataset.train.size()); ++k) {
+    if (!dataset.train[k].landmarks_2d) continue;
+    const std::vector<Vec2f>& all = *dataset.train[k].landmarks_2d;
+    const int width = data.camera(k).width(), height = data.camera(k).height();
+    std::vector<uint8_t> eye(size_t(width) * height, 0);
+    for (int first : {36, 42}) {
+      // ExpressionRegion skips non-finite landmarks: keep this eye's six.
+      std::vector<Vec2f> one(all.size(), Vec2f::Constant(std::numeric_limits<float>::quiet_NaN()));
+      for (int i = first; i < first + 6 && i < int(all.size()); ++i) one[i] = all[i];
+      const Image region = ExpressionRegion(width, height, one, {}, DefaultRegionDilation(width));
+      for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x)
+          if (region.At(x, y, 0) > 0.f) eye[size_t(y) * width + x] = 1;
+    }
+    for (int y = 0; y < height; ++y)
+      for (int x = 0; x < width; ++x)
+        if (eye[size_t(y) * width + x]) pixels.push_back(data.PixelIndex(k, x, y));
+  }
+  return pixels;
 }
 
 }  // namespace icef

@@ -10,15 +10,21 @@
 #include <vector>
 
 #include "icef/core/parallel.h"
+#include "icef/data/dataset.h"
 #include "icef/face/face_fit.h"
 #include "icef/train/training_data.h"
 
 namespace icef {
 
-// [data.num_pixels()] ray parameters t (world units along the pixel-centre ray), NaN outside the
-// region pixels and where the ray misses the fitted surface. expressions[k] is frame k's weights in
-// the face model's order (negative values act as 0). Deterministic for any executor.
+// [data.num_pixels()] ray parameters t (world units along the pixel-centre ray), NaN outside
+// `pixels` (global indices) and where the ray misses the fitted surface. expressions[k] is frame
+// k's weights in the face model's order (negative values act as 0). Deterministic for any executor.
 std::vector<float> FaceModelDepthTargets(const face::FaceFit& fit, const TrainingData& data,
-                                         const std::vector<std::vector<float>>& expressions, const Executor& executor);
+                                         const std::vector<std::vector<float>>& expressions,
+                                         const std::vector<int64_t>& pixels, const Executor& executor);
+
+// The training pixels of the eyes: each eye's 2D landmark hull (iBUG 36-41, 42-47) of each frame
+// with landmarks, dilated as the expression region (DefaultRegionDilation). Global pixel indices.
+std::vector<int64_t> EyePixels(const Dataset& dataset, const TrainingData& data);
 
 }  // namespace icef

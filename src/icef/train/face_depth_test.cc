@@ -18,9 +18,7 @@
 namespace icef {
 namespace {
 
-// A style-free subject placed off the head frame (scaled and moved), so the fit's similarity is not
-// the identity: each depth target's world point must land on the subject's own surface.
-TEST(FaceDepthTest, TargetsLieOnTheSubjectsSurfaceInsideTheExpressionRegionsOnly) {
+synth::SynthOptions SubjectOptions() {
   synth::SynthOptions o;
   o.out_dir = testing::MakeTempDir("face_depth_subject");
   o.identity_seed = 5;
@@ -31,6 +29,13 @@ TEST(FaceDepthTest, TargetsLieOnTheSubjectsSurfaceInsideTheExpressionRegionsOnly
   o.novel_per_tier = 1;
   o.head_scale = 0.8;
   o.head_offset = Vec3d(0.05, -0.03, 0.02);
+  return o;
+}
+
+// A style-free subject placed off the head frame (scaled and moved), so the fit's similarity is not
+// the identity: each depth target's world point must land on the subject's own surface.
+TEST(FaceDepthTest, TargetsLieOnTheSubjectsSurfaceInsideTheExpressionRegionsOnly) {
+  const synth::SynthOptions o = SubjectOptions();
   const Executor ex(2);
   ASSERT_TRUE(synth::SynthesizeDataset(o, ex).ok());
   auto dataset = LoadDataset(o.out_dir);
@@ -42,9 +47,9 @@ TEST(FaceDepthTest, TargetsLieOnTheSubjectsSurfaceInsideTheExpressionRegionsOnly
   std::vector<std::vector<float>> expressions;
   for (const Frame& f : dataset->train) expressions.push_back(f.expression);
 
-  const std::vector<float> depth = FaceModelDepthTargets(*fit, *data, expressions, ex);
+  const std::vector<float> depth = FaceModelDepthTargets(*fit, *data, expressions, data->region_pixels(), ex);
   ASSERT_EQ(int64_t(depth.size()), data->num_pixels());
-  const std::vector<float> one_thread = FaceModelDepthTargets(*fit, *data, expressions, Executor(1));
+  const std::vector<float> one_thread = FaceModelDepthTargets(*fit, *data, expressions, data->region_pixels(), Executor(1));
   EXPECT_EQ(std::memcmp(depth.data(), one_thread.data(), depth.size() * sizeof(float)), 0) << "thread count";
 
   const std::vector<int64_t>& region = data->region_pixels();
@@ -82,6 +87,31 @@ TEST(FaceDepthTest, TargetsLieOnTheSubjectsSurfaceInsideTheExpressionRegionsOnly
   // Measured: median 0.0002, 90th percentile 0.0003 head units (the fitted shape is not exact).
   EXPECT_LT(median, 0.001) << "head units";
   EXPECT_LT(p90, 0.002) << "head units";
+}
+
+// train.depth_prior_region = "eyes": each eye's landmark hull, dilated; inside the expression region,
+// on every frame, holding every eye landmark's pixel and no mouth landmark's.
+TEST(FaceDepthTest, EyePixelsAreTheEyesOfEveryFrame) {
+  synth::SynthOptions o = SubjectOptions();
+  o.out_dir = testing::MakeTempDir("face_depth_eyes");
+  ASSERT_TRUE(synth::SynthesizeDataset(o, Executor(2)).ok());
+  auto dataset = LoadDataset(o.out_dir);
+  ASSERT_TRUE(dataset.ok()) << dataset.status().message();
+  auto data = TrainingData::Load(*dataset);
+  ASSERT_TRUE(data.ok()) << data.status().message();
+  const std::vector<int64_t> eyes = EyePixels(*dataset, *data);
+  std::vector<uint8_t> in_region(size_t(data->num_pixels()), 0), in_eyes(size_t(data->num_pixels()), 0);
+  for (int64_t p : data->region_pixels()) in_region[p] = 1;
+  for (int64_t p : eyes) in_eyes[p] = 1;
+  ASSERT_LT(eyes.size(), data->region_pixels().size() / 2);
+  for (int64_t p : eyes) EXPECT_TRUE(in_region[p]) << p;
+  for (int k = 0; k < data->num_frames(); ++k) {
+    const std::vector<Vec2f>& lm = *dataset->train[k].landmarks_2d;
+    auto pixel = [&](int i) { return data->PixelIndex(k, int(std::floor(lm[i].x())), int(std::floor(lm[i].y()))); };
+    for (int i = 36; i < 48; ++i) EXPECT_TRUE(in_eyes[pixel(i)]) << "frame " << k << " landmark " << i;
+    for (int i = 48; i < 68; ++i) EXPECT_FALSE(in_eyes[pixel(i)]) << "frame " << k << " landmark " << i;
+    EXPECT_FALSE(in_eyes[pixel(30)]) << "frame " << k << ": the nose tip";
+  }
 }
 
 }  // namespace

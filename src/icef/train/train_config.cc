@@ -33,6 +33,9 @@ void TrainConfig::Bind(ConfigSchema& s) {
            "weight of L_depth: each training ray through the expression regions (brows, eyes, mouth) pulled to "
            "the depth at which it meets the fitted face model at its frame's expression, distances in aabb "
            "diagonals (icef-prior, warp-prior; 0 = off)");
+  s.String("depth_prior_region", &depth_prior_region,
+           "the pixels L_depth acts on: \"expression\" (the expression region: brows, eyes, mouth and what lies "
+           "between them, as train.region_rays) or \"eyes\" (each eye's landmark hull)");
   s.Number("symmetry_colour", &symmetry_colour,
            "weight of the symmetry prior's colour part relative to its opacity part (0 = geometry only)");
   s.Int("symmetry_max_samples", &symmetry_max_samples, "samples per step mirrored by the symmetry prior");
@@ -124,6 +127,8 @@ Status TrainConfig::Validate() const {
     return Status::Error("train: anneal_steps, grid_anneal_steps, density_start_steps, occupancy_warmup, checkpoint_every, eval_every must be >= 0 and "
                          "occupancy_every, log_every >= 1");
   if (threads < 0) return Status::Error("train.threads must be >= 0");
+  if (depth_prior_region != "expression" && depth_prior_region != "eyes")
+    return Status::Error("train.depth_prior_region must be \"expression\" or \"eyes\", got \"" + depth_prior_region + "\"");
   if (on_nonfinite != "stop" && on_nonfinite != "skip")
     return Status::Error("train.on_nonfinite must be \"stop\" or \"skip\", got \"" + on_nonfinite + "\"");
   return Status::Ok();

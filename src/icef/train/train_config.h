@@ -40,6 +40,7 @@ struct TrainConfig {
   // Weight of L_depth: the expression regions' training rays pulled to the fitted face model's depth
   // (methods on the face-model prior; 0 = off; train/face_depth.h).
   double lambda_depth_prior = 0.0;
+  std::string depth_prior_region = "expression";  // L_depth's pixels: "expression" (brows, eyes, mouth) or "eyes"
   double symmetry_colour = LossWeights{}.symmetry_colour;  // weight of L_sym's colour part relative to its opacity part
   int symmetry_max_samples = LossWeights{}.symmetry_max_samples;  // samples per step mirrored by L_sym
   // Training rays through random points of their pixels (true) or through the centres (false, the

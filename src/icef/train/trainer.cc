@@ -62,9 +62,12 @@ Trainer::Trainer(const Dataset& dataset, fs::path model_dir, RunConfig config, T
       model_(std::move(model)),
       executor_(config_.train.threads) {
   // L_depth's targets: a function of the data and the fit alone, so a resumed run recomputes them.
-  if (config_.train.lambda_depth_prior > 0 && model_->setup().face_fit)
+  if (config_.train.lambda_depth_prior > 0 && model_->setup().face_fit) {
+    const std::vector<int64_t> pixels =
+        config_.train.depth_prior_region == "eyes" ? EyePixels(dataset_, data_) : data_.region_pixels();
     data_.SetDepthTargets(FaceModelDepthTargets(*model_->setup().face_fit, data_, model_->setup().training_expressions,
-                                                executor_));
+                                                pixels, executor_));
+  }
   adam_ = std::make_unique<nn::Adam>(MakeAdamOptions(), &model_->store());
   ApplySchedules();
 }

@@ -364,6 +364,17 @@ TEST(TrainerTest, DepthPriorActsOnThePriorOnly) {
       EXPECT_EQ(terms->Get("depth") > 0, prior) << method;
     }
     if (!prior) continue;
+    // The eyes alone: fewer rays with a target, so another (smaller, still positive) term.
+    RunConfig eyes_config = config;
+    eyes_config.train.depth_prior_region = "eyes";
+    auto eyes = Trainer::Create(TinySubject(), testing::MakeTempDir("trainer_depth_prior_eyes"), eyes_config);
+    ASSERT_TRUE(eyes.ok()) << eyes.status().message();
+    auto fresh = Trainer::Create(TinySubject(), testing::MakeTempDir("trainer_depth_prior_fresh"), config);
+    ASSERT_TRUE(fresh.ok()) << fresh.status().message();
+    const Result<LossTerms> eyes_terms = (*eyes)->Step(), all_terms = (*fresh)->Step();
+    ASSERT_TRUE(eyes_terms.ok() && all_terms.ok());
+    EXPECT_GT(eyes_terms->Get("depth"), 0);
+    EXPECT_LT(eyes_terms->Get("depth"), all_terms->Get("depth"));
     ASSERT_TRUE((*trainer)->SaveCheckpoint().ok());
     auto resumed = Trainer::Resume(TinySubject(), dir, std::nullopt, std::nullopt, std::nullopt);
     ASSERT_TRUE(resumed.ok()) << resumed.status().message();
@@ -373,6 +384,9 @@ TEST(TrainerTest, DepthPriorActsOnThePriorOnly) {
   }
   RunConfig bad = SmallConfig("icef-prior");
   bad.train.lambda_depth_prior = -1;
+  EXPECT_FALSE(bad.Validate().ok());
+  bad = SmallConfig("icef-prior");
+  bad.train.depth_prior_region = "nose";
   EXPECT_FALSE(bad.Validate().ok());
 }
 
