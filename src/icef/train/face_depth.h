@@ -1,10 +1,11 @@
-// Depth targets from the fitted face model (train.lambda_depth_prior): for each training pixel of
-// the expression regions (brows, eyes and mouth by the frame's 2D landmarks: TrainingData's region
-// pixels), where the centre ray through it meets the fitted face model's surface at that frame's
+// Depth targets from the fitted face model (train.lambda_depth_prior): for each chosen training
+// pixel (train.depth_prior_region: the expression region of TrainingData's region pixels, or the
+// eyes alone), where the centre ray through it meets the fitted face model's surface at that frame's
 // expression (the fit's shape and expression style, head_from_world carrying the ray into the head
 // frame). The loss (model/losses.h, L_depth) pulls each such ray's compositing-weighted depth
-// towards it: five views pin the depth of a one-pixel feature (the lid margin on the eyeball)
-// down poorly, and the face model knows where the lid and the eyeball are.
+// towards it. Built to test whether five views pin the depth of a one-pixel feature (the lid
+// margin on the eyeball) down too poorly; measured on the validation identities, it does not move
+// the eyes, so it is off by default (docs/results/near_tier_variants).
 #pragma once
 
 #include <vector>
