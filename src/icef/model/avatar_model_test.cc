@@ -400,6 +400,8 @@ TEST(AvatarModelTest, TrainLossGradientMatchesFiniteDifferences) {
     w.lambda_mask = 0.2;
     w.lambda_distortion = 0.01 * std::sqrt(3.0);  // distances in aabb diagonals (sqrt 3 here)
     w.lambda_depth_prior = 300.0;
+    w.depth_prior_window = 0.05;  // offsets clamped to +-0.05 diagonals, samples 0.25 behind left out:
+    w.depth_prior_reach = 0.25;   // both fixed along each ray, so L_depth stays smooth in the parameters
     w.lambda_symmetry = 0.3;  // mirrored samples through the warp and both fields
     w.symmetry_colour = 0.0;  // its colour weight is a stop-gradient (symmetry_loss_test checks that part)
     w.symmetry_max_samples = 64;

@@ -145,13 +145,15 @@ class DepthPriorTerm final : public Loss {
     const double inv_r = InvRays(ctx), inv_diag = 1.0 / ctx.setup.aabb.Extent().norm();
     if (ws.d_weights.size() != ws.samples.size()) ws.d_weights.assign(ws.samples.size(), 0.f);
     const float scale = static_cast<float>(weight * inv_r * inv_diag * inv_diag);
+    const DepthWindow<float> shape{static_cast<float>(ctx.weights.depth_prior_window / inv_diag),
+                                   static_cast<float>(ctx.weights.depth_prior_reach / inv_diag)};
     double loss = 0;
     for (int64_t r = 0; r < num_rays; ++r) {
       const float target = ctx.batch.depth_target[r];
       const int64_t off = ws.samples.ray_offset[r], cnt = ws.samples.ray_count[r];
       if (!std::isfinite(target) || cnt == 0) continue;
       loss += DepthMomentLossRay<float>(static_cast<int>(cnt), &ws.composite.weights[off], &ws.samples.t[off], target,
-                                        scale, &ws.d_weights[off]) * inv_diag * inv_diag;
+                                        shape, scale, &ws.d_weights[off]) * inv_diag * inv_diag;
     }
     return loss * inv_r;
   }

@@ -36,6 +36,13 @@ void TrainConfig::Bind(ConfigSchema& s) {
   s.String("depth_prior_region", &depth_prior_region,
            "the pixels L_depth acts on: \"expression\" (the expression region: brows, eyes, mouth and what lies "
            "between them, as train.region_rays) or \"eyes\" (each eye's landmark hull)");
+  s.Number("depth_prior_window", &depth_prior_window,
+           "half-width of L_depth's window about the face model's depth, in aabb diagonals: each sample's "
+           "offset from it is clamped to the window, so the weight a ray keeps far behind the face (where it "
+           "leaves the head) pulls no harder than weight just past the window (0 = no window)");
+  s.Number("depth_prior_reach", &depth_prior_reach,
+           "L_depth leaves out the samples farther than this behind the face model's depth, in aabb diagonals: "
+           "inside the head and where the ray leaves it, which no face-model depth describes (0 = all samples)");
   s.Number("symmetry_colour", &symmetry_colour,
            "weight of the symmetry prior's colour part relative to its opacity part (0 = geometry only)");
   s.Int("symmetry_max_samples", &symmetry_max_samples, "samples per step mirrored by the symmetry prior");
@@ -87,6 +94,8 @@ LossWeights TrainConfig::Losses(bool has_alpha) const {
   w.lambda_mask = has_alpha ? lambda_mask : 0.0;
   w.lambda_distortion = lambda_distortion;
   w.lambda_depth_prior = lambda_depth_prior;
+  w.depth_prior_window = depth_prior_window;
+  w.depth_prior_reach = depth_prior_reach;
   w.lambda_occlusion = lambda_occlusion;
   w.lambda_symmetry = lambda_symmetry;
   w.symmetry_colour = symmetry_colour;
@@ -112,6 +121,8 @@ Status TrainConfig::Validate() const {
   if (!non_negative(lambda_mask)) return Status::Error("train.lambda_mask must be a finite number >= 0");
   if (!non_negative(lambda_distortion)) return Status::Error("train.lambda_distortion must be a finite number >= 0");
   if (!non_negative(lambda_depth_prior)) return Status::Error("train.lambda_depth_prior must be a finite number >= 0");
+  if (!non_negative(depth_prior_window)) return Status::Error("train.depth_prior_window must be a finite number >= 0");
+  if (!non_negative(depth_prior_reach)) return Status::Error("train.depth_prior_reach must be a finite number >= 0");
   if (!non_negative(lambda_occlusion)) return Status::Error("train.lambda_occlusion must be a finite number >= 0");
   if (!non_negative(lambda_symmetry)) return Status::Error("train.lambda_symmetry must be a finite number >= 0");
   if (!non_negative(symmetry_colour)) return Status::Error("train.symmetry_colour must be a finite number >= 0");

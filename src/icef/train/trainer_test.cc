@@ -6,6 +6,7 @@
 #include <cmath>
 #include <fstream>
 #include <iostream>
+#include <limits>
 
 #include "icef/data/landmark_region.h"
 #include "icef/model/render_image.h"
@@ -387,6 +388,12 @@ TEST(TrainerTest, DepthPriorActsOnThePriorOnly) {
   EXPECT_FALSE(bad.Validate().ok());
   bad = SmallConfig("icef-prior");
   bad.train.depth_prior_region = "nose";
+  EXPECT_FALSE(bad.Validate().ok());
+  bad = SmallConfig("icef-prior");
+  bad.train.depth_prior_window = -0.01;
+  EXPECT_FALSE(bad.Validate().ok());
+  bad = SmallConfig("icef-prior");
+  bad.train.depth_prior_reach = std::numeric_limits<double>::quiet_NaN();
   EXPECT_FALSE(bad.Validate().ok());
 }
 
