@@ -40,7 +40,7 @@ struct LossWeights {
   double lambda_symmetry = 0.0;
   double lambda_depth_prior = 0.0;   // L_depth: rays with a face-model depth (TrainRays::depth_target)
   double depth_prior_window = 0.0;   // L_depth's window half-width about t*, aabb diagonals (0: none; render/depth_loss.h)
-  double depth_prior_reach = 0.0;    // L_depth leaves out samples farther behind t*, aabb diagonals (0: none)
+  double depth_prior_reach = 0.0;    // L_depth's reach behind t*, aabb diagonals (0: none; render/depth_loss.h)
   double symmetry_colour = 0.0;      // weight of the colour part of L_sym (model/symmetry_loss.h)
   int symmetry_max_samples = 4096;   // cap on the samples mirrored by L_sym per batch
   double smooth_epsilon = 0.01;      // finite-difference offset of L_smooth, in half-extent units of the aabb

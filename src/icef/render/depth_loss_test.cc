@@ -35,20 +35,32 @@ TEST(DepthLossTest, TheWindowBoundsThePullOfFarWeight) {
   EXPECT_NEAR(windowed[4] / windowed[2], 0.15 / 0.1, 1e-9);
 }
 
-TEST(DepthLossTest, WeightBeyondTheReachIsLeftOut) {
-  // The same ray: with a reach of 0.5 the far sample (1.0 behind t*) is left out, so the ray's
-  // weight is centred and costs nothing, and the far sample gets no gradient.
-  const std::vector<double> w = {0.3, 0.4, 0.3, 0.0, 0.01}, t = {1.1, 1.2, 1.3, 1.5, 2.2};
+TEST(DepthLossTest, BeyondTheReachCountsAsOneTerminationAtTheReach) {
+  const DepthWindow<double> shape{0.15, 0.5};
+  const std::vector<double> t = {1.1, 1.2, 1.3, 1.5, 2.2};
+  // 0.99 of the weight centred on t*, 0.01 far behind it (beyond the reach): that 0.01 counts as if
+  // at the reach, clamped to the window, and pulls on nothing itself.
+  const std::vector<double> w = {0.3, 0.39, 0.3, 0.0, 0.01};
   std::vector<double> d(5, 0.0);
-  EXPECT_NEAR(DepthMomentLossRay<double>(5, w.data(), t.data(), 1.2, DepthWindow<double>{0.15, 0.5}, 1.0, d.data()),
-              0.0, 1e-30);
-  for (double g : d) EXPECT_NEAR(g, 0.0, 1e-15);
-  // Weight inside the reach still counts: 0.01 at 0.3 behind, clamped to the window.
-  const std::vector<double> w2 = {0.3, 0.4, 0.3, 0.01, 0.01};
-  EXPECT_NEAR(DepthMomentLossRay<double>(5, w2.data(), t.data(), 1.2, DepthWindow<double>{0.15, 0.5}, 1.0, d.data()),
+  EXPECT_NEAR(DepthMomentLossRay<double>(5, w.data(), t.data(), 1.2, shape, 1.0, d.data()),
               0.01 * 0.15 * 0.01 * 0.15, 1e-15);
   EXPECT_DOUBLE_EQ(d[4], 0.0);
-  EXPECT_GT(d[3], 0.0);
+  for (int i = 0; i < 3; ++i) EXPECT_LT(d[i], 0.0) << i;  // more weight within the window lowers the loss
+  EXPECT_DOUBLE_EQ(d[3], 0.0);  // past the window's edge, a sample is as far as the reach
+  // The same 0.01 passing through the ray (transmitted to the background) costs the same.
+  const std::vector<double> through = {0.3, 0.39, 0.3, 0.0, 0.0};
+  std::vector<double> d2(5, 0.0);
+  EXPECT_NEAR(DepthMomentLossRay<double>(5, through.data(), t.data(), 1.2, shape, 1.0, d2.data()),
+              0.01 * 0.15 * 0.01 * 0.15, 1e-15);
+  for (int i = 0; i < 4; ++i) EXPECT_NEAR(d2[i], d[i], 1e-15) << i;
+  // A transparent ray cannot meet the prior: it costs the window squared.
+  const std::vector<double> none(5, 0.0);
+  std::vector<double> d3(5, 0.0);
+  EXPECT_NEAR(DepthMomentLossRay<double>(5, none.data(), t.data(), 1.2, shape, 1.0, d3.data()), 0.15 * 0.15, 1e-15);
+  EXPECT_LT(d3[1], 0.0);
+  // Fully opaque and centred: zero.
+  const std::vector<double> opaque = {0.3, 0.4, 0.3, 0.0, 0.0};
+  EXPECT_NEAR(DepthMomentLossRay<double>(5, opaque.data(), t.data(), 1.2, shape, 1.0, d3.data()), 0.0, 1e-30);
 }
 
 TEST(DepthLossTest, GradientMatchesCentralDifferences) {
@@ -65,7 +77,7 @@ TEST(DepthLossTest, GradientMatchesCentralDifferences) {
     const double target = rng.Uniform(t[0], t[n - 1]), scale = rng.Uniform(0.5, 2.0);
     // Half the seeds with a window, half with a reach (the offsets' kinks lie between samples, never
     // on one: the gradient is with respect to the weights).
-    const DepthWindow<double> window{seed % 2 ? rng.Uniform(0.05, 0.3) : 0.0, seed % 4 >= 2 ? rng.Uniform(0.2, 1.0) : 0.0};
+    const DepthWindow<double> window{seed % 2 ? rng.Uniform(0.05, 0.3) : 0.0, seed % 4 >= 2 ? rng.Uniform(0.1, 0.5) : 0.0};
     // d starts non-zero: the gradient is added, not written.
     std::vector<double> base(n);
     for (int i = 0; i < n; ++i) d[i] = base[i] = rng.Uniform(-1.0, 1.0);

@@ -41,8 +41,10 @@ void TrainConfig::Bind(ConfigSchema& s) {
            "offset from it is clamped to the window, so the weight a ray keeps far behind the face (where it "
            "leaves the head) pulls no harder than weight just past the window (0 = no window)");
   s.Number("depth_prior_reach", &depth_prior_reach,
-           "L_depth leaves out the samples farther than this behind the face model's depth, in aabb diagonals: "
-           "inside the head and where the ray leaves it, which no face-model depth describes (0 = all samples)");
+           "L_depth's reach behind the face model's depth, in aabb diagonals: weight farther behind (inside the "
+           "head, and where the ray leaves it) and the light that passes through the ray count as one "
+           "termination at the reach, so the far side of the head is left alone and a hole is no way to meet "
+           "the prior (0 = no reach: every sample counts, transmitted light costs nothing)");
   s.Number("symmetry_colour", &symmetry_colour,
            "weight of the symmetry prior's colour part relative to its opacity part (0 = geometry only)");
   s.Int("symmetry_max_samples", &symmetry_max_samples, "samples per step mirrored by the symmetry prior");

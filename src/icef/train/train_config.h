@@ -42,7 +42,7 @@ struct TrainConfig {
   double lambda_depth_prior = 0.0;
   std::string depth_prior_region = "expression";  // L_depth's pixels: "expression" (brows, eyes, mouth) or "eyes"
   double depth_prior_window = 0.0;  // L_depth's window half-width about the target, aabb diagonals (0 = none)
-  double depth_prior_reach = 0.0;   // L_depth leaves out samples farther behind the target, aabb diagonals (0 = none)
+  double depth_prior_reach = 0.0;   // L_depth's reach behind the target, aabb diagonals (0 = none; render/depth_loss.h)
   double symmetry_colour = LossWeights{}.symmetry_colour;  // weight of L_sym's colour part relative to its opacity part
   int symmetry_max_samples = LossWeights{}.symmetry_max_samples;  // samples per step mirrored by L_sym
   // Training rays through random points of their pixels (true) or through the centres (false, the
