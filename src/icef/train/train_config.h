@@ -38,11 +38,12 @@ struct TrainConfig {
   double lambda_occlusion = 1e-4;    // weight of the occlusion sparsity prior (0 = off)
   double lambda_symmetry = 0.1;      // weight of the left-right symmetry prior L_sym (0 = off)
   // Weight of L_depth: the expression regions' training rays pulled to the fitted face model's depth
-  // (methods on the face-model prior; 0 = off; train/face_depth.h).
-  double lambda_depth_prior = 0.0;
+  // (methods on the face-model prior; 0 = off; train/face_depth.h). 10, with the window and reach
+  // below, chosen on validation identities 101-108 (docs/results/near_tier_variants).
+  double lambda_depth_prior = 10.0;
   std::string depth_prior_region = "expression";  // L_depth's pixels: "expression" (brows, eyes, mouth) or "eyes"
-  double depth_prior_window = 0.0;  // L_depth's window half-width about the target, aabb diagonals (0 = none)
-  double depth_prior_reach = 0.0;   // L_depth's reach behind the target, aabb diagonals (0 = none; render/depth_loss.h)
+  double depth_prior_window = 0.01;  // L_depth's window half-width about the target, aabb diagonals (0 = none)
+  double depth_prior_reach = 0.05;   // L_depth's reach behind the target, aabb diagonals (0 = none; render/depth_loss.h)
   double symmetry_colour = LossWeights{}.symmetry_colour;  // weight of L_sym's colour part relative to its opacity part
   int symmetry_max_samples = LossWeights{}.symmetry_max_samples;  // samples per step mirrored by L_sym
   // Training rays through random points of their pixels (true) or through the centres (false, the
