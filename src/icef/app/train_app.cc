@@ -93,6 +93,9 @@ Result<TrainSummary> RunTrain(const TrainAppOptions& o, std::ostream& out) {
       out << "prior shading: light [" << light->x() << ", " << light->y() << ", " << light->z() << "] (strength "
           << light->norm() << ", fitted to the training images' skin)\n";
     if (!trainer->density_start_note().empty()) out << trainer->density_start_note() << "\n";
+    if (trainer->num_view_rays() > 0)
+      out << "depth prior: " << trainer->num_view_rays() << " rays from " << config.train.depth_prior_views
+          << " unseen views per training frame, " << config.train.depth_prior_view_rays << " per step\n";
     if (!trainer->prior_shading_note().empty())
       out << "prior shading: off, no light fitted (" << trainer->prior_shading_note() << ")\n";
     if (fit->Poor())

@@ -61,7 +61,7 @@ namespace {
 
 double InvRays(const LossContext& ctx) { return 1.0 / std::max<size_t>(ctx.batch.rays.size(), 1); }
 
-// L_photo: mean squared error of the composited colour over rays and channels.
+// L_photo: mean squared error of the composited colour over the pixel rays and channels.
 class PhotoTerm final : public Loss {
  public:
   std::string_view name() const override { return "photo"; }
@@ -69,8 +69,8 @@ class PhotoTerm final : public Loss {
   double Weight(const LossContext&) const override { return 1.0; }
   double Evaluate(LossContext& ctx, double weight) override {
     ModelWorkspace& ws = ctx.ws;
-    const int64_t num_rays = static_cast<int64_t>(ctx.batch.rays.size());
-    const double inv_c = InvRays(ctx) / 3.0;
+    const int64_t num_rays = ctx.batch.NumPhotoRays();
+    const double inv_c = 1.0 / std::max<int64_t>(num_rays, 1) / 3.0;
     double photo = 0;
     for (int64_t i = 0; i < 3 * num_rays; ++i) {
       const double e = ws.composite.color[i] - ctx.batch.target_rgb[i];
@@ -81,7 +81,8 @@ class PhotoTerm final : public Loss {
   }
 };
 
-// L_mask: mean squared error of the opacity against the images' alpha (images with alpha only).
+// L_mask: mean squared error of the opacity against the images' alpha over the pixel rays (images
+// with alpha only).
 class MaskTerm final : public Loss {
  public:
   std::string_view name() const override { return "mask"; }
@@ -91,8 +92,8 @@ class MaskTerm final : public Loss {
   }
   double Evaluate(LossContext& ctx, double weight) override {
     ModelWorkspace& ws = ctx.ws;
-    const int64_t num_rays = static_cast<int64_t>(ctx.batch.rays.size());
-    const double inv_r = InvRays(ctx);
+    const int64_t num_rays = ctx.batch.NumPhotoRays();
+    const double inv_r = 1.0 / std::max<int64_t>(num_rays, 1);
     double loss = 0;
     for (int64_t r = 0; r < num_rays; ++r) {
       const double e = ws.composite.opacity[r] - ctx.batch.target_alpha[r];

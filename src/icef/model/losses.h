@@ -79,6 +79,11 @@ struct TrainRays {
                                       // empty for setup.background
   std::vector<float> depth_target;    // [R] ray parameter t where the fitted face model's surface is
                                       // hit (train.lambda_depth_prior), NaN where there is none; or empty
+  // Rays [0, photo_rays) are pixels of the training images, with colour (and alpha) targets; the
+  // rays after them look at the head from unseen views and carry a depth_target alone
+  // (train.depth_prior_views): L_photo and L_mask skip them. -1: every ray is a pixel.
+  int64_t photo_rays = -1;
+  int64_t NumPhotoRays() const { return photo_rays < 0 ? int64_t(rays.size()) : photo_rays; }
 };
 
 struct ModelWorkspace;  // model/model_workspace.h

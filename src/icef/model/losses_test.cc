@@ -170,5 +170,69 @@ TEST(LossesTest, EachTermsGradientIsItsWeightTimesItsDerivative) {
   }
 }
 
+// Rays after TrainRays::photo_rays (unseen views, train.depth_prior_views) carry a depth target
+// alone: L_photo and L_mask are those of the pixel rays (their garbage colour and alpha targets
+// count nothing), the depth term reaches them, and its gradient on them is its derivative.
+TEST(LossesTest, RaysAfterThePhotoRaysCountOnlyInTheDepthTerm) {
+  const TrainRays pixels = Batch(true);
+  TrainRays with_views = pixels;
+  const TrainRays extra = testing_model::RandomBatch(8, 11, true);
+  Rng rng(6, StreamId("view_depth"));
+  for (int r = 0; r < 8; ++r) {
+    with_views.rays.push_back(extra.rays[r]);
+    with_views.frame.push_back(extra.frame[r]);
+    for (int a = 0; a < 3; ++a) with_views.target_rgb.push_back(5.f);  // what no colour could match
+    with_views.target_alpha.push_back(3.f);
+    with_views.depth_target.push_back(static_cast<float>(rng.Uniform(1.5, 2.5)));
+  }
+  with_views.photo_rays = int64_t(pixels.rays.size());
+  ASSERT_EQ(with_views.NumPhotoRays(), 24);
+  ASSERT_EQ(pixels.NumPhotoRays(), 24);
+  const Executor ex(1);
+
+  // Photo and mask alone: the same values and parameter gradients as without the view rays.
+  LossWeights photo_mask;
+  photo_mask.lambda_mask = 0.2;
+  auto model = MakeModel("icef", true);
+  nn::ParameterStore& store = model->store();
+  store.ZeroGrads();
+  const LossTerms a = model->TrainForwardBackward(pixels, photo_mask, 3, 0, ex);
+  const std::vector<float> g_a(store.grads(), store.grads() + store.size());
+  store.ZeroGrads();
+  const LossTerms b = model->TrainForwardBackward(with_views, photo_mask, 3, 0, ex);
+  const std::vector<float> g_b(store.grads(), store.grads() + store.size());
+  EXPECT_DOUBLE_EQ(a.Get("photo"), b.Get("photo"));
+  EXPECT_DOUBLE_EQ(a.Get("mask"), b.Get("mask"));
+  EXPECT_NEAR(a.psnr(), b.psnr(), 1e-12);
+  double max_diff = 0, max_g = 0;
+  for (size_t i = 0; i < g_a.size(); ++i) {
+    max_diff = std::max(max_diff, std::abs(double(g_a[i]) - double(g_b[i])));
+    max_g = std::max(max_g, std::abs(double(g_a[i])));
+  }
+  EXPECT_GT(max_g, 0.0);
+  EXPECT_LE(max_diff, 1e-6 * max_g);
+
+  // The depth term sees the view rays: only they carry a target here.
+  LossWeights depth = photo_mask;
+  depth.lambda_depth_prior = 30.0;
+  TrainRays views_only = with_views;
+  std::fill(views_only.depth_target.begin(), views_only.depth_target.begin() + 24, NAN);
+  store.ZeroGrads();
+  const double value = model->TrainForwardBackward(views_only, depth, 3, 0, ex).Get("depth");
+  EXPECT_GT(value, 0.0);
+  store.ZeroGrads();
+  model->TrainForwardBackward(views_only, photo_mask, 3, 0, ex);
+  const std::vector<float> g_off(store.grads(), store.grads() + store.size());
+  store.ZeroGrads();
+  model->TrainForwardBackward(views_only, depth, 3, 0, ex);
+  std::vector<double> added(store.size());
+  for (size_t i = 0; i < added.size(); ++i) added[i] = double(store.grads()[i]) - double(g_off[i]);
+  const testing::ParameterGradientCheck check;
+  const auto report = check.Run(store.params(), added, [&] {
+    return depth.lambda_depth_prior * model->TrainForwardBackward(views_only, depth, 3, 0, ex).Get("depth");
+  });
+  EXPECT_TRUE(report.ok()) << report.failures;
+}
+
 }  // namespace
 }  // namespace icef

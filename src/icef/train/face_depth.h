@@ -3,9 +3,9 @@
 // eyes alone), where the centre ray through it meets the fitted face model's surface at that frame's
 // expression (the fit's shape and expression style, head_from_world carrying the ray into the head
 // frame). The loss (model/losses.h, L_depth) pulls each such ray's compositing-weighted depth
-// towards it. Built to test whether five views pin the depth of a one-pixel feature (the lid
-// margin on the eyeball) down too poorly; measured on the validation identities, it does not move
-// the eyes, so it is off by default (docs/results/near_tier_variants).
+// towards it, within a window and a reach along the ray (render/depth_loss.h). On by default for
+// the face-model prior (lambda 10, window 0.01, reach 0.05): on the validation identities it adds
+// expression and PSNR in every tier, though not at the eyes (docs/results/near_tier_variants).
 #pragma once
 
 #include <vector>
@@ -23,6 +23,29 @@ namespace icef {
 std::vector<float> FaceModelDepthTargets(const face::FaceFit& fit, const TrainingData& data,
                                          const std::vector<std::vector<float>>& expressions,
                                          const std::vector<int64_t>& pixels, const Executor& executor);
+
+// Unseen views (train.depth_prior_views): each training frame's camera turned about the fitted
+// face's centre by a yaw about the head's up axis and a pitch about the camera's right axis, each
+// uniform within +-max_yaw_deg / +-max_pitch_deg, drawn from Rng(seed, "depth_prior_views", frame).
+struct ViewRayOptions {
+  int views_per_frame = 0;
+  double max_yaw_deg = 20.0;
+  double max_pitch_deg = 10.0;
+  uint64_t seed = 0;
+};
+
+// The cameras of those views: [frame][view], intrinsics of the frame's camera.
+std::vector<std::vector<Camera>> UnseenViewCameras(const face::FaceFit& fit, const TrainingData& data,
+                                                   const ViewRayOptions& options);
+
+// The centre rays of the pixels of every unseen view that lie in the expression region of the
+// fitted face model's own landmarks at that frame's expression (projected into the view;
+// ExpressionRegion, dilated as the training frames' regions) and meet its surface there, each with
+// the surface's ray parameter. L_depth on these reaches the geometry between the training views,
+// which no image constrains. Deterministic for any executor.
+std::vector<ViewRay> FaceModelViewRays(const face::FaceFit& fit, const TrainingData& data,
+                                       const std::vector<std::vector<float>>& expressions,
+                                       const ViewRayOptions& options, const Executor& executor);
 
 // The training pixels of the eyes: each eye's 2D landmark hull (iBUG 36-41, 42-47) of each frame
 // with landmarks, dilated as the expression region (DefaultRegionDilation). Global pixel indices.

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <set>
 #include <vector>
 
 #include "icef/data/dataset.h"
@@ -87,6 +88,79 @@ TEST(FaceDepthTest, TargetsLieOnTheSubjectsSurfaceInsideTheExpressionRegionsOnly
   // Measured: median 0.0002, 90th percentile 0.0003 head units (the fitted shape is not exact).
   EXPECT_LT(median, 0.001) << "head units";
   EXPECT_LT(p90, 0.002) << "head units";
+}
+
+// train.depth_prior_views: each unseen view is its training camera turned about one pivot by at most
+// the options' angles (same intrinsics, same distance to the pivot, not the training view itself);
+// its rays meet the subject's own surface at their depth, at their frame's expression, come from
+// every frame, and do not depend on the thread count.
+TEST(FaceDepthTest, UnseenViewRaysLieOnTheSubjectsSurface) {
+  synth::SynthOptions o = SubjectOptions();
+  o.out_dir = testing::MakeTempDir("face_depth_views");
+  const Executor ex(2);
+  ASSERT_TRUE(synth::SynthesizeDataset(o, ex).ok());
+  auto dataset = LoadDataset(o.out_dir);
+  ASSERT_TRUE(dataset.ok()) << dataset.status().message();
+  auto data = TrainingData::Load(*dataset);
+  ASSERT_TRUE(data.ok()) << data.status().message();
+  auto fit = FitFaceModelToDataset(*dataset);
+  ASSERT_TRUE(fit.ok()) << fit.status().message();
+  std::vector<std::vector<float>> expressions;
+  for (const Frame& f : dataset->train) expressions.push_back(f.expression);
+
+  ViewRayOptions options;
+  options.views_per_frame = 3;
+  options.max_yaw_deg = 25;
+  options.max_pitch_deg = 12;
+  options.seed = 4;
+  const auto cameras = UnseenViewCameras(*fit, *data, options);
+  ASSERT_EQ(int(cameras.size()), data->num_frames());
+  // The pivot: the fitted face's centre (its neutral landmarks' mean), in the world.
+  const face::FaceModel fitted(fit->shape, fit->style);
+  Vec3d centre = Vec3d::Zero();
+  for (const Vec3f& p : fitted.NeutralLandmarks()) centre += p.cast<double>() / 68.0;
+  const Vec3d pivot = fit->head_from_world.ApplyInverse(centre);
+  for (int k = 0; k < data->num_frames(); ++k) {
+    ASSERT_EQ(cameras[k].size(), 3u);
+    const Camera& train = data->camera(k);
+    for (const Camera& view : cameras[k]) {
+      EXPECT_EQ(view.intrinsics().fl_x, train.intrinsics().fl_x);
+      const Mat3d turn = view.world_from_cam().block<3, 3>(0, 0) * train.world_from_cam().block<3, 3>(0, 0).transpose();
+      const double angle = Eigen::AngleAxisd(turn).angle() * 180.0 / 3.14159265358979323846;
+      EXPECT_LE(angle, std::hypot(25.0, 12.0) + 1e-6);
+      EXPECT_GT(angle, 0.01);
+      // The centre turns with the camera about the pivot.
+      EXPECT_LT((view.Center() - pivot - turn * (train.Center() - pivot)).norm(), 1e-9);
+    }
+  }
+
+  const std::vector<ViewRay> rays = FaceModelViewRays(*fit, *data, expressions, options, ex);
+  const std::vector<ViewRay> one_thread = FaceModelViewRays(*fit, *data, expressions, options, Executor(1));
+  ASSERT_EQ(rays.size(), one_thread.size());
+  for (size_t i = 0; i < rays.size(); ++i) {
+    ASSERT_EQ(rays[i].depth, one_thread[i].depth) << i;
+    ASSERT_EQ(rays[i].ray.direction, one_thread[i].ray.direction) << i;
+  }
+  ASSERT_GT(rays.size(), 3u * 3u * 200u);  // about a tenth of each 96 x 96 view
+
+  const synth::IdentityParams identity = synth::SynthIdentity(o);
+  const face::FaceModel truth(identity.shape, identity.style);
+  std::vector<double> distances;
+  std::set<int> frames;
+  for (const ViewRay& r : rays) {
+    ASSERT_TRUE(std::isfinite(r.depth));
+    frames.insert(r.frame);
+    const Vec3d x_world = r.ray.At(r.depth).cast<double>();
+    const Vec3f x_head = ((x_world - o.head_offset) / o.head_scale).cast<float>();
+    distances.push_back(std::abs(truth.Distance(x_head, truth.Prepare(expressions[r.frame]))));
+  }
+  EXPECT_EQ(int(frames.size()), data->num_frames());
+  std::sort(distances.begin(), distances.end());
+  EXPECT_LT(distances[distances.size() / 2], 0.001) << "head units";
+  EXPECT_LT(distances[distances.size() * 9 / 10], 0.002) << "head units";
+
+  options.views_per_frame = 0;
+  EXPECT_TRUE(FaceModelViewRays(*fit, *data, expressions, options, ex).empty());
 }
 
 // train.depth_prior_region = "eyes": each eye's landmark hull, dilated; inside the expression region,

@@ -45,6 +45,16 @@ void TrainConfig::Bind(ConfigSchema& s) {
            "head, and where the ray leaves it) and the light that passes through the ray count as one "
            "termination at the reach, so the far side of the head is left alone and a hole is no way to meet "
            "the prior (0 = no reach: every sample counts, transmitted light costs nothing)");
+  s.Int("depth_prior_views", &depth_prior_views,
+        "unseen views per training frame whose rays L_depth also pulls to the face model's depth: the frame's "
+        "camera turned about the face (by up to depth_prior_view_yaw / depth_prior_view_pitch degrees), its "
+        "expression region's pixel rays that meet the fitted face model; no colour, only depth (0 = off)");
+  s.Int("depth_prior_view_rays", &depth_prior_view_rays,
+        "unseen-view rays per step (train.depth_prior_views), on top of train.batch_rays");
+  s.Number("depth_prior_view_yaw", &depth_prior_view_yaw,
+           "largest turn (degrees) of an unseen view about the head's up axis");
+  s.Number("depth_prior_view_pitch", &depth_prior_view_pitch,
+           "largest turn (degrees) of an unseen view about its camera's right axis");
   s.Number("symmetry_colour", &symmetry_colour,
            "weight of the symmetry prior's colour part relative to its opacity part (0 = geometry only)");
   s.Int("symmetry_max_samples", &symmetry_max_samples, "samples per step mirrored by the symmetry prior");
@@ -125,6 +135,12 @@ Status TrainConfig::Validate() const {
   if (!non_negative(lambda_depth_prior)) return Status::Error("train.lambda_depth_prior must be a finite number >= 0");
   if (!non_negative(depth_prior_window)) return Status::Error("train.depth_prior_window must be a finite number >= 0");
   if (!non_negative(depth_prior_reach)) return Status::Error("train.depth_prior_reach must be a finite number >= 0");
+  if (depth_prior_views < 0) return Status::Error("train.depth_prior_views must be >= 0");
+  if (depth_prior_view_rays < 0) return Status::Error("train.depth_prior_view_rays must be >= 0");
+  if (!non_negative(depth_prior_view_yaw) || depth_prior_view_yaw > 90)
+    return Status::Error("train.depth_prior_view_yaw must be a number of degrees in [0, 90]");
+  if (!non_negative(depth_prior_view_pitch) || depth_prior_view_pitch > 90)
+    return Status::Error("train.depth_prior_view_pitch must be a number of degrees in [0, 90]");
   if (!non_negative(lambda_occlusion)) return Status::Error("train.lambda_occlusion must be a finite number >= 0");
   if (!non_negative(lambda_symmetry)) return Status::Error("train.lambda_symmetry must be a finite number >= 0");
   if (!non_negative(symmetry_colour)) return Status::Error("train.symmetry_colour must be a finite number >= 0");

@@ -44,6 +44,12 @@ struct TrainConfig {
   std::string depth_prior_region = "expression";  // L_depth's pixels: "expression" (brows, eyes, mouth) or "eyes"
   double depth_prior_window = 0.01;  // L_depth's window half-width about the target, aabb diagonals (0 = none)
   double depth_prior_reach = 0.05;   // L_depth's reach behind the target, aabb diagonals (0 = none; render/depth_loss.h)
+  // L_depth on rays from unseen views too: each training frame's camera turned about the face by up
+  // to +-yaw / +-pitch degrees, views per frame (0 = off), rays per step from them (train/face_depth.h).
+  int depth_prior_views = 0;
+  int depth_prior_view_rays = 512;
+  double depth_prior_view_yaw = 20.0;
+  double depth_prior_view_pitch = 10.0;
   double symmetry_colour = LossWeights{}.symmetry_colour;  // weight of L_sym's colour part relative to its opacity part
   int symmetry_max_samples = LossWeights{}.symmetry_max_samples;  // samples per step mirrored by L_sym
   // Training rays through random points of their pixels (true) or through the centres (false, the

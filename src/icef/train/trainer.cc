@@ -67,6 +67,15 @@ Trainer::Trainer(const Dataset& dataset, fs::path model_dir, RunConfig config, T
         config_.train.depth_prior_region == "eyes" ? EyePixels(dataset_, data_) : data_.region_pixels();
     data_.SetDepthTargets(FaceModelDepthTargets(*model_->setup().face_fit, data_, model_->setup().training_expressions,
                                                 pixels, executor_));
+    if (config_.train.depth_prior_views > 0 && config_.train.depth_prior_view_rays > 0) {
+      ViewRayOptions views;
+      views.views_per_frame = config_.train.depth_prior_views;
+      views.max_yaw_deg = config_.train.depth_prior_view_yaw;
+      views.max_pitch_deg = config_.train.depth_prior_view_pitch;
+      views.seed = static_cast<uint64_t>(config_.train.seed);
+      data_.SetViewRays(FaceModelViewRays(*model_->setup().face_fit, data_, model_->setup().training_expressions,
+                                          views, executor_));
+    }
   }
   adam_ = std::make_unique<nn::Adam>(MakeAdamOptions(), &model_->store());
   ApplySchedules();
@@ -249,6 +258,7 @@ Result<LossTerms> Trainer::Step() {
   how.random_background = t.random_background;
   how.jitter = t.pixel_jitter;
   how.region_fraction = t.region_rays;
+  how.view_rays = t.depth_prior_view_rays;
   data_.SampleBatch(t.batch_rays, seed, state_.step, how, &batch_, executor_);
   const LossWeights w = t.Losses(data_.has_alpha());
   const LossTerms terms = model_->TrainForwardBackward(batch_, w, seed, state_.step, executor_);

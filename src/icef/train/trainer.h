@@ -92,6 +92,8 @@ class Trainer {
   const std::string& prior_shading_note() const { return prior_shading_note_; }
   // What the density start did ("" when train.density_start_steps is 0 or the method has no prior).
   const std::string& density_start_note() const { return density_start_note_; }
+  // The unseen-view rays L_depth acts on (train.depth_prior_views; 0 when off).
+  size_t num_view_rays() const { return data_.view_rays().size(); }
   // Which initialisation train.start_trials kept and why ("" when start_trials is 1).
   const std::string& start_trials_note() const { return start_trials_note_; }
   const RunConfig& config() const { return config_; }

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <iostream>
 #include <limits>
+#include <set>
 
 #include "icef/data/landmark_region.h"
 #include "icef/model/render_image.h"
@@ -395,6 +396,89 @@ TEST(TrainerTest, DepthPriorActsOnThePriorOnly) {
   bad = SmallConfig("icef-prior");
   bad.train.depth_prior_reach = std::numeric_limits<double>::quiet_NaN();
   EXPECT_FALSE(bad.Validate().ok());
+  bad = SmallConfig("icef-prior");
+  bad.train.depth_prior_views = -1;
+  EXPECT_FALSE(bad.Validate().ok());
+  bad = SmallConfig("icef-prior");
+  bad.train.depth_prior_view_rays = -5;
+  EXPECT_FALSE(bad.Validate().ok());
+  bad = SmallConfig("icef-prior");
+  bad.train.depth_prior_view_yaw = 120;
+  EXPECT_FALSE(bad.Validate().ok());
+  bad = SmallConfig("icef-prior");
+  bad.train.depth_prior_view_pitch = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(bad.Validate().ok());
+}
+
+// train.depth_prior_views: the trainer builds the unseen-view pool for the prior alone, each step
+// appends depth_prior_view_rays of its rays after the pixel rays, and the depth term then acts
+// with no pixel ray holding a target.
+TEST(TrainerTest, UnseenViewRaysJoinTheDepthPrior) {
+  for (const std::string method : {"icef-prior", "icef"}) {
+    RunConfig config = SmallConfig(method);
+    config.train.lambda_depth_prior = 10;
+    config.train.depth_prior_region = "eyes";
+    config.train.region_rays = 0;
+    config.train.depth_prior_views = 2;
+    config.train.depth_prior_view_rays = 64;
+    config.train.checkpoint_every = 0;
+    config.train.steps = 2;
+    auto trainer = Trainer::Create(TinySubject(), testing::MakeTempDir("trainer_view_rays_" + method), config);
+    ASSERT_TRUE(trainer.ok()) << trainer.status().message();
+    const bool prior = method == "icef-prior";
+    EXPECT_EQ((*trainer)->num_view_rays() > 0, prior) << method;
+    if (!prior) continue;
+    RunConfig none = config;
+    none.train.depth_prior_views = 0;
+    auto without = Trainer::Create(TinySubject(), testing::MakeTempDir("trainer_view_rays_none"), none);
+    ASSERT_TRUE(without.ok());
+    EXPECT_EQ((*without)->num_view_rays(), 0u);
+    const Result<LossTerms> with_terms = (*trainer)->Step(), without_terms = (*without)->Step();
+    ASSERT_TRUE(with_terms.ok() && without_terms.ok());
+    EXPECT_GT(with_terms->Get("depth"), without_terms->Get("depth"));
+    // The pixel rays are those of the run without views: the same photo term.
+    EXPECT_DOUBLE_EQ(with_terms->Get("photo"), without_terms->Get("photo"));
+  }
+}
+
+TEST(TrainingDataTest, ViewRaysFollowThePixelRays) {
+  auto data = TrainingData::Load(TinySubject());
+  ASSERT_TRUE(data.ok()) << data.status().message();
+  std::vector<ViewRay> pool;
+  for (int i = 0; i < 10; ++i)
+    pool.push_back(ViewRay{Ray{Vec3f(0.1f * i, 0, 3), Vec3f(0, 0, -1)}, int32_t(i % data->num_frames()), 2.f + i});
+  RaySampling how;
+  how.view_rays = 16;
+  TrainRays plain, with_pool, again;
+  data->SampleBatch(100, 4, 2, how, &plain, Executor(2));  // no pool: no view rays
+  EXPECT_EQ(plain.rays.size(), 100u);
+  EXPECT_EQ(plain.NumPhotoRays(), 100);
+  data->SetViewRays(pool);
+  data->SampleBatch(100, 4, 2, how, &with_pool, Executor(2));
+  data->SampleBatch(100, 4, 2, how, &again, Executor(1));
+  ASSERT_EQ(with_pool.rays.size(), 116u);
+  EXPECT_EQ(with_pool.NumPhotoRays(), 100);
+  ASSERT_EQ(with_pool.depth_target.size(), 116u);
+  for (int r = 0; r < 100; ++r) {
+    EXPECT_EQ(with_pool.rays[r].direction, plain.rays[r].direction);
+    EXPECT_EQ(with_pool.target_rgb[3 * r], plain.target_rgb[3 * r]);
+    EXPECT_TRUE(std::isnan(with_pool.depth_target[r]));  // no depth targets set on the pixels
+  }
+  std::set<int> drawn;
+  for (int r = 100; r < 116; ++r) {
+    const int i = int(std::lround(with_pool.depth_target[r] - 2.f));
+    ASSERT_GE(i, 0);
+    ASSERT_LT(i, 10);
+    drawn.insert(i);
+    EXPECT_EQ(with_pool.rays[r].origin, pool[i].ray.origin);
+    EXPECT_EQ(with_pool.frame[r], pool[i].frame);
+    EXPECT_EQ(with_pool.rays[r].origin, again.rays[r].origin);  // any thread count
+  }
+  EXPECT_GT(drawn.size(), 4u);
+  how.view_rays = 0;
+  data->SampleBatch(100, 4, 2, how, &again, Executor(2));
+  EXPECT_EQ(again.rays.size(), 100u);
+  EXPECT_EQ(again.photo_rays, -1);
 }
 
 // train.start_trials tries that many initialisations for start_trial_steps steps and trains the

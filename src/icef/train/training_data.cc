@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "icef/data/landmark_region.h"
 
@@ -68,12 +69,15 @@ void TrainingData::SetDepthTargets(std::vector<float> depth) {
 
 void TrainingData::SampleBatch(int num_rays, uint64_t seed, int64_t step, const RaySampling& how, TrainRays* batch,
                                const Executor& executor) const {
-  batch->rays.resize(num_rays);
-  batch->frame.resize(num_rays);
-  batch->target_rgb.resize(3 * size_t(num_rays));
-  batch->target_alpha.resize(has_alpha_ ? num_rays : 0);
-  batch->background.resize(3 * size_t(num_rays));
-  batch->depth_target.resize(depth_.empty() ? 0 : num_rays);
+  const int extra = view_rays_.empty() ? 0 : std::max(how.view_rays, 0);
+  const int all_rays = num_rays + extra;
+  batch->photo_rays = extra > 0 ? num_rays : -1;
+  batch->rays.resize(all_rays);
+  batch->frame.resize(all_rays);
+  batch->target_rgb.assign(3 * size_t(all_rays), 0.f);
+  batch->target_alpha.assign(has_alpha_ ? all_rays : 0, 0.f);
+  batch->background.resize(3 * size_t(all_rays));
+  batch->depth_target.assign(depth_.empty() && extra == 0 ? 0 : all_rays, std::numeric_limits<float>::quiet_NaN());
   const bool random = how.random_background && has_alpha_;
   const bool jitter = how.jitter;
   // The draws in ray order on the caller (three streams, each consumed in order), then the rays and
@@ -115,6 +119,15 @@ void TrainingData::SampleBatch(int num_rays, uint64_t seed, int64_t step, const 
       if (!depth_.empty()) batch->depth_target[r] = depth_[p];
     }
   });
+  // The unseen-view rays: no colour to match, only the face model's depth.
+  Rng view_rng(seed, StreamId("view_rays"), uint64_t(step));
+  for (int r = num_rays; r < all_rays; ++r) {
+    const ViewRay& v = view_rays_[view_rng.Below(view_rays_.size())];
+    batch->rays[r] = v.ray;
+    batch->frame[r] = v.frame;
+    batch->depth_target[r] = v.depth;
+    for (int a = 0; a < 3; ++a) batch->background[3 * r + a] = background_[a];
+  }
 }
 
 }  // namespace icef

@@ -21,6 +21,17 @@ struct RaySampling {
   // eyes and mouth by their 2D landmarks: data/landmark_region.h); the rest uniformly over all
   // pixels. 0 with no frame with landmarks.
   double region_fraction = 0;
+  // Rays appended after the pixel rays, drawn uniformly from the unseen-view pool (SetViewRays):
+  // depth targets alone (TrainRays::photo_rays). 0, or an empty pool: none.
+  int view_rays = 0;
+};
+
+// A ray from an unseen view of a training frame's expression with the fitted face model's depth on it
+// (train.depth_prior_views; train/face_depth.h builds them).
+struct ViewRay {
+  Ray ray;        // world frame
+  int32_t frame;  // the training frame whose expression the view shows
+  float depth;    // ray parameter t of the face model's surface
 };
 
 class TrainingData {
@@ -47,6 +58,9 @@ class TrainingData {
   // SampleBatch copies into TrainRays::depth_target; empty (the default) leaves it empty.
   void SetDepthTargets(std::vector<float> depth);
   const std::vector<float>& depth_targets() const { return depth_; }
+  // The pool SampleBatch draws RaySampling::view_rays from (empty by default).
+  void SetViewRays(std::vector<ViewRay> rays) { view_rays_ = std::move(rays); }
+  const std::vector<ViewRay>& view_rays() const { return view_rays_; }
   // The global pixel index of (frame k, x, y).
   int64_t PixelIndex(int k, int x, int y) const { return frame_offset_[k] + int64_t(y) * cameras_[k].width() + x; }
 
@@ -55,6 +69,8 @@ class TrainingData {
   // region_pixels(), the rest uniformly over all training pixels. With random_background (and
   // alpha), each ray's target is its foreground composited over a random colour that the model
   // also renders over, so the field cannot fake the background with haze (instant-ngp's trick).
+  // With view_rays and a pool, that many unseen-view rays follow the num_rays pixel rays (their own
+  // stream: the pixel rays are those of a batch without them); batch->photo_rays = num_rays.
   // The same batch for any executor.
   void SampleBatch(int num_rays, uint64_t seed, int64_t step, const RaySampling& how, TrainRays* batch,
                    const Executor& executor) const;
@@ -70,6 +86,7 @@ class TrainingData {
   bool has_alpha_ = false;
   std::vector<int64_t> region_pixels_;     // see region_pixels()
   std::vector<float> depth_;               // see SetDepthTargets()
+  std::vector<ViewRay> view_rays_;         // see SetViewRays()
 };
 
 }  // namespace icef
