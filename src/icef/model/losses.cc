@@ -160,12 +160,15 @@ class DepthPriorTerm final : public Loss {
   }
 };
 
-// L_occ: the occlusion sparsity prior per ray (render/occlusion_loss.h).
+// L_occ: the occlusion sparsity prior per ray (render/occlusion_loss.h), under a weight of its own on
+// the face-model prior (train.lambda_occlusion_prior).
 class OcclusionTerm final : public Loss {
  public:
   std::string_view name() const override { return "occlusion"; }
   LossStage stage() const override { return LossStage::kSamples; }
-  double Weight(const LossContext& ctx) const override { return ctx.weights.lambda_occlusion; }
+  double Weight(const LossContext& ctx) const override {
+    return ctx.traits.prior ? ctx.weights.lambda_occlusion_prior : ctx.weights.lambda_occlusion;
+  }
   double Evaluate(LossContext& ctx, double weight) override {
     ModelWorkspace& ws = ctx.ws;
     const int64_t num_rays = static_cast<int64_t>(ctx.batch.rays.size());

@@ -37,6 +37,7 @@ struct LossWeights {
   double lambda_mask = 0.0;
   double lambda_distortion = 0.0;
   double lambda_occlusion = 0.0;
+  double lambda_occlusion_prior = 0.0;  // L_occ's weight for the methods on the face-model prior
   double lambda_symmetry = 0.0;
   double lambda_depth_prior = 0.0;   // L_depth: rays with a face-model depth (TrainRays::depth_target)
   double depth_prior_window = 0.0;   // L_depth's window half-width about t*, aabb diagonals (0: none; render/depth_loss.h)

@@ -154,6 +154,25 @@ TEST(PriorGuidedTest, IdentityLossOnThePriorHasItsOwnWeight) {
   }
 }
 
+// On the prior, L_occ takes train.lambda_occlusion_prior; the methods without it lambda_occlusion.
+TEST(PriorGuidedTest, OcclusionPriorOnThePriorHasItsOwnWeight) {
+  LossWeights w;
+  w.lambda_occlusion = 0.25;
+  w.lambda_occlusion_prior = 3.0;
+  auto weight_of = [](const LossTerms& t) {
+    for (const LossValue& v : t.terms)
+      if (v.name == "occlusion") return v.weight;
+    return -1.0;
+  };
+  for (const char* method : {"icef-prior", "warp-prior"}) {
+    auto model = MakePriorModel(method, 0.3f);
+    EXPECT_EQ(weight_of(model->TrainForwardBackward(Batch(32, 2), w, 3, 0, Executor(1))), 3.0) << method;
+  }
+  auto plain = std::move(AvatarModel::Create(TinyModelConfig("icef"), TinySetup(), Executor(1))).value();
+  plain->Initialize(7);
+  EXPECT_EQ(weight_of(plain->TrainForwardBackward(Batch(32, 2), w, 3, 0, Executor(1))), 0.25);
+}
+
 // D_final = P + kappa R_phi + (1 - kappa) R_lin: P enters with weight 1 at every kappa.
 TEST(PriorGuidedTest, ConfidenceBlendsOnlyTheResidual) {
   auto with_prior = MakePriorModel("icef-prior", 0.3f);

@@ -39,6 +39,8 @@ TEST(ConfigDefaultsTest, EmptyConfigBuildsEveryComponentWithItsOwnDefaults) {
   EXPECT_EQ(w.symmetry_max_samples, d.symmetry_max_samples);
   EXPECT_EQ(w.lambda_id, config.train.lambda_id);
   EXPECT_EQ(w.lambda_id_prior, config.train.lambda_id_prior);
+  EXPECT_EQ(w.lambda_occlusion, config.train.lambda_occlusion);
+  EXPECT_EQ(w.lambda_occlusion_prior, config.train.lambda_occlusion_prior);
   EXPECT_EQ(config.train.Losses(false).lambda_mask, 0.0);
 }
 

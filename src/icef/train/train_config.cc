@@ -26,6 +26,10 @@ void TrainConfig::Bind(ConfigSchema& s) {
   s.Number("lambda_distortion", &lambda_distortion, "weight of the mip-NeRF 360 distortion loss, distances in aabb diagonals (few-shot prior; 0 = off)");
   s.Number("lambda_occlusion", &lambda_occlusion,
            "weight of the occlusion sparsity prior: density behind what the training rays already hit (0 = off)");
+  s.Number("lambda_occlusion_prior", &lambda_occlusion_prior,
+           "weight of the occlusion sparsity prior for the methods on the face-model prior (icef-prior, "
+           "warp-prior; 0 = off: their face-model depth prior holds the geometry, and this prior eroded the "
+           "back of the head, which few training rays see)");
   s.Number("lambda_symmetry", &lambda_symmetry,
            "weight of the left-right symmetry prior: opacity (and colour) of canonical samples against their "
            "mirror images across the face's landmark symmetry plane (few-shot prior; 0 = off)");
@@ -102,6 +106,7 @@ LossWeights TrainConfig::Losses(bool has_alpha) const {
   LossWeights w;
   w.lambda_id = lambda_id;
   w.lambda_id_prior = lambda_id_prior;
+  w.lambda_occlusion_prior = lambda_occlusion_prior;
   w.lambda_smooth = lambda_smooth;
   w.lambda_mask = has_alpha ? lambda_mask : 0.0;
   w.lambda_distortion = lambda_distortion;
@@ -129,6 +134,8 @@ Status TrainConfig::Validate() const {
   if (!positive(lr_final_factor) || lr_final_factor > 1) return Status::Error("train.lr_final_factor must be in (0, 1]");
   if (!non_negative(lambda_id)) return Status::Error("train.lambda_id must be a finite number >= 0");
   if (!non_negative(lambda_id_prior)) return Status::Error("train.lambda_id_prior must be a finite number >= 0");
+  if (!non_negative(lambda_occlusion_prior))
+    return Status::Error("train.lambda_occlusion_prior must be a finite number >= 0");
   if (!non_negative(lambda_smooth)) return Status::Error("train.lambda_smooth must be a finite number >= 0");
   if (!non_negative(lambda_mask)) return Status::Error("train.lambda_mask must be a finite number >= 0");
   if (!non_negative(lambda_distortion)) return Status::Error("train.lambda_distortion must be a finite number >= 0");

@@ -36,6 +36,10 @@ struct TrainConfig {
   double smooth_epsilon = LossWeights{}.smooth_epsilon;  // finite-difference offset of L_smooth (half-extent units)
   int smooth_max_samples = LossWeights{}.smooth_max_samples;  // boundary samples per step used by L_smooth
   double lambda_occlusion = 1e-4;    // weight of the occlusion sparsity prior (0 = off)
+  // Its weight for the methods on the face-model prior (icef-prior, warp-prior): 0, since L_depth
+  // holds their geometry and L_occ eroded the back of the head there; on validation identities
+  // 101-108 PSNR +0.56 to +0.68 dB at an unchanged expression (docs/results/near_tier_variants).
+  double lambda_occlusion_prior = 0.0;
   double lambda_symmetry = 0.1;      // weight of the left-right symmetry prior L_sym (0 = off)
   // Weight of L_depth: the expression regions' training rays pulled to the fitted face model's depth
   // (methods on the face-model prior; 0 = off; train/face_depth.h). 10, with the window and reach

@@ -397,6 +397,9 @@ TEST(TrainerTest, DepthPriorActsOnThePriorOnly) {
   bad.train.depth_prior_reach = std::numeric_limits<double>::quiet_NaN();
   EXPECT_FALSE(bad.Validate().ok());
   bad = SmallConfig("icef-prior");
+  bad.train.lambda_occlusion_prior = -1e-4;
+  EXPECT_FALSE(bad.Validate().ok());
+  bad = SmallConfig("icef-prior");
   bad.train.depth_prior_views = -1;
   EXPECT_FALSE(bad.Validate().ok());
   bad = SmallConfig("icef-prior");
