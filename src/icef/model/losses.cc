@@ -161,7 +161,8 @@ class DepthPriorTerm final : public Loss {
 };
 
 // L_occ: the occlusion sparsity prior per ray (render/occlusion_loss.h), under a weight of its own on
-// the face-model prior (train.lambda_occlusion_prior).
+// the face-model prior (train.lambda_occlusion_prior), where it may act inside the expression
+// regions alone (train.occlusion_prior_in_regions: each sample's term times the region mask M).
 class OcclusionTerm final : public Loss {
  public:
   std::string_view name() const override { return "occlusion"; }
@@ -174,11 +175,13 @@ class OcclusionTerm final : public Loss {
     const int64_t num_rays = static_cast<int64_t>(ctx.batch.rays.size());
     const double inv_r = InvRays(ctx);
     const float scale = static_cast<float>(weight * inv_r);
+    const float* region =
+        ctx.traits.prior && ctx.weights.occlusion_prior_in_regions ? ctx.RegionMaskValues().data() : nullptr;
     double occ = 0;
     for (int64_t r = 0; r < num_rays; ++r) {
       const int64_t off = ws.samples.ray_offset[r], cnt = ws.samples.ray_count[r];
       occ += OcclusionLossRay<float>(static_cast<int>(cnt), &ws.composite.weights[off], &ws.sigma[off],
-                                     &ws.samples.dt[off], scale, &ws.d_sigma[off]);
+                                     &ws.samples.dt[off], scale, &ws.d_sigma[off], region ? region + off : nullptr);
     }
     return occ * inv_r;
   }

@@ -38,6 +38,7 @@ struct LossWeights {
   double lambda_distortion = 0.0;
   double lambda_occlusion = 0.0;
   double lambda_occlusion_prior = 0.0;  // L_occ's weight for the methods on the face-model prior
+  bool occlusion_prior_in_regions = false;  // there, L_occ inside the expression regions only (times M)
   double lambda_symmetry = 0.0;
   double lambda_depth_prior = 0.0;   // L_depth: rays with a face-model depth (TrainRays::depth_target)
   double depth_prior_window = 0.0;   // L_depth's window half-width about t*, aabb diagonals (0: none; render/depth_loss.h)

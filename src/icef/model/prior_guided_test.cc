@@ -173,6 +173,27 @@ TEST(PriorGuidedTest, OcclusionPriorOnThePriorHasItsOwnWeight) {
   EXPECT_EQ(weight_of(plain->TrainForwardBackward(Batch(32, 2), w, 3, 0, Executor(1))), 0.25);
 }
 
+// train.occlusion_prior_in_regions: on the prior, L_occ counts each sample times the region mask M
+// (some of the batch lies outside the regions, so less than the whole prior, and more than none);
+// the methods without the prior keep the whole prior.
+TEST(PriorGuidedTest, OcclusionPriorInTheRegionsOnly) {
+  auto occlusion = [](AvatarModel& model, bool in_regions) {
+    LossWeights w;
+    w.lambda_occlusion = w.lambda_occlusion_prior = 1.0;
+    w.occlusion_prior_in_regions = in_regions;
+    const LossTerms t = model.TrainForwardBackward(Batch(64, 5), w, 3, 0, Executor(1));
+    return t.Get("occlusion");
+  };
+  auto model = MakePriorModel("icef-prior", 0.3f, true, 2.0f);  // dense: light is absorbed early
+  const double whole = occlusion(*model, false), regions = occlusion(*model, true);
+  EXPECT_GT(whole, 0.0);
+  EXPECT_GT(regions, 0.0);
+  EXPECT_LT(regions, 0.9 * whole);
+  auto plain = std::move(AvatarModel::Create(TinyModelConfig("icef"), TinySetup(), Executor(1))).value();
+  plain->Initialize(7);
+  EXPECT_EQ(occlusion(*plain, true), occlusion(*plain, false));
+}
+
 // D_final = P + kappa R_phi + (1 - kappa) R_lin: P enters with weight 1 at every kappa.
 TEST(PriorGuidedTest, ConfidenceBlendsOnlyTheResidual) {
   auto with_prior = MakePriorModel("icef-prior", 0.3f);

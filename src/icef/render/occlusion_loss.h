@@ -7,6 +7,8 @@
 // already hidden, it never pays the ray to become more transparent in front. alpha saturates, so
 // a solid interior costs at most its sample count and is not hollowed out; thin haze behind the
 // surface is what the gradient dL/dsigma_i = o_i dt_i exp(-sigma_i dt_i) removes.
+// With per-sample factors m_i (e.g. the expression-region mask M at each sample) the prior acts
+// where they are non-zero only: L = sum_i m_i o_i alpha_i.
 #pragma once
 
 #include <cmath>
@@ -14,15 +16,17 @@
 
 namespace icef {
 
-// One ray: weights, sigma, dt [n]. Returns the loss; ADDS scale * dL/dsigma to d_sigma [n] when
-// d_sigma is not null.
+// One ray: weights, sigma, dt [n], and the factors m [n] (null: 1 everywhere). Returns the loss;
+// ADDS scale * dL/dsigma to d_sigma [n] when d_sigma is not null.
 template <typename T>
-T OcclusionLossRay(int n, const T* weights, const T* sigma, const T* dt, T scale, T* d_sigma) {
+T OcclusionLossRay(int n, const T* weights, const T* sigma, const T* dt, T scale, T* d_sigma,
+                   const T* m = nullptr) {
   T absorbed = T(0), loss = T(0);
   for (int i = 0; i < n; ++i) {
+    const T held = m ? absorbed * m[i] : absorbed;
     const T transmit = std::exp(-sigma[i] * dt[i]);
-    loss += absorbed * (T(1) - transmit);
-    if (d_sigma) d_sigma[i] += scale * absorbed * dt[i] * transmit;
+    loss += held * (T(1) - transmit);
+    if (d_sigma) d_sigma[i] += scale * held * dt[i] * transmit;
     absorbed += weights[i];
   }
   return loss;

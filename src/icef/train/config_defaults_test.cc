@@ -41,6 +41,7 @@ TEST(ConfigDefaultsTest, EmptyConfigBuildsEveryComponentWithItsOwnDefaults) {
   EXPECT_EQ(w.lambda_id_prior, config.train.lambda_id_prior);
   EXPECT_EQ(w.lambda_occlusion, config.train.lambda_occlusion);
   EXPECT_EQ(w.lambda_occlusion_prior, config.train.lambda_occlusion_prior);
+  EXPECT_EQ(w.occlusion_prior_in_regions, config.train.occlusion_prior_in_regions);
   EXPECT_EQ(config.train.Losses(false).lambda_mask, 0.0);
 }
 

@@ -30,6 +30,11 @@ void TrainConfig::Bind(ConfigSchema& s) {
            "weight of the occlusion sparsity prior for the methods on the face-model prior (icef-prior, "
            "warp-prior; 0 = off: their face-model depth prior holds the geometry, and this prior eroded the "
            "back of the head, which few training rays see)");
+  s.Bool("occlusion_prior_in_regions", &occlusion_prior_in_regions,
+         "on the face-model prior, the occlusion sparsity prior (train.lambda_occlusion_prior) inside the "
+         "expression regions (brows, eyes, mouth) alone: each sample's term weighted by the region mask M, "
+         "the back of the head left alone (off: on validation identities it cost expression everywhere, "
+         "the eyes included; docs/results/near_tier_variants)");
   s.Number("lambda_symmetry", &lambda_symmetry,
            "weight of the left-right symmetry prior: opacity (and colour) of canonical samples against their "
            "mirror images across the face's landmark symmetry plane (few-shot prior; 0 = off)");
@@ -107,6 +112,7 @@ LossWeights TrainConfig::Losses(bool has_alpha) const {
   w.lambda_id = lambda_id;
   w.lambda_id_prior = lambda_id_prior;
   w.lambda_occlusion_prior = lambda_occlusion_prior;
+  w.occlusion_prior_in_regions = occlusion_prior_in_regions;
   w.lambda_smooth = lambda_smooth;
   w.lambda_mask = has_alpha ? lambda_mask : 0.0;
   w.lambda_distortion = lambda_distortion;

@@ -40,6 +40,9 @@ struct TrainConfig {
   // holds their geometry and L_occ eroded the back of the head there; on validation identities
   // 101-108 PSNR +0.56 to +0.68 dB at an unchanged expression (docs/results/near_tier_variants).
   double lambda_occlusion_prior = 0.0;
+  // On the prior, L_occ inside the expression regions alone (each sample's term times the mask M);
+  // off: on validation identities 101-108 it cost expression in every tier, the eyes included.
+  bool occlusion_prior_in_regions = false;
   double lambda_symmetry = 0.1;      // weight of the left-right symmetry prior L_sym (0 = off)
   // Weight of L_depth: the expression regions' training rays pulled to the fitted face model's depth
   // (methods on the face-model prior; 0 = off; train/face_depth.h). 10, with the window and reach
