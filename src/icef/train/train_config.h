@@ -45,9 +45,10 @@ struct TrainConfig {
   bool occlusion_prior_in_regions = false;
   double lambda_symmetry = 0.1;      // weight of the left-right symmetry prior L_sym (0 = off)
   // Weight of L_depth: the expression regions' training rays pulled to the fitted face model's depth
-  // (methods on the face-model prior; 0 = off; train/face_depth.h). 10, with the window and reach
-  // below, chosen on validation identities 101-108 (docs/results/near_tier_variants).
-  double lambda_depth_prior = 10.0;
+  // (methods on the face-model prior; 0 = off; train/face_depth.h). 30, with the window and reach
+  // below, chosen on validation identities 101-108 (docs/results/near_tier_variants): more of the
+  // expression and nearer the truth's identity in every tier, for a few hundredths of a dB.
+  double lambda_depth_prior = 30.0;
   std::string depth_prior_region = "expression";  // L_depth's pixels: "expression" (brows, eyes, mouth) or "eyes"
   double depth_prior_window = 0.01;  // L_depth's window half-width about the target, aabb diagonals (0 = none)
   double depth_prior_reach = 0.05;   // L_depth's reach behind the target, aabb diagonals (0 = none; render/depth_loss.h)
