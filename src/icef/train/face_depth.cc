@@ -143,4 +143,21 @@ std::vector<int64_t> EyePixels(const Dataset& dataset, const TrainingData& data)
   return pixels;
 }
 
+std::vector<int64_t> FacePixels(const Dataset& dataset, const TrainingData& data) {
+  std::vector<uint8_t> face(size_t(data.num_pixels()), 0);
+  for (int64_t p : data.region_pixels()) face[size_t(p)] = 1;
+  for (int k = 0; k < data.num_frames() && k < int(dataset.train.size()); ++k) {
+    if (!dataset.train[k].landmarks_2d) continue;
+    const int width = data.camera(k).width(), height = data.camera(k).height();
+    const Image hull = LandmarkHullRegion(width, height, *dataset.train[k].landmarks_2d);
+    for (int y = 0; y < height; ++y)
+      for (int x = 0; x < width; ++x)
+        if (hull.At(x, y, 0) > 0.f) face[size_t(data.PixelIndex(k, x, y))] = 1;
+  }
+  std::vector<int64_t> pixels;
+  for (size_t p = 0; p < face.size(); ++p)
+    if (face[p]) pixels.push_back(int64_t(p));
+  return pixels;
+}
+
 }  // namespace icef

@@ -1,6 +1,6 @@
 // Depth targets from the fitted face model (train.lambda_depth_prior): for each chosen training
-// pixel (train.depth_prior_region: the expression region of TrainingData's region pixels, or the
-// eyes alone), where the centre ray through it meets the fitted face model's surface at that frame's
+// pixel (train.depth_prior_region: the expression region of TrainingData's region pixels, the
+// eyes alone, or the whole face), where the centre ray through it meets the fitted face model's surface at that frame's
 // expression (the fit's shape and expression style, head_from_world carrying the ray into the head
 // frame). The loss (model/losses.h, L_depth) pulls each such ray's compositing-weighted depth
 // towards it, within a window and a reach along the ray (render/depth_loss.h). On by default for
@@ -50,5 +50,11 @@ std::vector<ViewRay> FaceModelViewRays(const face::FaceFit& fit, const TrainingD
 // The training pixels of the eyes: each eye's 2D landmark hull (iBUG 36-41, 42-47) of each frame
 // with landmarks, dilated as the expression region (DefaultRegionDilation). Global pixel indices.
 std::vector<int64_t> EyePixels(const Dataset& dataset, const TrainingData& data);
+
+// The training pixels of the face (train.depth_prior_region = "face"): the filled hull of all 68
+// landmarks of each frame with landmarks (jaw line to brows: cheeks, nose and chin as well),
+// united with the expression region (region_pixels(), dilated beyond the hull at the brows).
+// Global pixel indices, ascending.
+std::vector<int64_t> FacePixels(const Dataset& dataset, const TrainingData& data);
 
 }  // namespace icef

@@ -188,5 +188,33 @@ TEST(FaceDepthTest, EyePixelsAreTheEyesOfEveryFrame) {
   }
 }
 
+// train.depth_prior_region = "face": the expression region and, on every frame, the hull of all 68
+// landmarks (nose and cheeks too), and nothing outside the face.
+TEST(FaceDepthTest, FacePixelsAreTheExpressionRegionAndTheLandmarkHull) {
+  synth::SynthOptions o = SubjectOptions();
+  o.out_dir = testing::MakeTempDir("face_depth_face");
+  ASSERT_TRUE(synth::SynthesizeDataset(o, Executor(2)).ok());
+  auto dataset = LoadDataset(o.out_dir);
+  ASSERT_TRUE(dataset.ok()) << dataset.status().message();
+  auto data = TrainingData::Load(*dataset);
+  ASSERT_TRUE(data.ok()) << data.status().message();
+  const std::vector<int64_t> face = FacePixels(*dataset, *data);
+  ASSERT_TRUE(std::is_sorted(face.begin(), face.end()));
+  ASSERT_TRUE(std::adjacent_find(face.begin(), face.end()) == face.end()) << "a pixel twice";
+  std::vector<uint8_t> in_face(size_t(data->num_pixels()), 0);
+  for (int64_t p : face) in_face[p] = 1;
+  for (int64_t p : data->region_pixels()) EXPECT_TRUE(in_face[p]) << p;
+  EXPECT_GT(face.size(), data->region_pixels().size() * 5 / 4) << "the cheeks and nose add pixels";
+  EXPECT_LT(face.size(), size_t(data->num_pixels()) / 2) << "the face, not the image";
+  for (int k = 0; k < data->num_frames(); ++k) {
+    const std::vector<Vec2f>& lm = *dataset->train[k].landmarks_2d;
+    auto pixel = [&](const Vec2f& p) { return data->PixelIndex(k, int(std::floor(p.x())), int(std::floor(p.y()))); };
+    EXPECT_TRUE(in_face[pixel(lm[30])]) << "frame " << k << ": the nose tip";
+    EXPECT_TRUE(in_face[pixel(0.5f * (lm[2] + lm[30]))]) << "frame " << k << ": the right cheek";
+    EXPECT_TRUE(in_face[pixel(0.5f * (lm[14] + lm[30]))]) << "frame " << k << ": the left cheek";
+    EXPECT_FALSE(in_face[data->PixelIndex(k, 0, 0)]) << "frame " << k << ": the image corner";
+  }
+}
+
 }  // namespace
 }  // namespace icef

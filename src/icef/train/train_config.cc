@@ -44,7 +44,8 @@ void TrainConfig::Bind(ConfigSchema& s) {
            "diagonals (icef-prior, warp-prior; 0 = off)");
   s.String("depth_prior_region", &depth_prior_region,
            "the pixels L_depth acts on: \"expression\" (the expression region: brows, eyes, mouth and what lies "
-           "between them, as train.region_rays) or \"eyes\" (each eye's landmark hull)");
+           "between them, as train.region_rays), \"eyes\" (each eye's landmark hull) or \"face\" (the hull of all 68 "
+           "landmarks, jaw line to brows, with the expression region)");
   s.Number("depth_prior_window", &depth_prior_window,
            "half-width of L_depth's window about the face model's depth, in aabb diagonals: each sample's "
            "offset from it is clamped to the window, so the weight a ray keeps far behind the face (where it "
@@ -169,8 +170,9 @@ Status TrainConfig::Validate() const {
     return Status::Error("train: anneal_steps, grid_anneal_steps, density_start_steps, occupancy_warmup, checkpoint_every, eval_every must be >= 0 and "
                          "occupancy_every, log_every >= 1");
   if (threads < 0) return Status::Error("train.threads must be >= 0");
-  if (depth_prior_region != "expression" && depth_prior_region != "eyes")
-    return Status::Error("train.depth_prior_region must be \"expression\" or \"eyes\", got \"" + depth_prior_region + "\"");
+  if (depth_prior_region != "expression" && depth_prior_region != "eyes" && depth_prior_region != "face")
+    return Status::Error("train.depth_prior_region must be \"expression\", \"eyes\" or \"face\", got \"" +
+                         depth_prior_region + "\"");
   if (on_nonfinite != "stop" && on_nonfinite != "skip")
     return Status::Error("train.on_nonfinite must be \"stop\" or \"skip\", got \"" + on_nonfinite + "\"");
   return Status::Ok();

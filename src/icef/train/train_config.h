@@ -49,7 +49,7 @@ struct TrainConfig {
   // below, chosen on validation identities 101-108 (docs/results/near_tier_variants): more of the
   // expression and nearer the truth's identity in every tier, for a few hundredths of a dB.
   double lambda_depth_prior = 30.0;
-  std::string depth_prior_region = "expression";  // L_depth's pixels: "expression" (brows, eyes, mouth) or "eyes"
+  std::string depth_prior_region = "expression";  // L_depth's pixels: "expression" (brows, eyes, mouth), "eyes" or "face"
   double depth_prior_window = 0.01;  // L_depth's window half-width about the target, aabb diagonals (0 = none)
   double depth_prior_reach = 0.05;   // L_depth's reach behind the target, aabb diagonals (0 = none; render/depth_loss.h)
   // L_depth on rays from unseen views too: each training frame's camera turned about the face by up

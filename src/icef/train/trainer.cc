@@ -63,8 +63,10 @@ Trainer::Trainer(const Dataset& dataset, fs::path model_dir, RunConfig config, T
       executor_(config_.train.threads) {
   // L_depth's targets: a function of the data and the fit alone, so a resumed run recomputes them.
   if (config_.train.lambda_depth_prior > 0 && model_->setup().face_fit) {
-    const std::vector<int64_t> pixels =
-        config_.train.depth_prior_region == "eyes" ? EyePixels(dataset_, data_) : data_.region_pixels();
+    const std::string& region = config_.train.depth_prior_region;
+    const std::vector<int64_t> pixels = region == "eyes"   ? EyePixels(dataset_, data_)
+                                        : region == "face" ? FacePixels(dataset_, data_)
+                                                           : data_.region_pixels();
     data_.SetDepthTargets(FaceModelDepthTargets(*model_->setup().face_fit, data_, model_->setup().training_expressions,
                                                 pixels, executor_));
     if (config_.train.depth_prior_views > 0 && config_.train.depth_prior_view_rays > 0) {
