@@ -377,6 +377,14 @@ TEST(TrainerTest, DepthPriorActsOnThePriorOnly) {
     ASSERT_TRUE(eyes_terms.ok() && all_terms.ok());
     EXPECT_GT(eyes_terms->Get("depth"), 0);
     EXPECT_LT(eyes_terms->Get("depth"), all_terms->Get("depth"));
+    // The whole face: more rays with a target (cheeks, nose, chin as well), so a larger term.
+    RunConfig face_config = config;
+    face_config.train.depth_prior_region = "face";
+    auto face = Trainer::Create(TinySubject(), testing::MakeTempDir("trainer_depth_prior_face"), face_config);
+    ASSERT_TRUE(face.ok()) << face.status().message();
+    const Result<LossTerms> face_terms = (*face)->Step();
+    ASSERT_TRUE(face_terms.ok());
+    EXPECT_GT(face_terms->Get("depth"), all_terms->Get("depth"));
     ASSERT_TRUE((*trainer)->SaveCheckpoint().ok());
     auto resumed = Trainer::Resume(TinySubject(), dir, std::nullopt, std::nullopt, std::nullopt);
     ASSERT_TRUE(resumed.ok()) << resumed.status().message();
