@@ -102,10 +102,11 @@ std::vector<ViewRay> FaceModelViewRays(const face::FaceFit& fit, const TrainingD
           projected[i] = p->uv.cast<float>();
       const int width = camera.width(), height = camera.height();
       const Image region = ExpressionRegion(width, height, projected, {}, DefaultRegionDilation(width));
+      const Image hull = options.whole_face ? LandmarkHullRegion(width, height, projected) : Image(width, height, 1, 0.f);
       std::vector<int64_t> pixels;
       for (int y = 0; y < height; ++y)
         for (int x = 0; x < width; ++x)
-          if (region.At(x, y, 0) > 0.f) pixels.push_back(int64_t(y) * width + x);
+          if (region.At(x, y, 0) > 0.f || hull.At(x, y, 0) > 0.f) pixels.push_back(int64_t(y) * width + x);
       std::vector<ViewRay> rays(pixels.size());
       ParallelFor(executor, int64_t(pixels.size()), [&](int64_t i0, int64_t i1, int) {
         for (int64_t i = i0; i < i1; ++i) {

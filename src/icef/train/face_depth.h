@@ -32,6 +32,9 @@ struct ViewRayOptions {
   double max_yaw_deg = 20.0;
   double max_pitch_deg = 10.0;
   uint64_t seed = 0;
+  // The view's pixels: the expression region (false) or, as well, the filled hull of all 68 of the
+  // face model's landmarks (true: nose, cheeks and chin; train.depth_prior_view_region = "face").
+  bool whole_face = false;
 };
 
 // The cameras of those views: [frame][view], intrinsics of the frame's camera.
@@ -40,7 +43,8 @@ std::vector<std::vector<Camera>> UnseenViewCameras(const face::FaceFit& fit, con
 
 // The centre rays of the pixels of every unseen view that lie in the expression region of the
 // fitted face model's own landmarks at that frame's expression (projected into the view;
-// ExpressionRegion, dilated as the training frames' regions) and meet its surface there, each with
+// ExpressionRegion, dilated as the training frames' regions; with options.whole_face also in their
+// filled hull, LandmarkHullRegion) and meet its surface there, each with
 // the surface's ray parameter. L_depth on these reaches the geometry between the training views,
 // which no image constrains. Deterministic for any executor.
 std::vector<ViewRay> FaceModelViewRays(const face::FaceFit& fit, const TrainingData& data,

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <filesystem>
 #include <set>
+#include <tuple>
 #include <vector>
 
 #include "icef/data/dataset.h"
@@ -158,6 +159,25 @@ TEST(FaceDepthTest, UnseenViewRaysLieOnTheSubjectsSurface) {
   std::sort(distances.begin(), distances.end());
   EXPECT_LT(distances[distances.size() / 2], 0.001) << "head units";
   EXPECT_LT(distances[distances.size() * 9 / 10], 0.002) << "head units";
+
+  // train.depth_prior_view_region = "face": the expression region's rays and more (nose, cheeks,
+  // chin), on the same surface.
+  ViewRayOptions face_options = options;
+  face_options.whole_face = true;
+  const std::vector<ViewRay> face_rays = FaceModelViewRays(*fit, *data, expressions, face_options, ex);
+  EXPECT_GT(face_rays.size(), rays.size() * 5 / 4);
+  std::set<std::tuple<int, float, float, float>> face_set;
+  for (const ViewRay& r : face_rays) face_set.insert({r.frame, r.ray.direction.x(), r.ray.direction.y(), r.ray.direction.z()});
+  for (const ViewRay& r : rays)
+    ASSERT_TRUE(face_set.count({r.frame, r.ray.direction.x(), r.ray.direction.y(), r.ray.direction.z()}));
+  std::vector<double> face_distances;
+  for (const ViewRay& r : face_rays) {
+    const Vec3f x_head = ((r.ray.At(r.depth).cast<double>() - o.head_offset) / o.head_scale).cast<float>();
+    face_distances.push_back(std::abs(truth.Distance(x_head, truth.Prepare(expressions[r.frame]))));
+  }
+  std::sort(face_distances.begin(), face_distances.end());
+  EXPECT_LT(face_distances[face_distances.size() / 2], 0.001) << "head units";
+  EXPECT_LT(face_distances[face_distances.size() * 9 / 10], 0.002) << "head units";
 
   options.views_per_frame = 0;
   EXPECT_TRUE(FaceModelViewRays(*fit, *data, expressions, options, ex).empty());

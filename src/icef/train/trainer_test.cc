@@ -419,6 +419,13 @@ TEST(TrainerTest, DepthPriorActsOnThePriorOnly) {
   bad = SmallConfig("icef-prior");
   bad.train.depth_prior_view_pitch = std::numeric_limits<double>::quiet_NaN();
   EXPECT_FALSE(bad.Validate().ok());
+  bad = SmallConfig("icef-prior");
+  bad.train.depth_prior_view_region = "eyes";
+  const Status view_region = bad.Validate();
+  ASSERT_FALSE(view_region.ok());
+  EXPECT_NE(view_region.message().find("train.depth_prior_view_region"), std::string::npos) << view_region.message();
+  bad.train.depth_prior_view_region = "face";
+  EXPECT_TRUE(bad.Validate().ok());
 }
 
 // train.depth_prior_views: the trainer builds the unseen-view pool for the prior alone, each step
