@@ -47,7 +47,8 @@ struct FittedHead {
 std::vector<float> FaceModelDepthTargets(const face::FaceFit& fit, const TrainingData& data,
                                          const std::vector<std::vector<float>>& expressions,
                                          const std::vector<int64_t>& pixels, const Executor& executor) {
-  ICEF_CHECK(int(expressions.size()) == data.num_frames(), "depth targets: one expression per training frame");
+  ICEF_CHECK(int(expressions.size()) == data.num_frames(),
+             "depth targets: one expression per training frame");
   const FittedHead fitted(fit, expressions);
   std::vector<float> depth(size_t(data.num_pixels()), std::numeric_limits<float>::quiet_NaN());
   ParallelFor(executor, int64_t(pixels.size()), [&](int64_t i0, int64_t i1, int) {
@@ -96,13 +97,15 @@ std::vector<ViewRay> FaceModelViewRays(const face::FaceFit& fit, const TrainingD
   for (int k = 0; k < data.num_frames(); ++k) {
     const std::array<Vec3f, 68> landmarks = fitted.head.Landmarks(fitted.states[k]);
     for (const Camera& camera : cameras[k]) {
-      std::vector<Vec2f> projected(landmarks.size(), Vec2f::Constant(std::numeric_limits<float>::quiet_NaN()));
+      std::vector<Vec2f> projected(landmarks.size(),
+                                   Vec2f::Constant(std::numeric_limits<float>::quiet_NaN()));
       for (size_t i = 0; i < landmarks.size(); ++i)
         if (const auto p = camera.Project(fitted.s.ApplyInverse(landmarks[i].cast<double>())))
           projected[i] = p->uv.cast<float>();
       const int width = camera.width(), height = camera.height();
       const Image region = ExpressionRegion(width, height, projected, {}, DefaultRegionDilation(width));
-      const Image hull = options.whole_face ? LandmarkHullRegion(width, height, projected) : Image(width, height, 1, 0.f);
+      const Image hull =
+          options.whole_face ? LandmarkHullRegion(width, height, projected) : Image(width, height, 1, 0.f);
       std::vector<int64_t> pixels;
       for (int y = 0; y < height; ++y)
         for (int x = 0; x < width; ++x)

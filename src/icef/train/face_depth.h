@@ -1,11 +1,12 @@
 // Depth targets from the fitted face model (train.lambda_depth_prior): for each chosen training
 // pixel (train.depth_prior_region: the expression region of TrainingData's region pixels, the
-// eyes alone, or the whole face), where the centre ray through it meets the fitted face model's surface at that frame's
-// expression (the fit's shape and expression style, head_from_world carrying the ray into the head
-// frame). The loss (model/losses.h, L_depth) pulls each such ray's compositing-weighted depth
-// towards it, within a window and a reach along the ray (render/depth_loss.h). On by default for
-// the face-model prior (lambda 10, window 0.01, reach 0.05): on the validation identities it adds
-// expression and PSNR in every tier, though not at the eyes (docs/results/near_tier_variants).
+// eyes alone, or the whole face), where the centre ray through it meets the fitted face model's
+// surface at that frame's expression (the fit's shape and expression style, head_from_world
+// carrying the ray into the head frame). The loss (model/losses.h, L_depth) pulls each such ray's
+// compositing-weighted depth towards it, within a window and a reach along the ray
+// (render/depth_loss.h). On by default for the face-model prior (lambda 30, window 0.01, reach
+// 0.05, the expression region): on the validation identities it adds expression in every tier and
+// brings the renders nearer the truth's identity (docs/results/near_tier_variants).
 #pragma once
 
 #include <vector>

@@ -51,7 +51,8 @@ TEST(FaceDepthTest, TargetsLieOnTheSubjectsSurfaceInsideTheExpressionRegionsOnly
 
   const std::vector<float> depth = FaceModelDepthTargets(*fit, *data, expressions, data->region_pixels(), ex);
   ASSERT_EQ(int64_t(depth.size()), data->num_pixels());
-  const std::vector<float> one_thread = FaceModelDepthTargets(*fit, *data, expressions, data->region_pixels(), Executor(1));
+  const std::vector<float> one_thread =
+      FaceModelDepthTargets(*fit, *data, expressions, data->region_pixels(), Executor(1));
   EXPECT_EQ(std::memcmp(depth.data(), one_thread.data(), depth.size() * sizeof(float)), 0) << "thread count";
 
   const std::vector<int64_t>& region = data->region_pixels();
@@ -126,7 +127,8 @@ TEST(FaceDepthTest, UnseenViewRaysLieOnTheSubjectsSurface) {
     const Camera& train = data->camera(k);
     for (const Camera& view : cameras[k]) {
       EXPECT_EQ(view.intrinsics().fl_x, train.intrinsics().fl_x);
-      const Mat3d turn = view.world_from_cam().block<3, 3>(0, 0) * train.world_from_cam().block<3, 3>(0, 0).transpose();
+      const Mat3d turn =
+          view.world_from_cam().block<3, 3>(0, 0) * train.world_from_cam().block<3, 3>(0, 0).transpose();
       const double angle = Eigen::AngleAxisd(turn).angle() * 180.0 / 3.14159265358979323846;
       EXPECT_LE(angle, std::hypot(25.0, 12.0) + 1e-6);
       EXPECT_GT(angle, 0.01);
@@ -167,7 +169,8 @@ TEST(FaceDepthTest, UnseenViewRaysLieOnTheSubjectsSurface) {
   const std::vector<ViewRay> face_rays = FaceModelViewRays(*fit, *data, expressions, face_options, ex);
   EXPECT_GT(face_rays.size(), rays.size() * 5 / 4);
   std::set<std::tuple<int, float, float, float>> face_set;
-  for (const ViewRay& r : face_rays) face_set.insert({r.frame, r.ray.direction.x(), r.ray.direction.y(), r.ray.direction.z()});
+  for (const ViewRay& r : face_rays)
+    face_set.insert({r.frame, r.ray.direction.x(), r.ray.direction.y(), r.ray.direction.z()});
   for (const ViewRay& r : rays)
     ASSERT_TRUE(face_set.count({r.frame, r.ray.direction.x(), r.ray.direction.y(), r.ray.direction.z()}));
   std::vector<double> face_distances;
@@ -201,7 +204,9 @@ TEST(FaceDepthTest, EyePixelsAreTheEyesOfEveryFrame) {
   for (int64_t p : eyes) EXPECT_TRUE(in_region[p]) << p;
   for (int k = 0; k < data->num_frames(); ++k) {
     const std::vector<Vec2f>& lm = *dataset->train[k].landmarks_2d;
-    auto pixel = [&](int i) { return data->PixelIndex(k, int(std::floor(lm[i].x())), int(std::floor(lm[i].y()))); };
+    auto pixel = [&](int i) {
+      return data->PixelIndex(k, int(std::floor(lm[i].x())), int(std::floor(lm[i].y())));
+    };
     for (int i = 36; i < 48; ++i) EXPECT_TRUE(in_eyes[pixel(i)]) << "frame " << k << " landmark " << i;
     for (int i = 48; i < 68; ++i) EXPECT_FALSE(in_eyes[pixel(i)]) << "frame " << k << " landmark " << i;
     EXPECT_FALSE(in_eyes[pixel(30)]) << "frame " << k << ": the nose tip";
@@ -228,7 +233,9 @@ TEST(FaceDepthTest, FacePixelsAreTheExpressionRegionAndTheLandmarkHull) {
   EXPECT_LT(face.size(), size_t(data->num_pixels()) / 2) << "the face, not the image";
   for (int k = 0; k < data->num_frames(); ++k) {
     const std::vector<Vec2f>& lm = *dataset->train[k].landmarks_2d;
-    auto pixel = [&](const Vec2f& p) { return data->PixelIndex(k, int(std::floor(p.x())), int(std::floor(p.y()))); };
+    auto pixel = [&](const Vec2f& p) {
+      return data->PixelIndex(k, int(std::floor(p.x())), int(std::floor(p.y())));
+    };
     EXPECT_TRUE(in_face[pixel(lm[30])]) << "frame " << k << ": the nose tip";
     EXPECT_TRUE(in_face[pixel(0.5f * (lm[2] + lm[30]))]) << "frame " << k << ": the right cheek";
     EXPECT_TRUE(in_face[pixel(0.5f * (lm[14] + lm[30]))]) << "frame " << k << ": the left cheek";
