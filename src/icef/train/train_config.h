@@ -54,7 +54,9 @@ struct TrainConfig {
   double depth_prior_reach = 0.05;   // L_depth's reach behind the target, aabb diagonals (0 = none; render/depth_loss.h)
   // L_depth on rays from unseen views too: each training frame's camera turned about the face by up
   // to +-yaw / +-pitch degrees, views per frame (0 = off), rays per step from them (train/face_depth.h).
-  int depth_prior_views = 0;
+  // On by default since 2026-11-29 (ninth): more of the expression in every tier, mostly in the eyes,
+  // identity and PSNR within their noise (docs/results/near_tier_variants/).
+  int depth_prior_views = 4;
   int depth_prior_view_rays = 512;
   double depth_prior_view_yaw = 20.0;
   double depth_prior_view_pitch = 10.0;

@@ -1,0 +1,23 @@
+# gnuplot id_distance.gp (run in this directory) draws id_distance.png and id_distance.svg
+set terminal pngcairo noenhanced size 460,480 font "sans,9"
+set output "id_distance.png"
+set multiplot layout 1,1 title "id_distance against delta (mean +- std over 3 identities)"
+set xlabel "delta (distance to the nearest training expression)"
+set ylabel "identity distance to own neutral render"
+set grid
+set key below horizontal box
+set offsets 0.05, 0.05, 0, 0
+set title "K = 5"
+plot 'id_distance.dat' index 0 using 1:2:3 with yerrorlines lw 2 pt 7 title "icef-prior"
+unset multiplot
+set terminal svg noenhanced size 460,480 font "sans,9"
+set output "id_distance.svg"
+set multiplot layout 1,1 title "id_distance against delta (mean +- std over 3 identities)"
+set xlabel "delta (distance to the nearest training expression)"
+set ylabel "identity distance to own neutral render"
+set grid
+set key below horizontal box
+set offsets 0.05, 0.05, 0, 0
+set title "K = 5"
+plot 'id_distance.dat' index 0 using 1:2:3 with yerrorlines lw 2 pt 7 title "icef-prior"
+unset multiplot
