@@ -40,6 +40,7 @@ void BenchOptions::ApplyQuick() {
                                          "model.sampler.num_samples=24",
                                          "model.occupancy.resolution=32",
                                          "train.batch_rays=512",
+                                         "train.depth_prior_view_rays=64",  // the default's 1/8 of batch_rays
                                          "train.anneal_steps=10",
                                          "train.occupancy_warmup=16",
                                          "train.occupancy_every=8",

@@ -47,6 +47,7 @@ RunConfig SmallConfig(const std::string& method) {
   c.model.sampler.num_samples = 24;
   c.model.occupancy.resolution = 32;
   c.train.batch_rays = 512;
+  c.train.depth_prior_view_rays = 64;  // the default's 1/8 of batch_rays
   c.train.threads = 2;
   c.train.log_every = 10;
   c.train.occupancy_warmup = 32;
@@ -356,6 +357,7 @@ TEST(TrainerTest, DepthPriorActsOnThePriorOnly) {
     config.train.checkpoint_every = 0;
     config.train.steps = 3;
     config.train.region_rays = 0.5;  // the targets lie in the expression regions
+    config.train.depth_prior_views = 0;  // the training pixels' regions alone (views: below)
     const fs::path dir = testing::MakeTempDir("trainer_depth_prior_" + method);
     auto trainer = Trainer::Create(TinySubject(), dir, config);
     ASSERT_TRUE(trainer.ok()) << trainer.status().message();
