@@ -44,6 +44,13 @@ struct FittedHead {
 
 }  // namespace
 
+ViewRayOptions::Region ViewRegionFromName(const std::string& name) {
+  if (name == "upper") return ViewRayOptions::Region::kUpper;
+  if (name == "face") return ViewRayOptions::Region::kFace;
+  ICEF_CHECK(name == "expression", "unknown unseen-view region " + name);
+  return ViewRayOptions::Region::kExpression;
+}
+
 std::vector<float> FaceModelDepthTargets(const face::FaceFit& fit, const TrainingData& data,
                                          const std::vector<std::vector<float>>& expressions,
                                          const std::vector<int64_t>& pixels, const Executor& executor) {
@@ -102,10 +109,12 @@ std::vector<ViewRay> FaceModelViewRays(const face::FaceFit& fit, const TrainingD
       for (size_t i = 0; i < landmarks.size(); ++i)
         if (const auto p = camera.Project(fitted.s.ApplyInverse(landmarks[i].cast<double>())))
           projected[i] = p->uv.cast<float>();
+      if (options.region == ViewRayOptions::Region::kUpper)  // drop the mouth (iBUG 48-67)
+        for (size_t i = 48; i < projected.size(); ++i) projected[i] = Vec2f::Constant(std::numeric_limits<float>::quiet_NaN());
       const int width = camera.width(), height = camera.height();
       const Image region = ExpressionRegion(width, height, projected, {}, DefaultRegionDilation(width));
       const Image hull =
-          options.whole_face ? LandmarkHullRegion(width, height, projected) : Image(width, height, 1, 0.f);
+          options.region == ViewRayOptions::Region::kFace ? LandmarkHullRegion(width, height, projected) : Image(width, height, 1, 0.f);
       std::vector<int64_t> pixels;
       for (int y = 0; y < height; ++y)
         for (int x = 0; x < width; ++x)

@@ -9,6 +9,7 @@
 // brings the renders nearer the truth's identity (docs/results/near_tier_variants).
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "icef/core/parallel.h"
@@ -33,10 +34,16 @@ struct ViewRayOptions {
   double max_yaw_deg = 20.0;
   double max_pitch_deg = 10.0;
   uint64_t seed = 0;
-  // The view's pixels: the expression region (false) or, as well, the filled hull of all 68 of the
-  // face model's landmarks (true: nose, cheeks and chin; train.depth_prior_view_region = "face").
-  bool whole_face = false;
+  // The view's pixels (train.depth_prior_view_region): the expression region ("expression", the
+  // dilated hull of brows, eyes and mouth), the same hull without the mouth ("upper": brows and
+  // eyes), or the expression region and the filled hull of all 68 landmarks ("face": nose, cheeks
+  // and chin as well).
+  enum class Region { kExpression, kUpper, kFace };
+  Region region = Region::kExpression;
 };
+
+// "expression", "upper" or "face" (TrainConfig::Validate accepts no other).
+ViewRayOptions::Region ViewRegionFromName(const std::string& name);
 
 // The cameras of those views: [frame][view], intrinsics of the frame's camera.
 std::vector<std::vector<Camera>> UnseenViewCameras(const face::FaceFit& fit, const TrainingData& data,
@@ -44,8 +51,8 @@ std::vector<std::vector<Camera>> UnseenViewCameras(const face::FaceFit& fit, con
 
 // The centre rays of the pixels of every unseen view that lie in the expression region of the
 // fitted face model's own landmarks at that frame's expression (projected into the view;
-// ExpressionRegion, dilated as the training frames' regions; with options.whole_face also in their
-// filled hull, LandmarkHullRegion) and meet its surface there, each with
+// ExpressionRegion, dilated as the training frames' regions; options.region can drop the mouth's
+// landmarks from it or add their filled hull, LandmarkHullRegion) and meet its surface there, each with
 // the surface's ray parameter. L_depth on these reaches the geometry between the training views,
 // which no image constrains. Deterministic for any executor.
 std::vector<ViewRay> FaceModelViewRays(const face::FaceFit& fit, const TrainingData& data,

@@ -165,7 +165,7 @@ TEST(FaceDepthTest, UnseenViewRaysLieOnTheSubjectsSurface) {
   // train.depth_prior_view_region = "face": the expression region's rays and more (nose, cheeks,
   // chin), on the same surface.
   ViewRayOptions face_options = options;
-  face_options.whole_face = true;
+  face_options.region = ViewRayOptions::Region::kFace;
   const std::vector<ViewRay> face_rays = FaceModelViewRays(*fit, *data, expressions, face_options, ex);
   EXPECT_GT(face_rays.size(), rays.size() * 5 / 4);
   std::set<std::tuple<int, float, float, float>> face_set;
@@ -181,6 +181,37 @@ TEST(FaceDepthTest, UnseenViewRaysLieOnTheSubjectsSurface) {
   std::sort(face_distances.begin(), face_distances.end());
   EXPECT_LT(face_distances[face_distances.size() / 2], 0.001) << "head units";
   EXPECT_LT(face_distances[face_distances.size() * 9 / 10], 0.002) << "head units";
+
+  // train.depth_prior_view_region = "upper": the expression region's rays above the mouth (brows and
+  // eyes): a subset, every hit above the truth's upper lip at its frame's expression, where the
+  // expression region's rays also reach below it.
+  ViewRayOptions upper_options = options;
+  upper_options.region = ViewRayOptions::Region::kUpper;
+  const std::vector<ViewRay> upper_rays = FaceModelViewRays(*fit, *data, expressions, upper_options, ex);
+  EXPECT_GT(upper_rays.size(), rays.size() / 4);
+  EXPECT_LT(upper_rays.size(), rays.size() * 3 / 4);
+  std::set<std::tuple<int, float, float, float>> expression_set;
+  for (const ViewRay& r : rays)
+    expression_set.insert({r.frame, r.ray.direction.x(), r.ray.direction.y(), r.ray.direction.z()});
+  const auto head_point = [&](const ViewRay& r) {
+    return ((r.ray.At(r.depth).cast<double>() - o.head_offset) / o.head_scale).cast<float>().eval();
+  };
+  const auto lip_top = [&](int frame) {  // the truth's highest mouth landmark at that frame
+    const std::array<Vec3f, 68> l = truth.Landmarks(truth.Prepare(expressions[frame]));
+    float top = -1e9f;
+    for (int i = 48; i < 68; ++i) top = std::max(top, l[i].y());
+    return top;
+  };
+  for (const ViewRay& r : upper_rays) {
+    ASSERT_TRUE(expression_set.count({r.frame, r.ray.direction.x(), r.ray.direction.y(), r.ray.direction.z()}));
+    ASSERT_GT(head_point(r).y(), lip_top(r.frame));
+  }
+  int below_lip = 0;
+  for (const ViewRay& r : rays) below_lip += head_point(r).y() < lip_top(r.frame);
+  EXPECT_GT(below_lip, int(rays.size()) / 10);
+  EXPECT_EQ(ViewRegionFromName("upper"), ViewRayOptions::Region::kUpper);
+  EXPECT_EQ(ViewRegionFromName("face"), ViewRayOptions::Region::kFace);
+  EXPECT_EQ(ViewRegionFromName("expression"), ViewRayOptions::Region::kExpression);
 
   options.views_per_frame = 0;
   EXPECT_TRUE(FaceModelViewRays(*fit, *data, expressions, options, ex).empty());

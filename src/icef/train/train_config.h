@@ -60,7 +60,7 @@ struct TrainConfig {
   int depth_prior_view_rays = 512;
   double depth_prior_view_yaw = 20.0;
   double depth_prior_view_pitch = 10.0;
-  std::string depth_prior_view_region = "expression";  // the unseen views' pixels: "expression" or "face"
+  std::string depth_prior_view_region = "expression";  // the unseen views' pixels: "expression", "upper" or "face"
   double symmetry_colour = LossWeights{}.symmetry_colour;  // weight of L_sym's colour part relative to its opacity part
   int symmetry_max_samples = LossWeights{}.symmetry_max_samples;  // samples per step mirrored by L_sym
   // Training rays through random points of their pixels (true) or through the centres (false, the

@@ -75,7 +75,7 @@ Trainer::Trainer(const Dataset& dataset, fs::path model_dir, RunConfig config, T
       views.max_yaw_deg = config_.train.depth_prior_view_yaw;
       views.max_pitch_deg = config_.train.depth_prior_view_pitch;
       views.seed = static_cast<uint64_t>(config_.train.seed);
-      views.whole_face = config_.train.depth_prior_view_region == "face";
+      views.region = ViewRegionFromName(config_.train.depth_prior_view_region);
       data_.SetViewRays(FaceModelViewRays(*model_->setup().face_fit, data_, model_->setup().training_expressions,
                                           views, executor_));
     }

@@ -428,6 +428,8 @@ TEST(TrainerTest, DepthPriorActsOnThePriorOnly) {
   EXPECT_NE(view_region.message().find("train.depth_prior_view_region"), std::string::npos) << view_region.message();
   bad.train.depth_prior_view_region = "face";
   EXPECT_TRUE(bad.Validate().ok());
+  bad.train.depth_prior_view_region = "upper";
+  EXPECT_TRUE(bad.Validate().ok());
 }
 
 // train.depth_prior_views: the trainer builds the unseen-view pool for the prior alone, each step
