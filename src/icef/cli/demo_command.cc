@@ -15,9 +15,13 @@ CommandFn RegisterDemo(CLI::App& app) {
   app.add_option("--identity-seed", o->identity_seed, "Which synthetic person")->capture_default_str();
   app.add_option("--k", o->k, "Training frames (3, 5 or 10)")->capture_default_str()->check(CLI::Range(1, 100));
   app.add_option("--res", o->resolution, "Image resolution")->capture_default_str()->check(CLI::Range(16, 1024));
-  app.add_option("--time-budget", o->time_budget, "Training time cap, seconds (0 = none); training stops at --steps or here")->capture_default_str()
+  app.add_option("--time-budget", o->time_budget,
+                 "Training time cap, seconds (0 = none); training stops at --steps or here")
+      ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
-  app.add_option("--steps", o->steps, "Training steps (1000: the bench's and the README sheet's)")->capture_default_str()->check(CLI::PositiveNumber);
+  app.add_option("--steps", o->steps, "Training steps (1000: the bench's and the README sheet's)")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   app.add_option("--threads", o->threads, "Worker threads (0 = all cores)")->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   app.add_flag("--quick", o->quick, "Tiny settings that finish in seconds (for tests)");

@@ -110,11 +110,13 @@ std::vector<ViewRay> FaceModelViewRays(const face::FaceFit& fit, const TrainingD
         if (const auto p = camera.Project(fitted.s.ApplyInverse(landmarks[i].cast<double>())))
           projected[i] = p->uv.cast<float>();
       if (options.region == ViewRayOptions::Region::kUpper)  // drop the mouth (iBUG 48-67)
-        for (size_t i = 48; i < projected.size(); ++i) projected[i] = Vec2f::Constant(std::numeric_limits<float>::quiet_NaN());
+        for (size_t i = 48; i < projected.size(); ++i)
+          projected[i] = Vec2f::Constant(std::numeric_limits<float>::quiet_NaN());
       const int width = camera.width(), height = camera.height();
       const Image region = ExpressionRegion(width, height, projected, {}, DefaultRegionDilation(width));
-      const Image hull =
-          options.region == ViewRayOptions::Region::kFace ? LandmarkHullRegion(width, height, projected) : Image(width, height, 1, 0.f);
+      const Image hull = options.region == ViewRayOptions::Region::kFace
+                             ? LandmarkHullRegion(width, height, projected)
+                             : Image(width, height, 1, 0.f);
       std::vector<int64_t> pixels;
       for (int y = 0; y < height; ++y)
         for (int x = 0; x < width; ++x)

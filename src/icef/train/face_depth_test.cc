@@ -203,7 +203,8 @@ TEST(FaceDepthTest, UnseenViewRaysLieOnTheSubjectsSurface) {
     return top;
   };
   for (const ViewRay& r : upper_rays) {
-    ASSERT_TRUE(expression_set.count({r.frame, r.ray.direction.x(), r.ray.direction.y(), r.ray.direction.z()}));
+    ASSERT_TRUE(
+        expression_set.count({r.frame, r.ray.direction.x(), r.ray.direction.y(), r.ray.direction.z()}));
     ASSERT_GT(head_point(r).y(), lip_top(r.frame));
   }
   int below_lip = 0;

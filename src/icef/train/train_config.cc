@@ -65,10 +65,11 @@ void TrainConfig::Bind(ConfigSchema& s) {
            "largest turn (degrees) of an unseen view about the head's up axis");
   s.Number("depth_prior_view_pitch", &depth_prior_view_pitch,
            "largest turn (degrees) of an unseen view about its camera's right axis");
-  s.String("depth_prior_view_region", &depth_prior_view_region,
-           "the unseen views' pixels: \"expression\" (the expression region of the face model's own landmarks "
-           "projected into the view), \"upper\" (that region without the mouth: brows and eyes) or \"face\" (the "
-           "filled hull of all 68 as well: nose, cheeks, chin)");
+  s.String(
+      "depth_prior_view_region", &depth_prior_view_region,
+      "the unseen views' pixels: \"expression\" (the expression region of the face model's own landmarks "
+      "projected into the view), \"upper\" (that region without the mouth: brows and eyes) or \"face\" (the "
+      "filled hull of all 68 as well: nose, cheeks, chin)");
   s.Number("symmetry_colour", &symmetry_colour,
            "weight of the symmetry prior's colour part relative to its opacity part (0 = geometry only)");
   s.Int("symmetry_max_samples", &symmetry_max_samples, "samples per step mirrored by the symmetry prior");
@@ -179,8 +180,9 @@ Status TrainConfig::Validate() const {
                          depth_prior_region + "\"");
   if (depth_prior_view_region != "expression" && depth_prior_view_region != "upper" &&
       depth_prior_view_region != "face")
-    return Status::Error("train.depth_prior_view_region must be \"expression\", \"upper\" or \"face\", got \"" +
-                         depth_prior_view_region + "\"");
+    return Status::Error(
+        "train.depth_prior_view_region must be \"expression\", \"upper\" or \"face\", got \"" +
+        depth_prior_view_region + "\"");
   if (on_nonfinite != "stop" && on_nonfinite != "skip")
     return Status::Error("train.on_nonfinite must be \"stop\" or \"skip\", got \"" + on_nonfinite + "\"");
   return Status::Ok();
