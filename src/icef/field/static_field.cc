@@ -116,10 +116,14 @@ void StaticField::DensityForward(const Executor& executor, int64_t n, const floa
                        keep_for_backward);
 }
 
-void StaticField::Forward(const Executor& executor, int64_t n, const float* positions, const float* directions,
-                          const float* condition, float* sigma, float* rgb, StaticFieldContext* ctx,
-                          bool keep_for_backward, bool need_position_grad) const {
+void StaticField::Forward(const Executor& executor, int64_t n, const float* positions,
+                          const float* directions, const float* condition, float* sigma, float* rgb,
+                          StaticFieldContext* ctx, bool keep_for_backward, bool need_position_grad,
+                          int64_t color_rows) const {
+  ICEF_CHECK(color_rows >= -1 && color_rows <= n, "color_rows out of range");
+  const int64_t nc = color_rows < 0 ? n : color_rows;
   DensityForward(executor, n, positions, condition, ctx, keep_for_backward, need_position_grad);
+  ctx->color_rows = nc;
   const int geo = options_.geo_features, sh = options_.sh_degree * options_.sh_degree, ci = geo + sh;
   nn::GrowTo(ctx->color_input, n * ci);
   float* cin = ctx->color_input.data();
@@ -127,11 +131,13 @@ void StaticField::Forward(const Executor& executor, int64_t n, const float* posi
   ParallelFor(executor, n, [&](int64_t b, int64_t e, int) {
     for (int64_t i = b; i < e; ++i) {
       sigma[i] = std::exp(std::min(h[i * geo] + options_.density_bias, kMaxLogDensity));
+      if (i >= nc) continue;
       std::copy(h + i * geo, h + (i + 1) * geo, cin + i * ci);
       nn::ShForward<float>(options_.sh_degree, 1, directions + 3 * i, cin + i * ci + geo);
     }
   });
-  color_mlp_.Forward(executor, n, cin, rgb, &ctx->color_mlp, keep_for_backward);
+  color_mlp_.Forward(executor, nc, cin, rgb, &ctx->color_mlp, keep_for_backward);
+  std::fill(rgb + 3 * nc, rgb + 3 * n, 0.f);
 }
 
 void StaticField::Backward(const Executor& executor, int64_t n, const float* sigma, const float* rgb,
@@ -144,8 +150,10 @@ void StaticField::Backward(const Executor& executor, int64_t n, const float* sig
   nn::GrowTo(ctx->d_color_input, n * ci);
   nn::GrowTo(ctx->d_density_output, n * geo);
   nn::GrowTo(ctx->d_density_input, n * di);
-  color_mlp_.Backward(executor, n, ctx->color_input.data(), rgb, d_rgb, &ctx->color_mlp,
+  const int64_t nc = ctx->color_rows;
+  color_mlp_.Backward(executor, nc, ctx->color_input.data(), rgb, d_rgb, &ctx->color_mlp,
                       ctx->d_color_input.data());
+  std::fill(ctx->d_color_input.begin() + nc * ci, ctx->d_color_input.begin() + n * ci, 0.f);
   const float* dci = ctx->d_color_input.data();
   const float* h = ctx->density_output.data();
   float* dh = ctx->d_density_output.data();

@@ -54,6 +54,7 @@ inline constexpr float kMaxLogDensity = 15.f;
 // Per-batch buffers; reused across batches (grows, never shrinks).
 struct StaticFieldContext {
   int64_t n = 0;
+  int64_t color_rows = 0;  // the rows [0, color_rows) of the last Forward that have a colour
   bool has_position_jacobian = false;
   nn::AlignedVector<float> unit_positions;  // [n, 3] in [0,1]^3
   nn::AlignedVector<float> density_input;   // [n, L*F + condition_dims]
@@ -80,13 +81,15 @@ class StaticField {
   // positions [n, 3] canonical world frame; directions [n, 3] unit, world frame; condition
   // [n, condition_dims] or null when condition_dims = 0 -> sigma [n], rgb [n, 3].
   // keep_for_backward keeps what Backward needs; need_position_grad also keeps the grid's
-  // Jacobian so Backward can return d/d positions.
+  // Jacobian so Backward can return d/d positions. color_rows (0 <= color_rows <= n, or -1 = n):
+  // only the samples [0, color_rows) run the colour MLP; the others get rgb 0 and no colour
+  // gradient (training's unseen-view rays, which only a depth term reads).
   void Forward(const Executor& executor, int64_t n, const float* positions, const float* directions,
                const float* condition, float* sigma, float* rgb, StaticFieldContext* ctx,
-               bool keep_for_backward, bool need_position_grad) const;
+               bool keep_for_backward, bool need_position_grad, int64_t color_rows = -1) const;
   // After Forward(keep_for_backward), with its outputs sigma [n] and rgb [n, 3]: accumulates
-  // parameter gradients into the store from d_sigma [n] and d_rgb [n, 3]; writes d_positions
-  // [n, 3] (world frame) unless null.
+  // parameter gradients into the store from d_sigma [n] and d_rgb [n, 3] (the rows of d_rgb past
+  // Forward's color_rows are not read); writes d_positions [n, 3] (world frame) unless null.
   void Backward(const Executor& executor, int64_t n, const float* sigma, const float* rgb, const float* d_sigma,
                 const float* d_rgb, StaticFieldContext* ctx, float* d_positions);
   // Density only (occupancy-grid updates): positions [n, 3] -> sigma [n].

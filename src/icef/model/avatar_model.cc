@@ -175,7 +175,8 @@ void AvatarModel::ExpandRays(const TrainRays& batch, ModelWorkspace& ws, const E
 }
 
 void AvatarModel::FieldForward(ModelWorkspace& ws, int64_t n, const float* positions, bool train,
-                               const Executor& executor) const {
+                               const Executor& executor, int64_t color_rows) const {
+  if (color_rows < 0) color_rows = n;
   const float* canonical = positions;
   if (warp_) {
     Fit(ws.canonical, 3 * n);
@@ -186,10 +187,11 @@ void AvatarModel::FieldForward(ModelWorkspace& ws, int64_t n, const float* posit
   }
   Fit(ws.sigma, n);
   Fit(ws.rgb, 3 * n);
-  static_field_->Forward(executor, n, canonical, ws.dirs.data(), traits_.entangled_beta ? ws.betas.data() : nullptr,
-                         ws.sigma.data(), ws.rgb.data(), &ws.static_ctx, train, train && warp_ != nullptr);
+  static_field_->Forward(executor, n, canonical, ws.dirs.data(),
+                         traits_.entangled_beta ? ws.betas.data() : nullptr, ws.sigma.data(), ws.rgb.data(),
+                         &ws.static_ctx, train, train && warp_ != nullptr, color_rows);
   ws.shade.clear();
-  if (light_ && ShadingNormals(ws, n, positions, executor)) {
+  if (light_ && ShadingNormals(ws, n, color_rows, positions, executor)) {
     Fit(ws.shade, n);
     if (train) ws.rgb_unshaded.assign(ws.rgb.begin(), ws.rgb.begin() + 3 * n);
     ApplyPriorShading(executor, n, ws.normals_obs.data(), ws.normals_can.data(), *light_, ws.rgb.data(),
@@ -203,14 +205,14 @@ void AvatarModel::FieldForward(ModelWorkspace& ws, int64_t n, const float* posit
   }
 }
 
-bool AvatarModel::ShadingNormals(ModelWorkspace& ws, int64_t n, const float* positions,
+bool AvatarModel::ShadingNormals(ModelWorkspace& ws, int64_t n, int64_t color_rows, const float* positions,
                                  const Executor& executor) const {
   // The face model's normals cost eight signed-distance evaluations: only at samples dense enough to
   // show (each weighs at most 1 - exp(-kShadeMinDensity dt) in its ray, about 2e-3 at 96 samples
   // across a [-1, 1]^3 aabb); elsewhere both normals are zero, which makes s = 1.
   const int b = setup_.expression_dim;
   ws.shade_index.clear();
-  for (int64_t i = 0; i < n; ++i)
+  for (int64_t i = 0; i < color_rows; ++i)
     if (ws.sigma[i] > kShadeMinDensity) ws.shade_index.push_back(i);
   const int64_t m = static_cast<int64_t>(ws.shade_index.size());
   Fit(ws.shade_positions, 3 * m);
@@ -297,7 +299,13 @@ LossTerms AvatarModel::TrainForwardBackward(const TrainRays& batch, const LossWe
     warp_->ForwardTrain(executor, n, ws.samples.positions.data(), ws.betas.data(), ws.offsets.data(),
                         ws.residual.data(), &ws.deform_ctx, true);
   }
-  FieldForward(ws, n, ws.samples.positions.data(), true, executor);
+  // The unseen views' rays (those after batch.photo_rays) carry a depth target alone: no term reads
+  // their samples' colour, unless the symmetry prior's colour part mirrors some of them.
+  const int64_t photo_rays = batch.NumPhotoRays();
+  const bool symmetry_colour = weights.lambda_symmetry != 0 && weights.symmetry_colour != 0;
+  const int64_t color_rows =
+      photo_rays < num_rays && !symmetry_colour ? ws.samples.ray_offset[photo_rays] : n;
+  FieldForward(ws, n, ws.samples.positions.data(), true, executor, color_rows);
 
   // Compositing over the known background.
   const float bg[3] = {setup_.background.x(), setup_.background.y(), setup_.background.z()};

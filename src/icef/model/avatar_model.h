@@ -137,12 +137,16 @@ class AvatarModel {
   void ExpandRays(const TrainRays& batch, ModelWorkspace& ws, const Executor& executor) const;
   // Static field (and the prior's shading and cavity) at n samples: canonical = positions +
   // ws.offsets; reads ws.dirs and ws.betas, writes ws.sigma and ws.rgb (and, when shaded, ws.shade and
-  // in training ws.rgb_unshaded).
-  void FieldForward(ModelWorkspace& ws, int64_t n, const float* positions, bool train, const Executor& executor) const;
+  // in training ws.rgb_unshaded). Only the samples [0, color_rows) get a colour (-1: all of them;
+  // StaticField::Forward): the others' rgb is 0 and unshaded.
+  void FieldForward(ModelWorkspace& ws, int64_t n, const float* positions, bool train,
+                    const Executor& executor, int64_t color_rows = -1) const;
+  // The face model's normals at the samples [0, color_rows) of FieldForward dense enough to show
+  // (others: zero normals, no shading) into ws.normals_obs / normals_can; false when the prior has
+  // none.
+  bool ShadingNormals(ModelWorkspace& ws, int64_t n, int64_t color_rows, const float* positions,
+                      const Executor& executor) const;
   // Runs the terms of one stage (model/losses.h) and records their values in `terms`.
-  // The face model's normals at the samples of FieldForward dense enough to show (others: zero
-  // normals, no shading) into ws.normals_obs / normals_can; false when the prior has none.
-  bool ShadingNormals(ModelWorkspace& ws, int64_t n, const float* positions, const Executor& executor) const;
   void RunLosses(LossStage stage, LossContext& ctx, LossTerms* terms);
   void WarpOffsets(const Executor& executor, int64_t n, const float* positions, std::span<const float> beta,
                    float* offsets, WarpPart part) const;
