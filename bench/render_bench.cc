@@ -126,7 +126,9 @@ BENCHMARK(BM_RenderImage256)->Unit(benchmark::kMillisecond)->UseRealTime();
 // occupancy-grid update every train.occupancy_every steps) on 2 threads, after warm-up steps of a
 // fresh trainer past train.occupancy_warmup, so that the timed steps are those of most of a run.
 // bf16:1 is the default config (model.bf16_training: the MLP products of training in BF16 with FP32
-// sums); bf16:0 the same step in FP32.
+// sums); bf16:0 the same step in FP32. composited:1 is the default (only the samples the pixel rays
+// composite run the colour MLP and the shading normals: AvatarModel::TrainForwardBackward);
+// composited:0 colours every sample, as training did before.
 void BM_TrainStep(benchmark::State& state) {
   const Subject& s = TrainedSubject();
   if (!s.error.empty()) return state.SkipWithError(s.error.c_str());
@@ -139,6 +141,7 @@ void BM_TrainStep(benchmark::State& state) {
       std::filesystem::temp_directory_path() / ("icef_train_bench_" + std::to_string(::getpid()));
   auto trainer = icef::Trainer::Create(s.dataset, dir, config);
   if (!trainer.ok()) return state.SkipWithError(trainer.status().message().c_str());
+  (*trainer)->model().set_color_composited_only(state.range(1) != 0);
   for (int i = 0; i < config.train.occupancy_warmup + 44; ++i)
     if (!(*trainer)->Step().ok()) return state.SkipWithError("warm-up step failed");
   int64_t samples = 0;
@@ -154,9 +157,10 @@ void BM_TrainStep(benchmark::State& state) {
   std::filesystem::remove_all(dir);
 }
 BENCHMARK(BM_TrainStep)
-    ->ArgName("bf16")
-    ->Arg(0)
-    ->Arg(1)
+    ->ArgNames({"bf16", "composited"})
+    ->Args({0, 1})
+    ->Args({1, 0})
+    ->Args({1, 1})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MinTime(3.0);

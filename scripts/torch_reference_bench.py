@@ -134,7 +134,7 @@ def cpp_rates(path):
     for b in json.load(open(path))["benchmarks"]:
         if b["name"] == "BM_ReferenceTrainStep":
             rates["BM_ReferenceTrainStep"] = b["samples_per_second"]
-        elif b["name"].startswith("BM_TrainStep/bf16:1"):
+        elif b["name"].startswith("BM_TrainStep/bf16:1/composited:1"):
             rates["BM_TrainStep"] = b["samples/s"]
     return rates
 

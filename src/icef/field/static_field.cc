@@ -116,28 +116,59 @@ void StaticField::DensityForward(const Executor& executor, int64_t n, const floa
                        keep_for_backward);
 }
 
-void StaticField::Forward(const Executor& executor, int64_t n, const float* positions,
-                          const float* directions, const float* condition, float* sigma, float* rgb,
-                          StaticFieldContext* ctx, bool keep_for_backward, bool need_position_grad,
-                          int64_t color_rows) const {
-  ICEF_CHECK(color_rows >= -1 && color_rows <= n, "color_rows out of range");
-  const int64_t nc = color_rows < 0 ? n : color_rows;
+void StaticField::ForwardDensity(const Executor& executor, int64_t n, const float* positions,
+                                 const float* condition, float* sigma, StaticFieldContext* ctx,
+                                 bool keep_for_backward, bool need_position_grad) const {
   DensityForward(executor, n, positions, condition, ctx, keep_for_backward, need_position_grad);
-  ctx->color_rows = nc;
-  const int geo = options_.geo_features, sh = options_.sh_degree * options_.sh_degree, ci = geo + sh;
-  nn::GrowTo(ctx->color_input, n * ci);
-  float* cin = ctx->color_input.data();
+  const int geo = options_.geo_features;
   const float* h = ctx->density_output.data();
   ParallelFor(executor, n, [&](int64_t b, int64_t e, int) {
-    for (int64_t i = b; i < e; ++i) {
+    for (int64_t i = b; i < e; ++i)
       sigma[i] = std::exp(std::min(h[i * geo] + options_.density_bias, kMaxLogDensity));
-      if (i >= nc) continue;
-      std::copy(h + i * geo, h + (i + 1) * geo, cin + i * ci);
-      nn::ShForward<float>(options_.sh_degree, 1, directions + 3 * i, cin + i * ci + geo);
+  });
+}
+
+void StaticField::ForwardColor(const Executor& executor, int64_t n, const float* directions,
+                               std::optional<std::span<const int32_t>> rows, float* rgb,
+                               StaticFieldContext* ctx, bool keep_for_backward) const {
+  ctx->color_all = !rows.has_value();
+  const int64_t m = rows ? static_cast<int64_t>(rows->size()) : n;
+  if (rows) {
+    ctx->color_rows.assign(rows->begin(), rows->end());
+    for (int64_t j = 0; j < m; ++j)
+      ICEF_CHECK(ctx->color_rows[j] >= 0 && ctx->color_rows[j] < n &&
+                     (j == 0 || ctx->color_rows[j] > ctx->color_rows[j - 1]),
+                 "StaticField::ForwardColor: rows must ascend within [0, n)");
+  }
+  const int geo = options_.geo_features, sh = options_.sh_degree * options_.sh_degree, ci = geo + sh;
+  nn::GrowTo(ctx->color_input, m * ci);
+  float* cin = ctx->color_input.data();
+  const float* h = ctx->density_output.data();
+  const int32_t* index = ctx->color_rows.data();
+  const bool all = ctx->color_all;
+  ParallelFor(executor, m, [&](int64_t b, int64_t e, int) {
+    for (int64_t j = b; j < e; ++j) {
+      const int64_t i = all ? j : index[j];
+      std::copy(h + i * geo, h + (i + 1) * geo, cin + j * ci);
+      nn::ShForward<float>(options_.sh_degree, 1, directions + 3 * i, cin + j * ci + geo);
     }
   });
-  color_mlp_.Forward(executor, nc, cin, rgb, &ctx->color_mlp, keep_for_backward);
-  std::fill(rgb + 3 * nc, rgb + 3 * n, 0.f);
+  if (all) {
+    color_mlp_.Forward(executor, n, cin, rgb, &ctx->color_mlp, keep_for_backward);
+    return;
+  }
+  nn::GrowTo(ctx->color_output, m * 3);
+  color_mlp_.Forward(executor, m, cin, ctx->color_output.data(), &ctx->color_mlp, keep_for_backward);
+  std::fill(rgb, rgb + 3 * n, 0.f);
+  for (int64_t j = 0; j < m; ++j)
+    for (int a = 0; a < 3; ++a) rgb[3 * index[j] + a] = ctx->color_output[3 * j + a];
+}
+
+void StaticField::Forward(const Executor& executor, int64_t n, const float* positions,
+                          const float* directions, const float* condition, float* sigma, float* rgb,
+                          StaticFieldContext* ctx, bool keep_for_backward, bool need_position_grad) const {
+  ForwardDensity(executor, n, positions, condition, sigma, ctx, keep_for_backward, need_position_grad);
+  ForwardColor(executor, n, directions, std::nullopt, rgb, ctx, keep_for_backward);
 }
 
 void StaticField::Backward(const Executor& executor, int64_t n, const float* sigma, const float* rgb,
@@ -147,19 +178,32 @@ void StaticField::Backward(const Executor& executor, int64_t n, const float* sig
   ICEF_CHECK(d_positions == nullptr || ctx->has_position_jacobian, "Forward was run without need_position_grad");
   const int g = grid_.output_dims(), c = options_.condition_dims, di = g + c;
   const int geo = options_.geo_features, sh = options_.sh_degree * options_.sh_degree, ci = geo + sh;
-  nn::GrowTo(ctx->d_color_input, n * ci);
+  const bool all = ctx->color_all;
+  const int64_t m = all ? n : static_cast<int64_t>(ctx->color_rows.size());
+  const int32_t* index = ctx->color_rows.data();
+  nn::GrowTo(ctx->d_color_input, m * ci);
   nn::GrowTo(ctx->d_density_output, n * geo);
   nn::GrowTo(ctx->d_density_input, n * di);
-  const int64_t nc = ctx->color_rows;
-  color_mlp_.Backward(executor, nc, ctx->color_input.data(), rgb, d_rgb, &ctx->color_mlp,
-                      ctx->d_color_input.data());
-  std::fill(ctx->d_color_input.begin() + nc * ci, ctx->d_color_input.begin() + n * ci, 0.f);
+  if (all) {
+    color_mlp_.Backward(executor, n, ctx->color_input.data(), rgb, d_rgb, &ctx->color_mlp,
+                        ctx->d_color_input.data());
+  } else {  // the coloured rows' gradients, gathered as ForwardColor packed them
+    nn::GrowTo(ctx->d_color_output, m * 3);
+    for (int64_t j = 0; j < m; ++j)
+      for (int a = 0; a < 3; ++a) ctx->d_color_output[3 * j + a] = d_rgb[3 * index[j] + a];
+    color_mlp_.Backward(executor, m, ctx->color_input.data(), ctx->color_output.data(),
+                        ctx->d_color_output.data(), &ctx->color_mlp, ctx->d_color_input.data());
+  }
   const float* dci = ctx->d_color_input.data();
   const float* h = ctx->density_output.data();
   float* dh = ctx->d_density_output.data();
+  if (!all) {
+    std::fill(dh, dh + n * geo, 0.f);
+    for (int64_t j = 0; j < m; ++j) std::copy(dci + j * ci, dci + j * ci + geo, dh + index[j] * geo);
+  }
   ParallelFor(executor, n, [&](int64_t b, int64_t e, int) {
     for (int64_t i = b; i < e; ++i) {
-      std::copy(dci + i * ci, dci + i * ci + geo, dh + i * geo);
+      if (all) std::copy(dci + i * ci, dci + i * ci + geo, dh + i * geo);
       // sigma = exp(min(h0 + bias, max)): d sigma / d h0 = sigma below the clamp, 0 above.
       if (h[i * geo] + options_.density_bias < kMaxLogDensity) dh[i * geo] += d_sigma[i] * sigma[i];
     }

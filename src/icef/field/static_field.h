@@ -11,7 +11,10 @@
 //   rgb      = ColorMlp([h, SH_4(d)])                   [n, 3]     (sigmoid)
 #pragma once
 
+#include <optional>
+#include <span>
 #include <string>
+#include <vector>
 
 #include "icef/core/parallel.h"
 #include "icef/core/status.h"
@@ -54,15 +57,18 @@ inline constexpr float kMaxLogDensity = 15.f;
 // Per-batch buffers; reused across batches (grows, never shrinks).
 struct StaticFieldContext {
   int64_t n = 0;
-  int64_t color_rows = 0;  // the rows [0, color_rows) of the last Forward that have a colour
   bool has_position_jacobian = false;
+  bool color_all = true;                    // the last ForwardColor coloured every sample
+  std::vector<int32_t> color_rows;          // else the samples it coloured, ascending
   nn::AlignedVector<float> unit_positions;  // [n, 3] in [0,1]^3
   nn::AlignedVector<float> density_input;   // [n, L*F + condition_dims]
   nn::AlignedVector<float> grid_jacobian;   // [n, L*F, 3] when positions need gradients
   nn::AlignedVector<float> density_output;  // [n, geo]
-  nn::AlignedVector<float> color_input;     // [n, geo + sh]
+  nn::AlignedVector<float> color_input;     // [m, geo + sh] for the m coloured samples
+  nn::AlignedVector<float> color_output;    // [m, 3] when not every sample is coloured
   nn::AlignedVector<float> grid_features;   // [n, L*F] (only when condition_dims > 0)
-  nn::AlignedVector<float> d_color_input;   // [n, geo + sh]
+  nn::AlignedVector<float> d_color_input;   // [m, geo + sh]
+  nn::AlignedVector<float> d_color_output;  // [m, 3] when not every sample is coloured
   nn::AlignedVector<float> d_density_output;// [n, geo]
   nn::AlignedVector<float> d_density_input; // [n, L*F + condition_dims]
   nn::AlignedVector<float> d_unit_positions;// [n, 3]
@@ -81,15 +87,23 @@ class StaticField {
   // positions [n, 3] canonical world frame; directions [n, 3] unit, world frame; condition
   // [n, condition_dims] or null when condition_dims = 0 -> sigma [n], rgb [n, 3].
   // keep_for_backward keeps what Backward needs; need_position_grad also keeps the grid's
-  // Jacobian so Backward can return d/d positions. color_rows (0 <= color_rows <= n, or -1 = n):
-  // only the samples [0, color_rows) run the colour MLP; the others get rgb 0 and no colour
-  // gradient (training's unseen-view rays, which only a depth term reads).
+  // Jacobian so Backward can return d/d positions.
   void Forward(const Executor& executor, int64_t n, const float* positions, const float* directions,
                const float* condition, float* sigma, float* rgb, StaticFieldContext* ctx,
-               bool keep_for_backward, bool need_position_grad, int64_t color_rows = -1) const;
+               bool keep_for_backward, bool need_position_grad) const;
+  // Forward in two steps, for a caller that picks the samples to colour by their density (training
+  // colours only the samples its rays composite): ForwardDensity -> sigma [n]; then ForwardColor ->
+  // rgb [n, 3] of the samples `rows` (ascending indices in [0, n); nullopt: all n), 0 elsewhere.
+  // Backward then reads d_rgb at those rows alone. Forward = both, every sample coloured.
+  void ForwardDensity(const Executor& executor, int64_t n, const float* positions, const float* condition,
+                      float* sigma, StaticFieldContext* ctx, bool keep_for_backward,
+                      bool need_position_grad) const;
+  void ForwardColor(const Executor& executor, int64_t n, const float* directions,
+                    std::optional<std::span<const int32_t>> rows, float* rgb, StaticFieldContext* ctx,
+                    bool keep_for_backward) const;
   // After Forward(keep_for_backward), with its outputs sigma [n] and rgb [n, 3]: accumulates
-  // parameter gradients into the store from d_sigma [n] and d_rgb [n, 3] (the rows of d_rgb past
-  // Forward's color_rows are not read); writes d_positions [n, 3] (world frame) unless null.
+  // parameter gradients into the store from d_sigma [n] and d_rgb [n, 3] (the rows ForwardColor
+  // coloured); writes d_positions [n, 3] (world frame) unless null.
   void Backward(const Executor& executor, int64_t n, const float* sigma, const float* rgb, const float* d_sigma,
                 const float* d_rgb, StaticFieldContext* ctx, float* d_positions);
   // Density only (occupancy-grid updates): positions [n, 3] -> sigma [n].

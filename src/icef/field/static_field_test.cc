@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <span>
+#include <string>
 #include <vector>
 
 namespace icef {
@@ -22,11 +24,11 @@ double MaxAbsDiff(const std::vector<float>& a, const std::vector<float>& b) {
   return m;
 }
 
-// Forward(color_rows = k) gives every sample its density and only the first k a colour (the rest
-// rgb 0); Backward then reads no colour gradient past row k and gives the parameter and position
-// gradients of a full pass whose colour gradient is zero past row k (what training's unseen-view
-// rays get from the losses, which read only their depth).
-TEST(StaticFieldTest, ColorRowsLimitTheColourToTheFirstSamples) {
+// ForwardDensity + ForwardColor(rows) give every sample its density and only the samples `rows` a
+// colour (the rest rgb 0); Backward then reads no colour gradient elsewhere and gives the parameter
+// and position gradients of a full Forward whose colour gradient is zero elsewhere (what training's
+// samples past a ray's termination, and its unseen-view rays, get from the losses).
+TEST(StaticFieldTest, ColouringSomeSamplesIsAFullPassWithoutTheOthersColour) {
   StaticFieldOptions options;
   options.grid.num_levels = 4;
   options.grid.log2_table_size = 10;
@@ -42,7 +44,7 @@ TEST(StaticFieldTest, ColorRowsLimitTheColourToTheFirstSamples) {
   const int64_t n = 300;
   std::mt19937 rng(11);
   std::uniform_real_distribution<float> u(-0.9f, 0.9f);
-  std::vector<float> positions(3 * n), directions(3 * n), d_sigma(n), d_rgb_full(3 * n);
+  std::vector<float> positions(3 * n), directions(3 * n), d_sigma(n);
   for (int64_t i = 0; i < n; ++i) {
     const Vec3f d = Vec3f(u(rng), u(rng), u(rng)).normalized();
     for (int a = 0; a < 3; ++a) {
@@ -51,14 +53,21 @@ TEST(StaticFieldTest, ColorRowsLimitTheColourToTheFirstSamples) {
     }
     d_sigma[i] = u(rng);
   }
+  std::vector<int32_t> scattered;  // runs of samples, as rays composite them
+  for (int32_t i = 0; i < n; ++i)
+    if ((i / 7) % 3 != 1) scattered.push_back(i);
+  std::vector<int32_t> all(n);
+  for (int32_t i = 0; i < n; ++i) all[i] = i;
   const Executor ex(2);
-  for (const int64_t k : {int64_t(0), int64_t(1), int64_t(181), n}) {
-    SCOPED_TRACE("color_rows " + std::to_string(k));
-    // The colour gradient: random on the first k rows; the partial pass gets garbage past them.
-    std::vector<float> d_rgb_partial(3 * n, 1e3f);
+  for (const std::vector<int32_t>& rows : {std::vector<int32_t>{}, std::vector<int32_t>{0}, scattered, all}) {
+    SCOPED_TRACE("rows " + std::to_string(rows.size()));
+    std::vector<uint8_t> coloured(n, 0);
+    for (int32_t i : rows) coloured[i] = 1;
+    // The colour gradient: random on the coloured rows; the partial pass gets garbage elsewhere.
+    std::vector<float> d_rgb_full(3 * n), d_rgb_partial(3 * n, 1e3f);
     for (int64_t i = 0; i < 3 * n; ++i) {
-      d_rgb_full[i] = i < 3 * k ? u(rng) : 0.f;
-      if (i < 3 * k) d_rgb_partial[i] = d_rgb_full[i];
+      d_rgb_full[i] = coloured[i / 3] ? u(rng) : 0.f;
+      if (coloured[i / 3]) d_rgb_partial[i] = d_rgb_full[i];
     }
     std::vector<float> sigma_a(n), rgb_a(3 * n), dpos_a(3 * n), sigma_b(n), rgb_b(3 * n, -1.f), dpos_b(3 * n);
     StaticFieldContext ctx_a, ctx_b;
@@ -69,15 +78,15 @@ TEST(StaticFieldTest, ColorRowsLimitTheColourToTheFirstSamples) {
                    dpos_a.data());
     const std::vector<float> grads_a(store.grads(), store.grads() + store.size());
     store.ZeroGrads();
-    field.Forward(ex, n, positions.data(), directions.data(), nullptr, sigma_b.data(), rgb_b.data(), &ctx_b,
-                  true, true, k);
+    field.ForwardDensity(ex, n, positions.data(), nullptr, sigma_b.data(), &ctx_b, true, true);
+    field.ForwardColor(ex, n, directions.data(), std::span<const int32_t>(rows), rgb_b.data(), &ctx_b, true);
     field.Backward(ex, n, sigma_b.data(), rgb_b.data(), d_sigma.data(), d_rgb_partial.data(), &ctx_b,
                    dpos_b.data());
     const std::vector<float> grads_b(store.grads(), store.grads() + store.size());
 
     EXPECT_EQ(sigma_a, sigma_b);
     for (int64_t i = 0; i < 3 * n; ++i) {
-      if (i < 3 * k)
+      if (coloured[i / 3])
         ASSERT_NEAR(rgb_b[i], rgb_a[i], 1e-6f) << i;
       else
         ASSERT_EQ(rgb_b[i], 0.f) << i;

@@ -175,8 +175,7 @@ void AvatarModel::ExpandRays(const TrainRays& batch, ModelWorkspace& ws, const E
 }
 
 void AvatarModel::FieldForward(ModelWorkspace& ws, int64_t n, const float* positions, bool train,
-                               const Executor& executor, int64_t color_rows) const {
-  if (color_rows < 0) color_rows = n;
+                               const Executor& executor, int64_t color_rays) const {
   const float* canonical = positions;
   if (warp_) {
     Fit(ws.canonical, 3 * n);
@@ -187,33 +186,60 @@ void AvatarModel::FieldForward(ModelWorkspace& ws, int64_t n, const float* posit
   }
   Fit(ws.sigma, n);
   Fit(ws.rgb, 3 * n);
-  static_field_->Forward(executor, n, canonical, ws.dirs.data(),
-                         traits_.entangled_beta ? ws.betas.data() : nullptr, ws.sigma.data(), ws.rgb.data(),
-                         &ws.static_ctx, train, train && warp_ != nullptr, color_rows);
+  static_field_->ForwardDensity(executor, n, canonical, traits_.entangled_beta ? ws.betas.data() : nullptr,
+                                ws.sigma.data(), &ws.static_ctx, train, train && warp_ != nullptr);
+  const bool cavity = warp_ && warp_->has_prior();
+  if (cavity) {
+    Fit(ws.cavity, n);
+    warp_->Cavity(executor, n, positions, ws.betas.data(), ws.cavity.data());
+  }
+  std::optional<std::span<const int32_t>> rows;
+  if (color_rays >= 0) {
+    CompositedRows(ws, color_rays, cavity);
+    rows = std::span<const int32_t>(ws.color_rows);
+  }
+  static_field_->ForwardColor(executor, n, ws.dirs.data(), rows, ws.rgb.data(), &ws.static_ctx, train);
   ws.shade.clear();
-  if (light_ && ShadingNormals(ws, n, color_rows, positions, executor)) {
+  if (light_ && ShadingNormals(ws, n, rows, positions, executor)) {
     Fit(ws.shade, n);
     if (train) ws.rgb_unshaded.assign(ws.rgb.begin(), ws.rgb.begin() + 3 * n);
     ApplyPriorShading(executor, n, ws.normals_obs.data(), ws.normals_can.data(), *light_, ws.rgb.data(),
                       ws.shade.data());
   }
-  if (warp_ && warp_->has_prior()) {
-    Fit(ws.cavity, n);
-    warp_->Cavity(executor, n, positions, ws.betas.data(), ws.cavity.data());
+  if (cavity) {
     const float colour[3] = {CavityColour(0), CavityColour(1), CavityColour(2)};
     ApplyCavity(n, ws.cavity.data(), colour, ws.sigma.data(), ws.rgb.data());
   }
 }
 
-bool AvatarModel::ShadingNormals(ModelWorkspace& ws, int64_t n, int64_t color_rows, const float* positions,
-                                 const Executor& executor) const {
+void AvatarModel::CompositedRows(ModelWorkspace& ws, int64_t rays, bool cavity) const {
+  const float eps = static_cast<float>(config_.compositing.transmittance_eps);  // as CompositeForward's
+  ws.color_rows.clear();
+  for (int64_t r = 0; r < rays; ++r) {
+    const int32_t off = ws.samples.ray_offset[r], cnt = ws.samples.ray_count[r];
+    const float* sigma = ws.sigma.data() + off;
+    if (cavity) {  // the densities compositing will see, after ApplyCavity
+      Fit(ws.ray_sigma, cnt);
+      for (int32_t k = 0; k < cnt; ++k) ws.ray_sigma[k] = ws.cavity[off + k] ? kCavityDensity : sigma[k];
+      sigma = ws.ray_sigma.data();
+    }
+    const int used = CompositeRayUsed<float>(cnt, sigma, ws.samples.dt.data() + off, eps);
+    for (int32_t k = 0; k < used; ++k) ws.color_rows.push_back(off + k);
+  }
+}
+
+bool AvatarModel::ShadingNormals(ModelWorkspace& ws, int64_t n, std::optional<std::span<const int32_t>> rows,
+                                 const float* positions, const Executor& executor) const {
   // The face model's normals cost eight signed-distance evaluations: only at samples dense enough to
   // show (each weighs at most 1 - exp(-kShadeMinDensity dt) in its ray, about 2e-3 at 96 samples
   // across a [-1, 1]^3 aabb); elsewhere both normals are zero, which makes s = 1.
   const int b = setup_.expression_dim;
   ws.shade_index.clear();
-  for (int64_t i = 0; i < color_rows; ++i)
+  const int64_t candidates = rows ? static_cast<int64_t>(rows->size()) : n;
+  for (int64_t j = 0; j < candidates; ++j) {
+    const int64_t i = rows ? (*rows)[j] : j;
     if (ws.sigma[i] > kShadeMinDensity) ws.shade_index.push_back(i);
+  }
   const int64_t m = static_cast<int64_t>(ws.shade_index.size());
   Fit(ws.shade_positions, 3 * m);
   Fit(ws.shade_betas, m * b);
@@ -299,13 +325,11 @@ LossTerms AvatarModel::TrainForwardBackward(const TrainRays& batch, const LossWe
     warp_->ForwardTrain(executor, n, ws.samples.positions.data(), ws.betas.data(), ws.offsets.data(),
                         ws.residual.data(), &ws.deform_ctx, true);
   }
-  // The unseen views' rays (those after batch.photo_rays) carry a depth target alone: no term reads
-  // their samples' colour, unless the symmetry prior's colour part mirrors some of them.
-  const int64_t photo_rays = batch.NumPhotoRays();
+  // Colour only what the pixel rays composite (see the header); the unseen views' rays come after
+  // them (batch.photo_rays).
   const bool symmetry_colour = weights.lambda_symmetry != 0 && weights.symmetry_colour != 0;
-  const int64_t color_rows =
-      photo_rays < num_rays && !symmetry_colour ? ws.samples.ray_offset[photo_rays] : n;
-  FieldForward(ws, n, ws.samples.positions.data(), true, executor, color_rows);
+  const int64_t color_rays = color_composited_only_ && !symmetry_colour ? batch.NumPhotoRays() : -1;
+  FieldForward(ws, n, ws.samples.positions.data(), true, executor, color_rays);
 
   // Compositing over the known background.
   const float bg[3] = {setup_.background.x(), setup_.background.y(), setup_.background.z()};

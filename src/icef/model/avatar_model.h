@@ -63,9 +63,18 @@ class AvatarModel {
   void Initialize(uint64_t seed);
 
   // Forward + backward of one batch: every loss term (model/losses.h) with its weight and value,
-  // and d total / d parameters accumulated into store().grads().
+  // and d total / d parameters accumulated into store().grads(). Only the samples that the pixel
+  // rays composite (up to each ray's early termination) run the colour MLP and the prior shading's
+  // normals: no term reads a colour elsewhere (the unseen views' rays carry a depth alone), unless
+  // the symmetry prior's colour part (train.symmetry_colour) compares samples with their mirror
+  // images, which then colours every sample.
   LossTerms TrainForwardBackward(const TrainRays& batch, const LossWeights& weights, uint64_t seed, int64_t step,
                                  const Executor& executor);
+  // false: every training sample is coloured, as before the above (the same function; float sums in
+  // another order). For tests and benchmarks.
+  void set_color_composited_only(bool on) { color_composited_only_ = on; }
+  // The last training step's buffers (tests).
+  const ModelWorkspace& train_workspace() const { return *train_ws_; }
 
   // Renders rays at expression beta [expression_dim] over `background`. Samples are placed by
   // `occupancy` (null: the training grid occupancy(); RenderImage passes RenderOccupancy(beta)).
@@ -137,21 +146,25 @@ class AvatarModel {
   void ExpandRays(const TrainRays& batch, ModelWorkspace& ws, const Executor& executor) const;
   // Static field (and the prior's shading and cavity) at n samples: canonical = positions +
   // ws.offsets; reads ws.dirs and ws.betas, writes ws.sigma and ws.rgb (and, when shaded, ws.shade and
-  // in training ws.rgb_unshaded). Only the samples [0, color_rows) get a colour (-1: all of them;
-  // StaticField::Forward): the others' rgb is 0 and unshaded.
+  // in training ws.rgb_unshaded). color_rays >= 0: only the samples that the first color_rays rays
+  // of ws.samples composite get a colour (ws.color_rows), the others rgb 0, unshaded; -1: all.
   void FieldForward(ModelWorkspace& ws, int64_t n, const float* positions, bool train,
-                    const Executor& executor, int64_t color_rows = -1) const;
-  // The face model's normals at the samples [0, color_rows) of FieldForward dense enough to show
-  // (others: zero normals, no shading) into ws.normals_obs / normals_can; false when the prior has
-  // none.
-  bool ShadingNormals(ModelWorkspace& ws, int64_t n, int64_t color_rows, const float* positions,
-                      const Executor& executor) const;
+                    const Executor& executor, int64_t color_rays = -1) const;
+  // ws.color_rows: the samples of the first `rays` rays up to where compositing stops each ray
+  // (CompositeRayUsed on the static field's densities, the cavity's where it is).
+  void CompositedRows(ModelWorkspace& ws, int64_t rays, bool cavity) const;
+  // The face model's normals at the samples `rows` (nullopt: all n) of FieldForward dense enough to
+  // show (others: zero normals, no shading) into ws.normals_obs / normals_can; false when the prior
+  // has none.
+  bool ShadingNormals(ModelWorkspace& ws, int64_t n, std::optional<std::span<const int32_t>> rows,
+                      const float* positions, const Executor& executor) const;
   // Runs the terms of one stage (model/losses.h) and records their values in `terms`.
   void RunLosses(LossStage stage, LossContext& ctx, LossTerms* terms);
   void WarpOffsets(const Executor& executor, int64_t n, const float* positions, std::span<const float> beta,
                    float* offsets, WarpPart part) const;
 
   ModelConfig config_;
+  bool color_composited_only_ = true;
   ModelSetup setup_;
   Method method_;
   MethodTraits traits_;

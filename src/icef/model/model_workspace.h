@@ -34,6 +34,8 @@ struct ModelWorkspace {
   std::vector<float> sigma, rgb;              // [n], [n, 3] the fields at the samples
   std::vector<float> mask_values, extras;     // [n] M(x); renders: [n, 2] per-sample extras
   std::vector<uint8_t> cavity;                // [n] inside the face model's open mouth
+  std::vector<int32_t> color_rows;            // training: the samples the pixel rays composite
+  std::vector<float> ray_sigma;               // training: one ray's densities with the cavity's
   // Prior shading (field/prior_shading.h): the face model's normals [n, 3] (observed, canonical), the
   // ratio s [n] (empty: not applied) and, in training, the colours before it [n, 3].
   std::vector<float> normals_obs, normals_can, shade, rgb_unshaded;

@@ -7,11 +7,12 @@
 #include <cmath>
 
 #include "icef/core/rng.h"
-#include "icef/model/avatar_model.h"
 #include "icef/face/expression.h"
 #include "icef/face/face_model.h"
+#include "icef/model/avatar_model.h"
 #include "icef/model/face_prior.h"
 #include "icef/model/model_test_util.h"
+#include "icef/model/model_workspace.h"
 
 namespace icef {
 namespace {
@@ -381,85 +382,90 @@ TEST(PriorGuidedTest, TrainLossGradientMatchesFiniteDifferences) {
   }
 }
 
-// Training's unseen-view rays (after TrainRays::photo_rays) skip the colour MLP and the prior
-// shading's normals: the pixel rays' colour terms and gradients are those of the pixel rays alone
-// (the shading still reaches them), and the depth term's gradient is the one it has when every ray
-// runs the colour MLP (the same rays counted as pixels, where the photo term sees them too).
-TEST(PriorGuidedTest, UnseenViewRaysSkipTheColourYetKeepTheirDepth) {
-  ModelConfig config = TinyModelConfig("icef-prior");
-  config.deformation.output_init_scale = 0.05f;
-  config.static_field.density_bias = -1.f;               // dense enough to be shaded
-  config.bf16_training = config.bf16_inference = false;  // FP32 products: differences of gradients below
-  ModelSetup setup = TinySetup();
-  setup.prior_light = Vec3f(0.f, 0.3f, 1.5f);
-  auto created =
-      AvatarModel::Create(config, setup, Executor(1), std::make_unique<TestPrior>(setup.expression_dim));
-  ASSERT_TRUE(created.ok()) << created.status().message();
-  AvatarModel& model = **created;
-  model.Initialize(7);
-  ASSERT_TRUE(model.prior_light().has_value());
-  const TrainRays pixels = Batch(24, 5);
-  TrainRays with_views = pixels;
-  const TrainRays extra = Batch(8, 9);
-  Rng rng(6, StreamId("view_depth"));
-  with_views.depth_target.assign(pixels.rays.size(), NAN);
-  for (int r = 0; r < 8; ++r) {
-    with_views.rays.push_back(extra.rays[r]);
-    with_views.frame.push_back(extra.frame[r]);
-    for (int a = 0; a < 3; ++a) with_views.target_rgb.push_back(5.f);  // what no colour could match
-    with_views.target_alpha.push_back(3.f);
-    with_views.depth_target.push_back(static_cast<float>(rng.Uniform(1.6, 2.2)));
-  }
-  with_views.photo_rays = int64_t(pixels.rays.size());
-  TrainRays all_pixels = with_views;
-  all_pixels.photo_rays = -1;
-  LossWeights colour;
-  colour.lambda_mask = 0.2;
-  LossWeights depth = colour;
-  depth.lambda_depth_prior = 30.0;
-  const Executor ex(1);
-  nn::ParameterStore& store = model.store();
-  const auto grads_of = [&](const TrainRays& batch, const LossWeights& w, LossTerms* terms) {
-    store.ZeroGrads();
-    *terms = model.TrainForwardBackward(batch, w, 3, 0, ex);
-    return std::vector<double>(store.grads(), store.grads() + store.size());
-  };
-  // a and b agree to 1e-6 of the largest gradient they were computed from (`scale`: a difference of
-  // two passes' float sums cancels to a few float roundings of its terms).
-  const auto expect_close = [](const std::vector<double>& a, const std::vector<double>& b, double scale,
-                               const char* what) {
-    double max_diff = 0, max_a = 0;
-    for (size_t i = 0; i < a.size(); ++i) {
-      max_diff = std::max(max_diff, std::abs(a[i] - b[i]));
-      max_a = std::max(max_a, std::abs(a[i]));
+// Training colours only the samples its pixel rays composite: the samples past a ray's early
+// termination and the unseen views' rays (after TrainRays::photo_rays, depth alone) skip the colour
+// MLP and the prior shading's normals. Every term and gradient is the one of a step that colours
+// every sample, to float rounding, on a sparse field and on one dense enough to stop rays early;
+// and the pixel rays' colour terms are those of the pixel rays alone.
+TEST(PriorGuidedTest, TrainingColoursOnlyWhatThePixelRaysComposite) {
+  for (const float density_bias : {-1.f, 4.f}) {
+    SCOPED_TRACE("density_bias " + std::to_string(density_bias));
+    ModelConfig config = TinyModelConfig("icef-prior");
+    config.deformation.output_init_scale = 0.05f;
+    config.static_field.density_bias = density_bias;       // dense enough to be shaded
+    config.bf16_training = config.bf16_inference = false;  // FP32 products: gradients compared below
+    ModelSetup setup = TinySetup();
+    setup.prior_light = Vec3f(0.f, 0.3f, 1.5f);
+    auto created =
+        AvatarModel::Create(config, setup, Executor(1), std::make_unique<TestPrior>(setup.expression_dim));
+    ASSERT_TRUE(created.ok()) << created.status().message();
+    AvatarModel& model = **created;
+    model.Initialize(7);
+    ASSERT_TRUE(model.prior_light().has_value());
+    const TrainRays pixels = Batch(24, 5);
+    TrainRays with_views = pixels;
+    const TrainRays extra = Batch(8, 9);
+    Rng rng(6, StreamId("view_depth"));
+    with_views.depth_target.assign(pixels.rays.size(), NAN);
+    for (int r = 0; r < 8; ++r) {
+      with_views.rays.push_back(extra.rays[r]);
+      with_views.frame.push_back(extra.frame[r]);
+      for (int a = 0; a < 3; ++a) with_views.target_rgb.push_back(5.f);  // what no colour could match
+      with_views.target_alpha.push_back(3.f);
+      with_views.depth_target.push_back(static_cast<float>(rng.Uniform(1.6, 2.2)));
     }
-    EXPECT_GT(max_a, 1e-3 * scale) << what;
-    EXPECT_LE(max_diff, 1e-6 * scale) << what;
-  };
-  const auto max_abs = [](const std::vector<double>& v) {
-    double m = 0;
-    for (double x : v) m = std::max(m, std::abs(x));
-    return m;
-  };
-  LossTerms a, b;
-  const std::vector<double> g_a = grads_of(pixels, colour, &a), g_b = grads_of(with_views, colour, &b);
-  EXPECT_DOUBLE_EQ(a.Get("photo"), b.Get("photo"));
-  EXPECT_DOUBLE_EQ(a.Get("mask"), b.Get("mask"));
-  expect_close(g_a, g_b, max_abs(g_a), "colour terms");
+    with_views.photo_rays = int64_t(pixels.rays.size());
+    LossWeights w;
+    w.lambda_mask = 0.2;
+    w.lambda_depth_prior = 30.0;
+    w.lambda_distortion = 0.01;
+    w.lambda_symmetry = 0.1;  // its opacity part reads samples past termination too
+    const Executor ex(1);
+    nn::ParameterStore& store = model.store();
+    const auto grads_of = [&](const TrainRays& batch, const LossWeights& weights, bool composited_only,
+                              LossTerms* terms) {
+      model.set_color_composited_only(composited_only);
+      store.ZeroGrads();
+      *terms = model.TrainForwardBackward(batch, weights, 3, 0, ex);
+      return std::vector<double>(store.grads(), store.grads() + store.size());
+    };
+    // a and b agree to 1e-6 of the largest gradient (float sums in another order).
+    const auto expect_close = [](const std::vector<double>& a, const std::vector<double>& b,
+                                 const char* what) {
+      double max_diff = 0, max_a = 0;
+      for (size_t i = 0; i < a.size(); ++i) {
+        max_diff = std::max(max_diff, std::abs(a[i] - b[i]));
+        max_a = std::max(max_a, std::abs(a[i]));
+      }
+      EXPECT_GT(max_a, 0.0) << what;
+      EXPECT_LE(max_diff, 1e-6 * max_a) << what;
+    };
 
-  // The depth term's share, with the view rays' colour skipped and with it run.
-  LossTerms views_on, pixels_off, pixels_on;
-  const std::vector<double> g_views = grads_of(with_views, depth, &views_on);
-  const std::vector<double> g_pixels_off = grads_of(all_pixels, colour, &pixels_off);
-  const std::vector<double> g_pixels_on = grads_of(all_pixels, depth, &pixels_on);
-  ASSERT_GT(views_on.Get("depth"), 0.0);
-  EXPECT_DOUBLE_EQ(views_on.Get("depth"), pixels_on.Get("depth"));
-  std::vector<double> share_views(g_views.size()), share_pixels(g_views.size());
-  for (size_t i = 0; i < g_views.size(); ++i) {
-    share_views[i] = g_views[i] - g_b[i];
-    share_pixels[i] = g_pixels_on[i] - g_pixels_off[i];
+    LossTerms all, some;
+    const std::vector<double> g_all = grads_of(with_views, w, false, &all);
+    const int64_t every_sample = model.train_workspace().samples.size();
+    const std::vector<double> g_some = grads_of(with_views, w, true, &some);
+    const ModelWorkspace& ws = model.train_workspace();
+    const int64_t pixel_samples = ws.samples.ray_offset[pixels.rays.size()];
+    ASSERT_GT(every_sample, pixel_samples);  // the view rays have samples
+    EXPECT_GT(ws.color_rows.size(), 0u);
+    EXPECT_LE(int64_t(ws.color_rows.size()), pixel_samples);
+    if (density_bias > 0) EXPECT_LT(int64_t(ws.color_rows.size()), pixel_samples / 2);  // rays end early
+    ASSERT_EQ(all.terms.size(), some.terms.size());
+    for (size_t k = 0; k < all.terms.size(); ++k)
+      EXPECT_NEAR(all.terms[k].value, some.terms[k].value, 1e-6 * std::abs(all.terms[k].value))
+          << all.terms[k].name;
+    expect_close(g_all, g_some, "every term");
+
+    LossWeights colour;
+    colour.lambda_mask = 0.2;
+    LossTerms a, b;
+    const std::vector<double> g_a = grads_of(pixels, colour, true, &a),
+                              g_b = grads_of(with_views, colour, true, &b);
+    EXPECT_DOUBLE_EQ(a.Get("photo"), b.Get("photo"));
+    EXPECT_DOUBLE_EQ(a.Get("mask"), b.Get("mask"));
+    expect_close(g_a, g_b, "the pixel rays' colour terms");
   }
-  expect_close(share_pixels, share_views, std::max(max_abs(g_pixels_on), max_abs(g_views)), "depth term");
 }
 
 }  // namespace

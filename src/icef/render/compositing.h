@@ -66,6 +66,21 @@ int CompositeRayForward(int n, const T* sigma, const T* rgb, const T* t, const T
   return m;
 }
 
+// The number of samples CompositeRayForward uses (its return value m) from sigma [n] and dt [n]
+// alone, by the same arithmetic: what a caller needs before it computes any colour, since the
+// samples past m add nothing to the ray nor to any gradient through it.
+template <typename T>
+int CompositeRayUsed(int n, const T* sigma, const T* dt, T transmittance_eps) {
+  T trans = T(1);
+  for (int m = 0; m < n;) {
+    const T alpha = T(1) - std::exp(-sigma[m] * dt[m]);
+    trans *= T(1) - alpha;
+    ++m;
+    if (trans < transmittance_eps) return m;
+  }
+  return n;
+}
+
 // Per-ray backward for the first m = num_used samples (from the forward). d_weights may be null.
 // Overwrites d_sigma [n] and d_rgb [n,3] (zero past m).
 template <typename T>

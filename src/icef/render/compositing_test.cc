@@ -129,6 +129,25 @@ TEST(CompositingTest, EarlyTerminationStopsAndItsBackwardIsConsistent) {
   for (int i = m_term; i < r.n; ++i) EXPECT_EQ(d_sigma[i], 0.0);
 }
 
+// CompositeRayUsed counts, from the densities alone, exactly the samples the float forward uses,
+// on rays that end early at every training and render threshold and on rays that never do.
+TEST(CompositingTest, UsedSamplesAreThoseTheForwardUses) {
+  int terminated = 0;
+  for (uint64_t seed = 0; seed < 400; ++seed) {
+    const RayData r = RandomRay(1 + int(seed % 97), 100 + seed, 0.5 * double(seed % 40));
+    const std::vector<float> sigma(r.sigma.begin(), r.sigma.end()), dt(r.dt.begin(), r.dt.end()),
+        rgb(r.rgb.begin(), r.rgb.end()), t(r.t.begin(), r.t.end()), bg(r.bg.begin(), r.bg.end());
+    for (const float eps : {0.f, 1e-4f, 1e-2f, 0.3f}) {
+      float c[3], op, d;
+      const int m = CompositeRayForward<float>(r.n, sigma.data(), rgb.data(), t.data(), dt.data(), bg.data(),
+                                               eps, c, &op, &d, nullptr);
+      ASSERT_EQ(CompositeRayUsed<float>(r.n, sigma.data(), dt.data(), eps), m) << seed << " " << eps;
+      terminated += m < r.n;
+    }
+  }
+  EXPECT_GT(terminated, 400);  // most rays with a threshold end early
+}
+
 TEST(CompositingTest, BatchedMatchesPerRayAndFloatMatchesDouble) {
   std::vector<RayData> rays = {RandomRay(7, 1, 5.0), RandomRay(0, 2, 5.0), RandomRay(11, 3, 5.0)};
   std::vector<double> sigma, rgb, t, dt, bg;
