@@ -13,6 +13,7 @@
 #include "icef/model/face_prior.h"
 #include "icef/model/model_test_util.h"
 #include "icef/model/model_workspace.h"
+#include "icef/testing/gradient_check.h"
 
 namespace icef {
 namespace {
@@ -380,6 +381,75 @@ TEST(PriorGuidedTest, TrainLossGradientMatchesFiniteDifferences) {
     const double fd = (lp - lm) / (2.0 * (double(saved + h) - double(saved)));
     EXPECT_NEAR(grads[i], fd, 3e-2 * std::abs(fd) + 1e-6) << "parameter " << i;
   }
+}
+
+// L_depth on the face-model prior (the face model's depth on half the pixel rays and on unseen-view
+// rays after TrainRays::photo_rays): the parameter gradients it adds are its weight times central
+// differences of its value, over the largest gradients and over the residual R_phi's largest. On a
+// coarse grid with random offsets on every parameter (structure for the differences to see), FP32
+// products. Parameters whose stencil straddles a kink of the trilinear grid or a ReLU are skipped
+// (testing/gradient_check.h).
+TEST(PriorGuidedTest, DepthTermsGradientIsItsWeightTimesItsDerivative) {
+  ModelConfig config = TinyModelConfig("icef-prior");
+  config.deformation.output_init_scale = 0.05f;
+  config.static_field.grid.num_levels = 2;
+  config.static_field.grid.finest_resolution = 6;
+  config.static_field.density_bias = -1.f;
+  config.bf16_training = config.bf16_inference = false;
+  ModelSetup setup = TinySetup();
+  setup.prior_light = Vec3f(0.f, 0.3f, 1.5f);
+  auto created =
+      AvatarModel::Create(config, setup, Executor(1), std::make_unique<TestPrior>(setup.expression_dim));
+  ASSERT_TRUE(created.ok()) << created.status().message();
+  AvatarModel& model = **created;
+  model.Initialize(7);
+  nn::ParameterStore& store = model.store();
+  Rng noise(12, StreamId("params"));
+  for (int64_t i = 0; i < store.size(); ++i)
+    store.params()[i] += static_cast<float>(noise.Uniform(-0.3, 0.3));
+
+  TrainRays batch = Batch(24, 5);
+  const TrainRays extra = Batch(8, 9);
+  Rng rng(6, StreamId("view_depth"));
+  for (int r = 0; r < 24; ++r)
+    batch.depth_target.push_back(r % 2 ? NAN : static_cast<float>(rng.Uniform(1.6, 2.2)));
+  batch.photo_rays = int64_t(batch.rays.size());
+  for (int r = 0; r < 8; ++r) {
+    batch.rays.push_back(extra.rays[r]);
+    batch.frame.push_back(extra.frame[r]);
+    for (int a = 0; a < 3; ++a) batch.target_rgb.push_back(0.5f);
+    batch.target_alpha.push_back(1.f);
+    batch.depth_target.push_back(static_cast<float>(rng.Uniform(1.6, 2.2)));
+  }
+  LossWeights off;  // the photo term alone
+  LossWeights on = off;
+  on.lambda_depth_prior = 30.0;
+  const Executor ex(1);
+  store.ZeroGrads();
+  model.TrainForwardBackward(batch, off, 3, 0, ex);
+  const std::vector<float> g_off(store.grads(), store.grads() + store.size());
+  store.ZeroGrads();
+  const double value = model.TrainForwardBackward(batch, on, 3, 0, ex).Get("depth");
+  ASSERT_GT(value, 0.0);
+  std::vector<double> added(store.size());
+  for (size_t i = 0; i < added.size(); ++i) added[i] = double(store.grads()[i]) - double(g_off[i]);
+  const auto depth = [&] {
+    return on.lambda_depth_prior * model.TrainForwardBackward(batch, on, 3, 0, ex).Get("depth");
+  };
+  const testing::ParameterGradientCheck check;
+  const auto all = check.Run(store.params(), added, depth);
+  EXPECT_TRUE(all.ok()) << "largest gradients:\n" << all.failures;
+
+  const int block = store.FindBlock("deformation");
+  ASSERT_GE(block, 0);
+  const int64_t d0 = store.block(block).offset, d1 = d0 + store.block(block).size;
+  std::vector<double> residual(added.size(), 0.0);
+  for (int64_t i = d0; i < d1; ++i) residual[i] = added[i];
+  const auto largest = std::max_element(residual.begin(), residual.end(),
+                                        [](double a, double b) { return std::abs(a) < std::abs(b); });
+  ASSERT_GT(std::abs(*largest), 1e-7);  // L_depth reaches R_phi
+  const auto r_phi = check.Run(store.params(), residual, depth);
+  EXPECT_TRUE(r_phi.ok()) << "R_phi:\n" << r_phi.failures;
 }
 
 // Training colours only the samples its pixel rays composite: the samples past a ray's early

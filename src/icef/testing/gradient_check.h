@@ -60,9 +60,17 @@ inline double Dot(const std::vector<double>& a, const std::vector<double>& b) {
 
 // A model's parameter gradients (float parameters, as trained) against central differences of its
 // loss, on the `top_k` parameters with the largest analytic gradient. The step is
-// max(min_step, rel_step |p|). The hash grid is trilinear, so its position derivative jumps at cell
-// faces: with skip_kinks, a parameter whose differences at h and h/2 disagree (its stencil
-// straddles a face, so neither is a derivative) is skipped, and at least min_checked must remain.
+// max(min_step, rel_step |p|). The hash grid is trilinear and the MLPs are ReLU, so derivatives
+// jump at cell faces and activation boundaries. With skip_kinks, a parameter whose stencil
+// straddles such a kink (neither difference is then a derivative) is skipped, and at least
+// min_checked must remain. A kink at distance d inside a stencil of half-width h shows as
+//   - central differences at h and h/2 that disagree: by |jump| d / 2h, which catches kinks
+//     towards the stencil's ends but vanishes as d -> 0 (both then average the two slopes);
+//   - one-sided slopes (f(p+h) - f(p)) / h and (f(p) - f(p-h)) / h that differ by nearly the whole
+//     jump, |jump| (1 - d/h), at h and at h/2 alike, which catches kinks near the parameter.
+//     Smooth curvature also parts them, by h |f''|, but halves with the step: the second rule
+//     fires only when the parting at h/2 is over 3/4 of that at h.
+// Between them every kink whose jump exceeds a few kink_tol of the gradient is skipped.
 struct ParameterGradientCheck {
   int top_k = 12;
   float rel_step = 1e-3f;
@@ -88,25 +96,36 @@ struct ParameterGradientCheck {
     std::partial_sort(order.begin(), order.begin() + k, order.end(),
                       [&](int64_t a, int64_t b) { return std::abs(analytic[a]) > std::abs(analytic[b]); });
     const double largest = k > 0 ? std::abs(analytic[order[0]]) : 0.0;
-    auto numeric = [&](int64_t i, float h) {
+    // Central difference and the one-sided slopes' parting (f(p+h) - 2 f(p) + f(p-h)) / h at step h.
+    struct Differences {
+      double central = 0, parting = 0;
+    };
+    const double at_params = loss();
+    auto differences = [&](int64_t i, float h) {
       const float saved = params[i];
       params[i] = saved + h;
       const double lp = loss();
       params[i] = saved - h;
       const double lm = loss();
       params[i] = saved;
-      return (lp - lm) / (2.0 * (double(saved + h) - double(saved)));  // the step as float represents it
+      const double up = double(saved + h) - double(saved),
+                   down = double(saved) - double(saved - h);  // as float holds them
+      return Differences{(lp - lm) / (up + down), (lp - at_params) / up - (at_params - lm) / down};
     };
     Report report;
     std::ostringstream failures;
     for (int64_t j = 0; j < k; ++j) {
       const int64_t i = order[j];
       const float h = std::max(min_step, rel_step * std::abs(params[i]));
-      double fd = numeric(i, h);
+      const Differences full = differences(i, h);
+      double fd = full.central;
       if (skip_kinks) {
-        const double fd_half = numeric(i, 0.5f * h);
-        if (std::abs(fd - fd_half) > kink_tol * std::abs(fd_half) + 1e-3 * largest) continue;
-        fd = fd_half;
+        const Differences half = differences(i, 0.5f * h);
+        const double tol = kink_tol * std::abs(half.central) + 1e-3 * largest;
+        if (std::abs(full.central - half.central) > tol) continue;  // a kink towards the stencil's ends
+        if (std::abs(half.parting) > tol && std::abs(half.parting) > 0.75 * std::abs(full.parting))
+          continue;  // a kink near the parameter
+        fd = half.central;
       }
       ++report.checked;
       const double tol = rel_tol * std::abs(fd) + abs_tol_frac * largest + abs_tol;
