@@ -1,6 +1,7 @@
 // icef: the command-line tool. Parses the subcommand, runs it, maps errors to exit codes:
 // 0 success, 1 user error (message on stderr), 2 internal error.
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <exception>
 #include <iostream>
 #include <map>
@@ -39,6 +40,21 @@ int main(int argc, char** argv) {
     runners[sub] = entry.second(*sub);
   }
 
+  // Bare `icef`: the overview of the subcommands rather than CLI11's one-line complaint.
+  if (argc < 2) {
+    std::cerr << app.help();
+    return 1;
+  }
+  // A first word that is no subcommand: name it (CLI11 would only say that a subcommand is required).
+  const std::string first = argv[1];
+  const bool known = std::any_of(std::begin(commands), std::end(commands),
+                                 [&](const auto& command) { return first == command.first; });
+  if (first[0] != '-' && !known) {
+    std::cerr << "icef: unknown subcommand '" << first << "'; the subcommands are:";
+    for (const auto& [name, entry] : commands) std::cerr << " " << name;
+    std::cerr << " (icef --help describes them)\n";
+    return 1;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

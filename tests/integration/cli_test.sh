@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# The tool's entry point: bare `icef` lists the subcommands (exit 1), --help and --version exit 0,
+# an unknown subcommand or option is one clear error with exit 1.
+set -euo pipefail
+ICEF="$1"
+TMP="$(mktemp -d)"
+trap 'rm -rf "$TMP"' EXIT
+
+set +e
+"$ICEF" > "$TMP/out" 2> "$TMP/err"; code=$?
+set -e
+[ "$code" -eq 1 ] || { echo "bare icef: expected exit 1, got $code" >&2; exit 1; }
+for sub in demo synth train render eval bench track; do
+  grep -q "^  $sub " "$TMP/err" || { echo "bare icef does not list '$sub'" >&2; cat "$TMP/err" >&2; exit 1; }
+done
+
+"$ICEF" --help > "$TMP/out"
+grep -q "Subcommands:" "$TMP/out"
+"$ICEF" --version | grep -q "^icef "
+
+set +e
+"$ICEF" frobnicate > /dev/null 2> "$TMP/err"; code=$?
+set -e
+[ "$code" -eq 1 ] && grep -q "unknown subcommand 'frobnicate'" "$TMP/err" && grep -q " track" "$TMP/err" \
+  || { echo "unknown subcommand: exit $code" >&2; cat "$TMP/err" >&2; exit 1; }
+[ "$(wc -l < "$TMP/err")" -eq 1 ]
+set +e
+"$ICEF" train "$TMP/data" --out "$TMP/model" --no-such-option > /dev/null 2> "$TMP/err"; code=$?
+set -e
+[ "$code" -eq 1 ] && grep -q "no-such-option" "$TMP/err" || { echo "unknown option: exit $code" >&2; exit 1; }
+echo "cli_test: ok"
