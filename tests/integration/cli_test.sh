@@ -28,4 +28,8 @@ set +e
 "$ICEF" train "$TMP/data" --out "$TMP/model" --no-such-option > /dev/null 2> "$TMP/err"; code=$?
 set -e
 [ "$code" -eq 1 ] && grep -q "no-such-option" "$TMP/err" || { echo "unknown option: exit $code" >&2; exit 1; }
+
+# `icef train --help` states the default step count, the one the resolved config holds.
+steps=$("$ICEF" config | python3 -c 'import json, sys; print(json.load(sys.stdin)["train"]["steps"])')
+"$ICEF" train --help | grep -q "default $steps;" || { echo "icef train --help does not give the default of $steps steps" >&2; exit 1; }
 echo "cli_test: ok"

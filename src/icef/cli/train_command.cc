@@ -3,6 +3,7 @@
 
 #include "icef/app/train_app.h"
 #include "icef/cli/commands.h"
+#include "icef/train/train_config.h"
 
 namespace icef::cli {
 
@@ -24,10 +25,20 @@ CommandFn RegisterTrain(CLI::App& app) {
   app.add_option("dataset", o->dataset, "Dataset directory (transforms_train.json ...)")->required();
   app.add_option("--out", o->out, "Model directory to write")->required();
   app.add_option("--method", *method, "icef-prior | warp-prior | icef | icef-no-id | icef-no-conf | icef-uniform | warp | nerface (default icef-prior: ICEF on the face model fitted to the training landmarks, docs/face_model.md; it needs the face model's expression names: re-express other datasets with icef track DATASET --keep-cameras, or train them with --method icef)");
-  app.add_option("--steps", *steps, "Optimiser steps")->check(CLI::PositiveNumber);
-  app.add_option("--time-budget", *budget, "Stop after this many seconds of training")->check(CLI::NonNegativeNumber);
+  const TrainConfig defaults;
+  app.add_option("--steps", *steps,
+                 "Optimiser steps (train.steps, default " + std::to_string(defaults.steps) +
+                     "; the bench and the demo train 1000)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--time-budget", *budget,
+                 "Stop after this many seconds of training, the step count still bounding it "
+                 "(train.time_budget_seconds, "
+                 "default 0 = no limit)")
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--config", *config, "Run config JSON ({\"parent\", \"model\": {...}, \"train\": {...}})");
-  app.add_option("--seed", *seed, "Root random seed")->check(CLI::NonNegativeNumber);
+  app.add_option("--seed", *seed,
+                 "Root random seed (train.seed, default " + std::to_string(defaults.seed) + ")")
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--threads", *threads, "Worker threads (0 = all cores)")->check(CLI::NonNegativeNumber);
   app.add_option("--set", o->overrides, "Config override SECTION.KEY=VALUE, e.g. train.lambda_id=0.2 (repeatable)");
   app.add_flag("--resume", o->resume,
