@@ -1,6 +1,7 @@
 // The face model's per-point costs, which the prior-guided methods pay per sample: the signed
 // distance, the prior warp and the surface normal (four distances), at points around the face of the
-// average head, neutral and with a moderate expression, on one thread.
+// average head, neutral and with a moderate expression, on one thread; and the neutral normals in
+// one vectorised batch.
 #include <benchmark/benchmark.h>
 
 #include <vector>
@@ -46,6 +47,22 @@ void BM_FaceModelPoint(benchmark::State& state) {
   state.counters["points/s"] =
       benchmark::Counter(static_cast<double>(state.iterations()) * points.size(), benchmark::Counter::kIsRate);
 }
+// The neutral surface's normals at many canonical points at once (the vectorised batch the prior's
+// shading uses), against BM_FaceModelNormal's one point at a time.
+void BM_FaceModelCanonicalNormals(benchmark::State& state) {
+  const face::FaceModel model{face::ShapeParams()};
+  const face::ExpressionState s = State(model, 0);
+  const std::vector<Vec3f> points = FacePoints(4096);
+  std::vector<Vec3f> normals(points.size());
+  for (auto _ : state) {
+    model.CanonicalNormals(points, s, normals.data());
+    benchmark::DoNotOptimize(normals.data());
+  }
+  state.counters["points/s"] = benchmark::Counter(static_cast<double>(state.iterations()) * points.size(),
+                                                  benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_FaceModelCanonicalNormals)->UseRealTime();
+
 BENCHMARK(BM_FaceModelPoint<0>)->Name("BM_FaceModelDistance")->ArgName("expr")->Arg(0)->Arg(1)->UseRealTime();
 BENCHMARK(BM_FaceModelPoint<1>)->Name("BM_FaceModelPriorWarp")->ArgName("expr")->Arg(0)->Arg(1)->UseRealTime();
 BENCHMARK(BM_FaceModelPoint<2>)->Name("BM_FaceModelNormal")->ArgName("expr")->Arg(0)->Arg(1)->UseRealTime();

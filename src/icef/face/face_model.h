@@ -107,6 +107,9 @@ class FaceModel {
   Sample Evaluate(const Vec3f& x, const ExpressionState& state) const;
   // Surface normal (unit, observation space) by central differences of Distance.
   Vec3f Normal(const Vec3f& x, const ExpressionState& state) const;
+  // Normals of the canonical surface (the state's lids, no warp, no mouth cavity) at many canonical
+  // points, vectorised; for a neutral state each equals Normal(point, state). normals: [points.size()].
+  void CanonicalNormals(std::span<const Vec3f> points, const ExpressionState& state, Vec3f* normals) const;
 
   // Sphere-traces the ray in [t_near, t_far]; returns the hit distance t or a negative value.
   float Trace(const Ray& ray, float t_near, float t_far, const ExpressionState& state, int max_steps = 192,
@@ -130,6 +133,10 @@ class FaceModel {
  private:
   // Neutral surface with eyelids at the state's lid angles (canonical space); material optional.
   float CanonicalDistance(const Vec3f& x_c, const ExpressionState& state, Material* material) const;
+  // CanonicalDistance without material at many points (a loop that vectorises). distances: [points.size()].
+  void CanonicalDistances(std::span<const Vec3f> points, const ExpressionState& state,
+                          float* distances) const;
+  static constexpr float kNormalStep = 4e-4f;  // Normal()'s finite-difference step (head units)
   // Backward displacement (x_c - x) of the jaw rotation and of every bump term.
   Vec3f JawDisplacement(const Vec3f& x, float angle, float weight_override) const;
   Vec3f BumpDisplacement(const Vec3f& x, const ExpressionState& state) const;

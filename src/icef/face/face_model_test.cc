@@ -58,6 +58,41 @@ TEST(FaceModelTest, ZeroExpressionIsTheNeutralSurface) {
   }
 }
 
+// The vectorised batch gives Normal()'s normals: at the neutral and with the eyes closing (lids
+// differ per side; no warp, no cavity), at points that are near the eyes, on the face and far
+// from it (the base's bound), on varied subjects.
+TEST(FaceModelTest, CanonicalNormalsMatchNormalPointByPoint) {
+  for (uint64_t subject : {3u, 8u}) {
+    const FaceModel face(TestShape(subject));
+    std::vector<float> closing = Zeros();
+    closing[kEyeCloseLeft] = 0.8f;
+    closing[kEyeCloseRight] = 0.3f;
+    Rng rng(subject, StreamId("test"));
+    std::vector<Vec3f> points;
+    for (int i = 0; i < 300; ++i) {
+      const Vec3f& eye = face.geometry().eye_c[i % 2];
+      points.push_back(eye +
+                       Vec3f(rng.Uniform(-0.03, 0.03), rng.Uniform(-0.03, 0.03), rng.Uniform(-0.02, 0.03)));
+      points.push_back(Vec3f(rng.Uniform(-0.3, 0.3), rng.Uniform(-0.5, 0.3), rng.Uniform(0.0, 0.45)));
+      points.push_back(Vec3f(rng.Uniform(-1.0, 1.0), rng.Uniform(-1.0, 1.0), rng.Uniform(-1.0, 1.0)));
+    }
+    for (const std::vector<float>& beta : {Zeros(), closing}) {
+      const ExpressionState s = face.Prepare(beta);
+      std::vector<Vec3f> normals(points.size());
+      face.CanonicalNormals(points, s, normals.data());
+      int far = 0;
+      for (size_t i = 0; i < points.size(); ++i) {
+        const Vec3f expected = face.Normal(points[i], s);
+        // Float round-off of the four distances (1 ulp of a distance is up to ~3e-5 of the difference
+        // quotient at h = 4e-4), not a different surface: a wrong side or lid would be off by ~0.1-1.
+        for (int a = 0; a < 3; ++a) EXPECT_NEAR(normals[i][a], expected[a], 1e-4f) << "point " << i;
+        far += face.Distance(points[i], s) > 0.04f;
+      }
+      EXPECT_GT(far, 200);  // the bound far from the face is exercised
+    }
+  }
+}
+
 TEST(FaceModelTest, PrepareFromASpanMatchesTheVector) {
   const FaceModel face(ShapeParams::Average());
   std::array<float, kNumExpressions> beta{};

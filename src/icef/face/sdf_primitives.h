@@ -10,12 +10,16 @@
 
 namespace icef::face {
 
-inline float SdSphere(const Vec3f& p, float r) { return p.norm() - r; }
+// The Euclidean length as std::sqrt of the squared norm: the same value as Eigen's norm(), which
+// takes the square root through an SSE intrinsic that a loop over points cannot vectorise.
+inline float Length(const Vec3f& p) { return std::sqrt(p.squaredNorm()); }
+
+inline float SdSphere(const Vec3f& p, float r) { return Length(p) - r; }
 
 // p relative to the centre; r: semi-axes.
 inline float SdEllipsoid(const Vec3f& p, const Vec3f& r) {
-  const float k0 = p.cwiseQuotient(r).norm();
-  const float k1 = p.cwiseQuotient(r.cwiseProduct(r)).norm();
+  const float k0 = Length(p.cwiseQuotient(r));
+  const float k1 = Length(p.cwiseQuotient(r.cwiseProduct(r)));
   return k1 > 1e-12f ? k0 * (k0 - 1.f) / k1 : -r.minCoeff();
 }
 
@@ -23,7 +27,7 @@ inline float SdEllipsoid(const Vec3f& p, const Vec3f& r) {
 inline float SdCone(const Vec3f& p, const Vec3f& a, const Vec3f& b, float ra, float rb) {
   const Vec3f ab = b - a;
   const float h = std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.f, 1.f);
-  return (p - a - h * ab).norm() - (ra + (rb - ra) * h);
+  return Length(p - a - h * ab) - (ra + (rb - ra) * h);
 }
 
 // Polynomial smooth minimum with blend width k (k > 0).

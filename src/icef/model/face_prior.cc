@@ -1,6 +1,7 @@
 #include "icef/model/face_prior.h"
 
 #include <sstream>
+#include <vector>
 
 #include "icef/face/expression.h"
 #include "icef/face/face_model.h"
@@ -55,16 +56,23 @@ class FacePrior final : public DeformationPrior {
                float* canonical) const override {
     ParallelFor(executor, n, [&](int64_t i0, int64_t i1, int) {
       StateCache cache;
+      std::vector<Vec3f> canonical_points(size_t(i1 - i0)), neutral_normals(size_t(i1 - i0));
+      for (int64_t i = i0; i < i1; ++i) {
+        const Vec3f x(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]);
+        const face::ExpressionState& state = cache.Get(model_, betas + i * face::kNumExpressions);
+        canonical_points[size_t(i - i0)] = model_.PriorWarp(head_from_world_ * x + translation_, state);
+      }
+      // The neutral surface's normal g at the canonical point P(x): the range's all at once.
+      model_.CanonicalNormals(canonical_points, neutral_, neutral_normals.data());
       for (int64_t i = i0; i < i1; ++i) {
         const Vec3f x(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]);
         const face::ExpressionState& state = cache.Get(model_, betas + i * face::kNumExpressions);
         const Vec3f x_h = head_from_world_ * x + translation_;
-        // The neutral surface's normal g at the canonical point P(x), and g carried back through the
-        // prior warp: the surface the warp makes of the neutral one is d(x) = d_neutral(P(x)), whose
-        // gradient is J^T g with J = dP/dx (central differences). Where the warp is a translation the
-        // two agree (s = 1) whatever the expression. Six warps cost a fraction of the four signed
-        // distances of the expressed model's own normal.
-        const Vec3f g = model_.Normal(model_.PriorWarp(x_h, state), neutral_);
+        // g carried back through the prior warp: the surface the warp makes of the neutral one is
+        // d(x) = d_neutral(P(x)), whose gradient is J^T g with J = dP/dx (central differences). Where
+        // the warp is a translation the two agree (s = 1) whatever the expression. Six warps cost a
+        // fraction of the four signed distances of the expressed model's own normal.
+        const Vec3f g = neutral_normals[size_t(i - i0)];
         Vec3f carried = g;
         if (!state.neutral) {
           Mat3f jacobian;
