@@ -3,6 +3,7 @@
 
 #include "icef/app/demo_app.h"
 #include "icef/cli/commands.h"
+#include "icef/cli/validators.h"
 
 namespace icef::cli {
 
@@ -18,12 +19,13 @@ CommandFn RegisterDemo(CLI::App& app) {
   app.add_option("--time-budget", o->time_budget,
                  "Training time cap, seconds (0 = none); training stops at --steps or here")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(kNonNegative);
   app.add_option("--steps", o->steps, "Training steps (1000: the bench's and the README sheet's)")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
-  app.add_option("--threads", o->threads, "Worker threads (0 = all cores)")->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(kPositive);
+  app.add_option("--threads", o->threads, "Worker threads (0 = all cores)")
+      ->capture_default_str()
+      ->check(kNonNegative);
   app.add_flag("--quick", o->quick, "Tiny settings that finish in seconds (for tests)");
   return [o]() { return RunDemo(*o, std::cout); };
 }

@@ -2,12 +2,57 @@
 // 0 success, 1 user error (message on stderr), 2 internal error.
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <cstdlib>
 #include <exception>
 #include <iostream>
 #include <map>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "icef/cli/commands.h"
+
+namespace {
+
+CLI::App* FindSubcommand(CLI::App* command, const std::string& name) {
+  const std::vector<CLI::App*> found =
+      command->get_subcommands([&](CLI::App* sub) { return sub->get_name() == name; });
+  return found.empty() ? nullptr : found.front();
+}
+
+// The subcommand the command line names (the words right after `icef`: `train`, `bench merge`) and
+// the index of the first argument after them.
+std::pair<CLI::App*, int> NamedCommand(CLI::App& app, int argc, char** argv) {
+  CLI::App* command = &app;
+  int i = 1;
+  for (; i < argc; ++i) {
+    CLI::App* sub = FindSubcommand(command, argv[i]);
+    if (sub == nullptr) break;
+    command = sub;
+  }
+  return {command, i};
+}
+
+// The first option after the subcommand that it does not define, or "" (CLI11 reports a missing
+// required argument first, which hides a misspelt option). Values that are numbers (`--yaw -30`)
+// and everything after `--` are not options.
+std::string UnknownOption(CLI::App* command, int first, int argc, char** argv) {
+  for (int i = first; i < argc; ++i) {
+    const std::string token = argv[i];
+    if (token == "--") break;
+    if (token.size() < 2 || token[0] != '-') continue;
+    char* end = nullptr;
+    std::strtod(token.c_str(), &end);
+    if (end != nullptr && *end == '\0') continue;  // a negative number
+    const std::string name = token.substr(0, token.find('='));
+    const bool is_long = name.rfind("--", 0) == 0;
+    if (!is_long && name.size() != 2) continue;  // grouped short flags: left to CLI11
+    if (command->get_option_no_throw(name) == nullptr) return name;
+  }
+  return "";
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{
@@ -53,6 +98,14 @@ int main(int argc, char** argv) {
     std::cerr << "icef: unknown subcommand '" << first << "'; the subcommands are:";
     for (const auto& [name, entry] : commands) std::cerr << " " << name;
     std::cerr << " (icef --help describes them)\n";
+    return 1;
+  }
+  const auto [command, first_argument] = NamedCommand(app, argc, argv);
+  if (const std::string option = UnknownOption(command, first_argument, argc, argv); !option.empty()) {
+    std::string name = command->get_name();  // "icef train", "icef bench merge"
+    for (CLI::App* parent = command->get_parent(); parent != nullptr; parent = parent->get_parent())
+      name = parent->get_name() + " " + name;
+    std::cerr << name << ": unknown option '" << option << "' (" << name << " --help lists the options)\n";
     return 1;
   }
   try {

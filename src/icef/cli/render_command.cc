@@ -3,6 +3,7 @@
 
 #include "icef/app/render_app.h"
 #include "icef/cli/commands.h"
+#include "icef/cli/validators.h"
 
 namespace icef::cli {
 
@@ -23,7 +24,8 @@ CommandFn RegisterRender(CLI::App& app) {
   app.add_option("--out", o->out, "Output directory")->required();
   app.add_option("--dataset", *dataset, "Dataset for --frame / --expression-frame");
   app.add_option("--frame", *frame, "Camera of a dataset frame, SPLIT:INDEX (e.g. test:2)");
-  app.add_option("--orbit", o->orbit, "Turntable of N views around the mean training view")->check(CLI::NonNegativeNumber);
+  app.add_option("--orbit", o->orbit, "Turntable of N views around the mean training view")
+      ->check(kNonNegative);
   app.add_option("--orbit-yaw", o->orbit_yaw, "Turntable yaw half-range, degrees")->capture_default_str();
   app.add_option("--orbit-pitch", o->orbit_pitch, "Camera pitch, degrees")->capture_default_str();
   app.add_option("--res", *res, "Image height of orbit/default cameras, pixels")->check(CLI::Range(8, 4096));
@@ -33,7 +35,7 @@ CommandFn RegisterRender(CLI::App& app) {
   app.add_option("--sweep", *sweep, "NAME=VALUE: frames from the expression to VALUE x --sweep-beyond");
   app.add_option("--sweep-frames", o->sweep_frames, "Frames of a sweep")->capture_default_str()->check(CLI::Range(2, 1000));
   app.add_option("--sweep-beyond", o->sweep_beyond, "The sweep ends at this multiple of the target")->capture_default_str();
-  app.add_option("--threads", o->threads, "Worker threads (0 = all cores)")->check(CLI::NonNegativeNumber);
+  app.add_option("--threads", o->threads, "Worker threads (0 = all cores)")->check(kNonNegative);
   app.add_option(
       "--set", o->overrides,
       "Override an inference-only model key, model.KEY=VALUE with KEY render.supersample, "

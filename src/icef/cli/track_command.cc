@@ -10,6 +10,7 @@
 #include "icef/app/detector_calibration.h"
 #include "icef/app/track_app.h"
 #include "icef/cli/commands.h"
+#include "icef/cli/validators.h"
 #include "icef/landmarks/face_landmark_detector.h"
 
 namespace icef::cli {
@@ -59,21 +60,24 @@ CommandFn RegisterTrack(CLI::App& app) {
                "smile is, ...) is read off those exact landmarks first, the weights are read in it, and the dataset's "
                "3D landmarks are the styled model's, so that icef train finds the style again (docs/tracking.md)");
   auto silhouette_points = std::make_shared<int>(-1);  // -1: the mode's default
-  app.add_option("--silhouette-points", *silhouette_points,
-                 "Refit each photo's pose, expression and the shape with this many points of its mask's edge "
-                 "beside the landmarks (0 = landmarks only; default 200); with --keep-cameras, the edge of each "
-                 "frame's alpha mask, or of its difference to the dataset's background image (NerFace's bg/), in "
-                 "the frames that have one (default 200 for dlib's landmarks and 0 for --landmarks model, which "
-                 "place the head already)")
-      ->check(CLI::NonNegativeNumber);
+  app.add_option(
+         "--silhouette-points", *silhouette_points,
+         "Refit each photo's pose, expression and the shape with this many points of its mask's edge "
+         "beside the landmarks (0 = landmarks only; default 200); with --keep-cameras, the edge of each "
+         "frame's alpha mask, or of its difference to the dataset's background image (NerFace's bg/), in "
+         "the frames that have one (default 200 for dlib's landmarks and 0 for --landmarks model, which "
+         "place the head already)")
+      ->check(kNonNegative);
   auto photometric = std::make_shared<double>(-1);  // -1: the mode's default
-  app.add_option("--photometric-weight", *photometric,
-                 "Refine each photo's expression and pose on the photos themselves: points of the neutral face, "
-                 "carried into every photo by the fitted warp and pose, must find the same colour there; their "
-                 "weight against the landmarks (0 = landmarks and outline only; default 16; with --keep-cameras 0 for "
-                 "--landmarks model, which are exact, and for dlib's landmarks 64 where the frames' outlines place "
-                 "the head, which the refit then holds, else 16: docs/tracking.md)")
-      ->check(CLI::NonNegativeNumber);
+  app.add_option(
+         "--photometric-weight", *photometric,
+         "Refine each photo's expression and pose on the photos themselves: points of the neutral face, "
+         "carried into every photo by the fitted warp and pose, must find the same colour there; their "
+         "weight against the landmarks (0 = landmarks and outline only; default 16; with --keep-cameras 0 "
+         "for "
+         "--landmarks model, which are exact, and for dlib's landmarks 64 where the frames' outlines place "
+         "the head, which the refit then holds, else 16: docs/tracking.md)")
+      ->check(kNonNegative);
   auto region = std::make_shared<std::string>("face");
   app.add_option("--silhouette-region", *region,
                  "Which part of the mask's edge the refit uses: face (where it touches the head between the chin and "
@@ -91,10 +95,11 @@ CommandFn RegisterTrack(CLI::App& app) {
                  "averaged over shifted boxes). With --keep-cameras: for --landmarks detect")
       ->check(CLI::IsMember({"dlib", "mesh"}));
   auto landmark_sigma = std::make_shared<double>(-1);
-  app.add_option("--landmark-sigma", *landmark_sigma,
-                 "The landmarks' noise in inter-ocular distances, which the priors are balanced against (default: "
-                 "0.05; with --keep-cameras 0.1, and 0.002 for --landmarks model, which are exact; docs/tracking.md)")
-      ->check(CLI::PositiveNumber);
+  app.add_option(
+         "--landmark-sigma", *landmark_sigma,
+         "The landmarks' noise in inter-ocular distances, which the priors are balanced against (default: "
+         "0.05; with --keep-cameras 0.1, and 0.002 for --landmarks model, which are exact; docs/tracking.md)")
+      ->check(kPositive);
   auto calibrate = std::make_shared<bool>(false);
   app.add_flag("--calibrate-detector", *calibrate,
                "Developer: measure where the detector (--detector) puts its landmarks on the face model (renders of "

@@ -3,6 +3,7 @@
 
 #include "icef/app/train_app.h"
 #include "icef/cli/commands.h"
+#include "icef/cli/validators.h"
 #include "icef/train/train_config.h"
 
 namespace icef::cli {
@@ -29,17 +30,17 @@ CommandFn RegisterTrain(CLI::App& app) {
   app.add_option("--steps", *steps,
                  "Optimiser steps (train.steps, default " + std::to_string(defaults.steps) +
                      "; the bench and the demo train 1000)")
-      ->check(CLI::PositiveNumber);
+      ->check(kPositive);
   app.add_option("--time-budget", *budget,
                  "Stop after this many seconds of training, the step count still bounding it "
                  "(train.time_budget_seconds, "
                  "default 0 = no limit)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(kNonNegative);
   app.add_option("--config", *config, "Run config JSON ({\"parent\", \"model\": {...}, \"train\": {...}})");
   app.add_option("--seed", *seed,
                  "Root random seed (train.seed, default " + std::to_string(defaults.seed) + ")")
-      ->check(CLI::NonNegativeNumber);
-  app.add_option("--threads", *threads, "Worker threads (0 = all cores)")->check(CLI::NonNegativeNumber);
+      ->check(kNonNegative);
+  app.add_option("--threads", *threads, "Worker threads (0 = all cores)")->check(kNonNegative);
   app.add_option("--set", o->overrides, "Config override SECTION.KEY=VALUE, e.g. train.lambda_id=0.2 (repeatable)");
   app.add_flag("--resume", o->resume,
                "Continue from MODEL/checkpoint.icef (its run config; only the step count, time budget, threads and "
