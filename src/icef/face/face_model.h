@@ -108,7 +108,8 @@ class FaceModel {
   // Surface normal (unit, observation space) by central differences of Distance.
   Vec3f Normal(const Vec3f& x, const ExpressionState& state) const;
   // Normals of the canonical surface (the state's lids, no warp, no mouth cavity) at many canonical
-  // points, vectorised; for a neutral state each equals Normal(point, state). normals: [points.size()].
+  // points, vectorised; for a neutral state (or one that only closes the eyes: no warp, no cavity)
+  // each equals Normal(point, state) to float round-off. normals: [points.size()].
   void CanonicalNormals(std::span<const Vec3f> points, const ExpressionState& state, Vec3f* normals) const;
 
   // Sphere-traces the ray in [t_near, t_far]; returns the hit distance t or a negative value.
