@@ -38,6 +38,19 @@ grep -q "\*\*Expression reproduced, K=3\*\*" "$R" || fail "no expression line"
 grep -q "tiers by delta: observed = 0, near (0, 0.35]" "$R" || fail "no tier thresholds"
 grep -q "identities (seeds): 1 (test identities" "$R" || fail "identities not named as test identities"
 grep -q "FDNeRF and NeRFFaceEditing proper are not available" "$R" || fail "no stand-in caveat"
+T="$WORK/m/report.tex"
+grep -q "label{tab:icef-bench-k3}" "$T" || fail "report.tex lacks the K = 3 table"
+grep -q "label{tab:icef-bench-far}" "$T" || fail "report.tex lacks the far-tier table"
+for m in icef-prior warp-prior icef icef-no-conf icef-uniform warp nerface; do
+  grep -q "texttt{$m}" "$T" || fail "report.tex lacks $m"
+done
+if command -v pdflatex > /dev/null && kpsewhich booktabs.sty > /dev/null; then  # not installed by the setup
+  mkdir "$WORK/tex"
+  printf '\\documentclass{article}\n\\usepackage{booktabs}\n\\begin{document}\n\\input{%s}\n\\end{document}\n' "$T" > "$WORK/tex/main.tex"
+  (cd "$WORK/tex" && pdflatex -interaction=nonstopmode -halt-on-error main.tex > latex.log 2>&1) \
+    || fail "report.tex does not compile: $(grep -A3 '^!' "$WORK/tex/latex.log")"
+  echo "report.tex compiles with pdflatex"
+fi
 grep -q "^| far | \`icef\` | 1 |" "$R" || fail "no far-tier icef row"
 [ "$(grep -c '^| observed | ' "$R")" = 14 ] || fail "expected 14 observed rows (7 methods, 2 tables)"
 python3 - "$WORK/m/report.json" <<'PY' || fail "report.json"

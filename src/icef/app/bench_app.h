@@ -1,5 +1,5 @@
 // `icef bench --out DIR ...`: the whole evaluation protocol (eval/bench_protocol.h): synthesise,
-// train and evaluate every identity x K x method, then report.md, report.json and plots. This
+// train and evaluate every identity x K x method, then report.md, report.json, report.tex and plots. This
 // resolves the command's options into eval::BenchOptions: the defaults, then --validation, then
 // --quick, with the options given explicitly winning over both.
 #pragma once

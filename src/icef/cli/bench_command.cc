@@ -28,8 +28,8 @@ CommandFn RegisterBench(CLI::App& app) {
   app.description(
       "Run the benchmark: for each identity seed x K x method, synthesise a dataset (cached in DIR/data/), train "
       "with the same budget, evaluate, and write DIR/runs/<id>_k<K>_<method>/metrics.json; then DIR/report.md, "
-      "report.json and plots/. Re-running skips finished runs. `icef bench merge A B --out C` builds one "
-      "report from shard directories.");
+      "report.json, report.tex (the tables in LaTeX, booktabs) and plots/. Re-running skips finished runs. "
+      "`icef bench merge A B --out C` builds one report from shard directories.");
   app.add_option("--out,-o", args->app.out, "Output directory (created)");
   app.add_option("--identities", o.identities, "Number of identities (test seeds 1..N; with --validation 6, seeds 101..106)")
       ->capture_default_str();

@@ -3,15 +3,15 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <map>
 #include <set>
 #include <sstream>
 #include <tuple>
-#include <cstdlib>
 
 #include "icef/core/progress.h"
+#include "icef/eval/report_latex.h"
 #include "icef/eval/training_view_sheet.h"
-
 #include "icef/io/atomic_file.h"
 #include "icef/model/method.h"
 
@@ -72,6 +72,25 @@ const char* MetricLabel(Metric m) {
     case Metric::kIdExcess: return "drift beyond the ground truth's own (0 = as the truth; < 0 = under-expression)";
   }
   return "?";
+}
+
+const char* MetricFormat(Metric m) {
+  switch (m) {
+    case Metric::kPsnr:
+      return "%.2f";
+    case Metric::kPsnrNeutralFloor:
+      return "%.2f";
+    case Metric::kRegionPsnr:
+      return "%.2f";
+    case Metric::kIdExcess:
+      return "%+.3f";
+    case Metric::kIdShareUnder06:
+      return "%.2f";
+    case Metric::kIdCosine:
+      return "%.4f";
+    default:
+      return "%.3f";
+  }
 }
 
 bool HigherIsBetter(Metric m) {
@@ -213,18 +232,6 @@ std::string Pm(const std::optional<Spread>& s, const char* format) {
   std::snprintf(lo, sizeof lo, format, s->min);
   std::snprintf(hi, sizeof hi, format, s->max);
   return std::string(m) + " ± " + d + " [" + lo + ", " + hi + "]";
-}
-
-const char* MetricFormat(Metric m) {
-  switch (m) {
-    case Metric::kPsnr: return "%.2f";
-    case Metric::kPsnrNeutralFloor: return "%.2f";
-    case Metric::kRegionPsnr: return "%.2f";
-    case Metric::kIdExcess: return "%+.3f";
-    case Metric::kIdShareUnder06: return "%.2f";
-    case Metric::kIdCosine: return "%.4f";
-    default: return "%.3f";
-  }
 }
 
 const std::vector<std::string>& Baselines() {
@@ -1035,6 +1042,7 @@ Status WriteReport(const fs::path& dir, const std::vector<RunRecord>& runs, Repo
   ICEF_ASSIGN_OR_RETURN(const std::vector<std::string> plots, WritePlots(dir, aggregate, &note));
   if (!note.empty()) context.notes.push_back(note);
   ICEF_RETURN_IF_ERROR(WriteFileAtomic(dir / "report.md", ReportMarkdown(aggregate, runs, context, plots)));
+  ICEF_RETURN_IF_ERROR(WriteFileAtomic(dir / "report.tex", ReportLatex(aggregate, context, runs.size())));
   return WriteFileAtomic(dir / "report.json", FormatJson(ReportJson(aggregate, runs, context)));
 }
 

@@ -1,10 +1,11 @@
 // The bench report (DESIGN.md §6): per tier, per method, per K, the mean and spread (sample std,
 // min, max) over identities of every metric, computed from the per-run metrics.json files; a
 // verdict on the paper's claim (does icef beat the baselines in the far tier on identity
-// similarity and PSNR?) derived from those numbers; written as report.md + report.json, and plots
-// of each metric against delta (one line per method, mean +- std over identities) drawn by gnuplot
-// as PNG + SVG. Beside them, per K and method, the training-view fit (how well the models reproduce
-// their own training views), and for validation benches a table of every run per identity.
+// similarity and PSNR?) derived from those numbers; written as report.md + report.json (+ report.tex,
+// eval/report_latex.h), and plots of each metric against delta (one line per method, mean +- std over
+// identities) drawn by gnuplot as PNG + SVG. Beside them, per K and method, the training-view fit (how well
+// the models reproduce their own training views), and for validation benches a table of every run per
+// identity.
 #pragma once
 
 #include <array>
@@ -56,6 +57,7 @@ const std::array<Metric, kNumMetrics>& AllMetrics();
 const char* MetricName(Metric metric);   // the metrics.json key, e.g. "id_distance"
 const char* MetricLabel(Metric metric);  // axis label, e.g. "identity distance to own neutral (lower = better)"
 bool HigherIsBetter(Metric metric);
+const char* MetricFormat(Metric metric);  // printf format of its values in the reports, e.g. "%.2f" for PSNR
 std::optional<double> TierValue(const TierMetrics& tier, Metric metric);
 
 // Mean and spread of values over identities.
@@ -205,7 +207,7 @@ Json ReportJson(const Aggregate& aggregate, const std::vector<RunRecord>& runs, 
 Result<std::vector<std::string>> WritePlots(const std::filesystem::path& dir, const Aggregate& aggregate,
                                             std::string* note);
 
-// Aggregates, plots and writes dir/report.md + dir/report.json.
+// Aggregates, plots and writes dir/report.md, dir/report.json and dir/report.tex (eval/report_latex.h).
 Status WriteReport(const std::filesystem::path& dir, const std::vector<RunRecord>& runs, ReportContext context);
 
 // Run records as stored under runs/<name>/metrics.json (metrics + a "run" object with
