@@ -3,7 +3,8 @@
 // default one ray per pixel) at a far expression, with the occupancy grid built for that expression
 // (the default), with the training grid, and with rays composited as deep as training does; building
 // that grid alone; `icef train`'s step (BM_TrainStep: rays/s, samples/s and steps/s of the full
-// default training step); and `icef eval` per test frame (BM_EvalFrame). The render model is
+// default training step) and the first 300 steps of a fresh run (BM_TrainWarmup); and `icef eval`
+// per test frame (BM_EvalFrame). The render model is
 // trained once per process (1000 steps, about a minute on 2 cores: as trained as the models users
 // render; at 300 steps it is still semi-transparent fog that every ray marches through), so the
 // first benchmark that needs it pays for it; the training step runs on a trainer of its own, warmed
@@ -164,6 +165,45 @@ BENCHMARK(BM_TrainStep)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MinTime(3.0);
+
+// The start of a run, which BM_TrainStep leaves out: a fresh trainer's first
+// train.occupancy_warmup + 44 steps (the steps BM_TrainStep takes before it times), on 2 threads.
+// While the field is still fog its rays stop late, so more of their samples run the colour MLP and
+// the prior shading's normals: a change to that per-sample work shows here more than in
+// BM_TrainStep. One iteration: a whole short training (docs/engine.md, "The start of a run").
+void BM_TrainWarmup(benchmark::State& state) {
+  const Subject& s = TrainedSubject();
+  if (!s.error.empty()) return state.SkipWithError(s.error.c_str());
+  icef::RunConfig config;
+  config.train.steps = 1000000;
+  config.train.threads = 2;
+  config.train.checkpoint_every = 0;
+  const int steps = config.train.occupancy_warmup + 44;
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("icef_warmup_bench_" + std::to_string(::getpid()));
+  int64_t samples = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    auto trainer = icef::Trainer::Create(s.dataset, dir, config);
+    if (!trainer.ok()) return state.SkipWithError(trainer.status().message().c_str());
+    state.ResumeTiming();
+    for (int i = 0; i < steps; ++i) {
+      const icef::Result<icef::LossTerms> terms = (*trainer)->Step();
+      if (!terms.ok()) return state.SkipWithError(terms.status().message().c_str());
+      samples += terms->samples;
+    }
+    state.PauseTiming();
+    trainer->reset();
+    std::filesystem::remove_all(dir);
+    state.ResumeTiming();
+  }
+  const double total = static_cast<double>(state.iterations()) * steps;
+  state.counters["steps/s"] = benchmark::Counter(total, benchmark::Counter::kIsRate);
+  state.counters["rays/s"] = benchmark::Counter(total * config.train.batch_rays, benchmark::Counter::kIsRate);
+  state.counters["samples/s"] = benchmark::Counter(static_cast<double>(samples), benchmark::Counter::kIsRate);
+  state.counters["samples/step"] = static_cast<double>(samples) / total;
+}
+BENCHMARK(BM_TrainWarmup)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
 
 // icef eval's work per test frame (the far frame of the subject): its render and the model's
 // neutral render of the same view, PSNR, SSIM, the expression-fidelity measures and, where the

@@ -367,8 +367,8 @@ Status RunBench(const BenchOptions& o, std::ostream& log, bool interactive) {
     context.notes.push_back("Partial: " + std::to_string(records.size()) + " of " + std::to_string(PlanRuns(o).size()) +
                             " planned runs are in this directory.");
   ICEF_RETURN_IF_ERROR(WriteReport(o.out_dir, records, context));
-  log << "bench: " << todo.size() << " runs in " << ProgressBar::FormatDuration(wall) << "; report: "
-      << (o.out_dir / "report.md").string() << "\n";
+  log << "bench: " << todo.size() << " runs in " << ProgressBar::FormatDuration(wall)
+      << "; report: " << (o.out_dir / "report.md").string() << " (LaTeX tables: report.tex)\n";
   for (const std::string& line : Verdict(AggregateRuns(records))) log << "  " << line << "\n";
   return Status::Ok();
 }
@@ -446,7 +446,8 @@ Status MergeBench(const std::vector<fs::path>& inputs, const fs::path& out_dir, 
   }
   context.notes.push_back("Merged from " + std::to_string(inputs.size()) + " bench directories (renders stay there).");
   ICEF_RETURN_IF_ERROR(WriteReport(out_dir, records, context));
-  log << "bench merge: " << records.size() << " runs; report: " << (out_dir / "report.md").string() << "\n";
+  log << "bench merge: " << records.size() << " runs; report: " << (out_dir / "report.md").string()
+      << " (LaTeX tables: report.tex)\n";
   for (const std::string& line : Verdict(AggregateRuns(records))) log << "  " << line << "\n";
   return Status::Ok();
 }

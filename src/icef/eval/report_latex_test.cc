@@ -1,6 +1,7 @@
 #include "icef/eval/report_latex.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <filesystem>
