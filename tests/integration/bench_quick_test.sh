@@ -77,6 +77,7 @@ if command -v gnuplot > /dev/null; then
   for p in psnr ssim expr_gain region_psnr id_distance id_cosine; do
     test -s "$WORK/m/plots/$p.png" || fail "no $p.png"
     test -s "$WORK/m/plots/$p.svg" || fail "no $p.svg"
+    test -s "$WORK/m/plots/$p.pdf" || fail "no $p.pdf"
   done
   grep -q "!\[plots/psnr.png\](plots/psnr.png)" "$R" || fail "report does not show the plots"
 fi

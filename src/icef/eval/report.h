@@ -3,8 +3,8 @@
 // verdict on the paper's claim (does icef beat the baselines in the far tier on identity
 // similarity and PSNR?) derived from those numbers; written as report.md + report.json (+ report.tex,
 // eval/report_latex.h), and plots of each metric against delta (one line per method, mean +- std over
-// identities) drawn by gnuplot as PNG + SVG. Beside them, per K and method, the training-view fit (how well
-// the models reproduce their own training views), and for validation benches a table of every run per
+// identities) drawn by gnuplot as PNG, SVG and PDF. Beside them, per K and method, the training-view fit (how
+// well the models reproduce their own training views), and for validation benches a table of every run per
 // identity.
 #pragma once
 
@@ -200,7 +200,7 @@ std::string ReportMarkdown(const Aggregate& aggregate, const std::vector<RunReco
                            const std::vector<std::string>& plots);
 Json ReportJson(const Aggregate& aggregate, const std::vector<RunRecord>& runs, const ReportContext& context);
 
-// Writes dir/plots/<metric>.{dat,gp,png,svg} (one panel per K, x = mean delta of each tier, one
+// Writes dir/plots/<metric>.{dat,gp,png,svg,pdf} (one panel per K, x = mean delta of each tier, one
 // line per method with std error bars) for each metric with values. Returns the PNG paths
 // relative to dir; when gnuplot is not installed, only the .dat/.gp files are written and
 // `*note` says so.

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 
 #include "icef/io/atomic_file.h"
 #include "icef/io/image.h"
@@ -226,6 +227,11 @@ TEST(ReportTest, WritesMarkdownJsonAndPlots) {
   if (std::system("command -v gnuplot >/dev/null 2>&1") == 0) {
     EXPECT_GT(fs::file_size(dir / "plots" / "psnr.png"), 1000u);
     EXPECT_GT(fs::file_size(dir / "plots" / "id_distance.svg"), 1000u);
+    std::ifstream pdf(dir / "plots" / "id_distance.pdf", std::ios::binary);
+    std::string magic(5, '\0');
+    pdf.read(magic.data(), 5);
+    EXPECT_EQ(magic, "%PDF-");
+    EXPECT_GT(fs::file_size(dir / "plots" / "id_distance.pdf"), 1000u);
     EXPECT_NE(md->find("![plots/psnr.png](plots/psnr.png)"), std::string::npos);
   }
   fs::remove_all(dir);
