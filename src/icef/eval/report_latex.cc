@@ -146,12 +146,10 @@ void FarTable(std::ostringstream& s, const Aggregate& a, const ReportContext& ct
   static const Metric kMetrics[] = {Metric::kPsnr, Metric::kExprGain, Metric::kIdDistanceGt};
   static const char* kHeaders[] = {"PSNR", "Expr.", "ID"};
   s << "\\begin{table}[t]\n\\centering\n\\small\n";
-  s << "\\caption{" << LatexEscape(ctx.title)
-    << ", far tier (expressions far from every training expression) "
-    << "against the number of training frames $K$: PSNR (dB, higher is better), expression gain (1 = the "
-       "full "
-    << "expression) and identity distance to the ground truth (lower is better). " << CaptionTail(a, ctx)
-    << "}\n";
+  s << "\\caption{" << LatexEscape(ctx.title) << ", far tier (expressions far from every training "
+    << "expression) against the number of training frames $K$: PSNR (dB, higher is better), expression "
+    << "gain (1 = the full expression) and identity distance to the ground truth (lower is better). "
+    << CaptionTail(a, ctx) << "}\n";
   s << "\\label{tab:icef-bench-far}\n";
   s << "\\begin{tabular}{l";
   for (size_t i = 0; i < a.ks.size(); ++i) s << "ccc";
