@@ -6,8 +6,9 @@
 # keys of report.json (psnr, expr_gain, id_distance_gt, ...); every cell "mean" or "mean ± std" must
 # equal that (K, method, tier) cell of the report's aggregate, rounded to the decimals shown. A
 # decimal number anywhere else in the section is an error: numbers live in checked tables.
-# Training curve: every row "| step | seconds | PSNR |" between the train-curve markers must be a
-# line of docs/results/train_k5_128_icef.jsonl (seconds to 0 and PSNR to 2 decimals).
+# Training curve: every row "| step | seconds | PSNR |" between <!-- train-curve:begin LOG.jsonl -->
+# and <!-- train-curve:end --> must be a line of that committed training log (seconds to 0 and
+# PSNR to 2 decimals).
 # Usage: readme_numbers_test.sh [ICEF]
 set -euo pipefail
 root="$(cd "$(dirname "$0")/../.." && pwd)"
@@ -70,9 +71,14 @@ print(f"readme_numbers_test: {checked} numbers of the README's bench summary mat
 PY
 
 # The README's training curve.
-log="$root/docs/results/train_k5_128_icef.jsonl"
+log_rel=$(sed -nE 's/.*<!-- train-curve:begin ([^ ]+) -->.*/\1/p' "$readme" | head -n 1)
+if [ -z "$log_rel" ] || [ ! -f "$root/$log_rel" ]; then
+  echo "readme_numbers_test: README.md has no '<!-- train-curve:begin LOG.jsonl -->' naming a committed log ('$log_rel')" >&2
+  exit 1
+fi
+log="$root/$log_rel"
 missing=0
-rows=$(sed -n '/<!-- train-curve:begin -->/,/<!-- train-curve:end -->/p' "$readme" | grep -E '^ *\| [0-9]+ \|' || true)
+rows=$(sed -n '/<!-- train-curve:begin /,/<!-- train-curve:end -->/p' "$readme" | grep -E '^ *\| [0-9]+ \|' || true)
 if [ -z "$rows" ]; then
   echo "readme_numbers_test: README.md has no train-curve rows" >&2
   missing=1
