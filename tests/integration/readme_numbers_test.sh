@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
 # The README's benchmark summary quotes numbers; none may be typed by hand.
 #
-# Bench: the section between <!-- bench-results:begin REPORT --> and <!-- bench-results:end -->
+# Benches: each section between <!-- bench-results:begin REPORT --> and <!-- bench-results:end -->
 # names the report.json it summarises. Its tables have columns K, tier, method and then metric
-# keys of report.json (psnr, expr_gain, id_distance_gt, ...); every cell "mean" or "mean ± std" must
-# equal that (K, method, tier) cell of the report's aggregate, rounded to the decimals shown. A
-# decimal number anywhere else in the section is an error: numbers live in checked tables.
+# keys of report.json (psnr, expr_gain, id_distance_gt, ...), or K, method and then keys of the
+# report's training-view fit (face_psnr, face_psnr_min, psnr); every cell "mean", "mean ± std",
+# "mean [min, max]" or "mean ± std [min, max]" must equal that cell of the report's aggregate
+# (train_fit), rounded to the decimals shown. A decimal number anywhere else in a section is an
+# error: numbers live in checked tables.
 # Training curve: every row "| step | seconds | PSNR |" between <!-- train-curve:begin LOG.jsonl -->
 # and <!-- train-curve:end --> must be a line of that committed training log (seconds to 0 and
 # PSNR to 2 decimals).
@@ -17,57 +19,65 @@ readme="$root/README.md"
 python3 - "$root" "$readme" <<'PY'
 import json, re, sys
 root, readme = sys.argv[1], open(sys.argv[2]).read()
-m = re.search(r"<!-- bench-results:begin (\S+) -->(.*?)<!-- bench-results:end -->", readme, re.S)
-if not m:
+sections = re.findall(r"<!-- bench-results:begin (\S+) -->(.*?)<!-- bench-results:end -->", readme, re.S)
+if not sections:
     sys.exit("readme_numbers_test: README.md has no '<!-- bench-results:begin REPORT.json -->' section")
-report_path, section = m.group(1), m.group(2)
-report = json.load(open(f"{root}/{report_path}"))
-if report_path.replace("report.json", "report.md") not in section:
-    sys.exit(f"readme_numbers_test: the section does not link {report_path.replace('report.json', 'report.md')}")
-cells = {(c["k"], c["method"], c["tier"]): c for c in report["aggregate"]}
+NUM = r"[-+]?\d+(?:\.\d+)?"
+CELL = re.compile(rf"^({NUM})(?:\s*±\s*({NUM}))?(?:\s*\[({NUM}),\s*({NUM})\])?$")
 
 def decimals(text):
     return len(text.split(".")[1]) if "." in text else 0
 
-errors, checked, header = [], 0, None
-outside = []
-for line in section.splitlines():
-    s = line.strip()
-    if not s.startswith("|"):
-        outside.append(line)
-        continue
-    cols = [c.strip() for c in s.strip("|").split("|")]
-    if cols[:3] == ["K", "tier", "method"]:
-        header = cols
-        continue
-    if header is None or set(s) <= set("|-: "):
-        continue
-    k, tier, method = int(cols[0]), cols[1], cols[2].strip("`")
-    cell = cells.get((k, method, tier))
-    if cell is None:
-        errors.append(f"row K={k} {tier} {method}: no such cell in {report_path}")
-        continue
-    for key, text in zip(header[3:], cols[3:]):
-        spread = cell.get(key)
-        nums = re.findall(r"[-+]?\d+\.\d+|[-+]?\d+", text)
-        if spread is None or not nums:
-            errors.append(f"row K={k} {tier} {method}: {key} '{text}' has no value in the report")
+errors = []
+for report_path, section in sections:
+    report = json.load(open(f"{root}/{report_path}"))
+    if report_path.replace("report.json", "report.md") not in section:
+        errors.append(f"the section of {report_path} does not link {report_path.replace('report.json', 'report.md')}")
+    tiers = {(c["k"], c["method"], c["tier"]): c for c in report["aggregate"]}
+    fits = {(c["k"], c["method"]): c for c in report.get("train_fit", [])}
+    checked, header, keyed, errors_before = 0, None, 0, len(errors)
+    outside = []
+    for line in section.splitlines():
+        s = line.strip()
+        if not s.startswith("|"):
+            outside.append(line)
             continue
-        for value, name in zip(nums, ["mean", "std"]):
-            want = f"{spread[name]:.{decimals(value)}f}"
-            if float(value) != float(want):
-                errors.append(f"row K={k} {tier} {method}: {key} {name} is {value} in the README, {want} in the report")
-            checked += 1
-for line in outside:
-    for n in re.findall(r"\d+\.\d+", line):
-        errors.append(f"a number outside the checked tables: {n} in '{line.strip()}'")
+        cols = [c.strip() for c in s.strip("|").split("|")]
+        if cols[:3] == ["K", "tier", "method"] or cols[:2] == ["K", "method"]:
+            header, keyed = cols, 3 if cols[1] == "tier" else 2
+            continue
+        if header is None or set(s) <= set("|-: "):
+            continue
+        k, method = int(cols[0]), cols[keyed - 1].strip("`")
+        name = f"K={k} {cols[1] + ' ' if keyed == 3 else ''}{method}"
+        cell = tiers.get((k, method, cols[1])) if keyed == 3 else fits.get((k, method))
+        if cell is None:
+            errors.append(f"{report_path}: row {name}: no such cell")
+            continue
+        for key, text in zip(header[keyed:], cols[keyed:]):
+            spread = cell.get(key)
+            m = CELL.match(text)
+            if spread is None or not m:
+                errors.append(f"{report_path}: row {name}: {key} '{text}' has no value in the report")
+                continue
+            for value, stat in zip(m.groups(), ["mean", "std", "min", "max"]):
+                if value is None:
+                    continue
+                want = f"{spread[stat]:.{decimals(value)}f}"
+                if float(value) != float(want):
+                    errors.append(f"{report_path}: row {name}: {key} {stat} is {value} in the README, {want} in the report")
+                checked += 1
+    for line in outside:
+        for n in re.findall(r"\d+\.\d+", line):
+            errors.append(f"{report_path}: a number outside the checked tables: {n} in '{line.strip()}'")
+    if checked < 10:
+        errors.append(f"only {checked} numbers checked against {report_path}: is the table there?")
+    elif len(errors) == errors_before:
+        print(f"readme_numbers_test: {checked} numbers of the README match {report_path} cell by cell")
 for e in errors:
     print("readme_numbers_test:", e, file=sys.stderr)
 if errors:
     sys.exit(1)
-if checked < 10:
-    sys.exit(f"readme_numbers_test: only {checked} numbers checked: is the table there?")
-print(f"readme_numbers_test: {checked} numbers of the README's bench summary match {report_path} cell by cell")
 PY
 
 # The README's training curve.
