@@ -431,6 +431,7 @@ Status MergeBench(const std::vector<fs::path>& inputs, const fs::path& out_dir, 
   }
   ICEF_ASSIGN_OR_RETURN(const std::vector<RunRecord> records, ReadRunRecords(out_dir));
   ReportContext context;
+  for (const auto& [name, entry] : merged) context.run_dirs[name] = entry.second.parent_path();
   if (settings) {
     for (const auto& [key, values] : union_parts.items()) (*settings)[key] = values;
     context.settings = *settings;
@@ -444,7 +445,10 @@ Status MergeBench(const std::vector<fs::path>& inputs, const fs::path& out_dir, 
     const synth::SynthOptions defaults;
     context.tier_thresholds = std::array<double, 2>{defaults.near_threshold, defaults.far_threshold};
   }
-  context.notes.push_back("Merged from " + std::to_string(inputs.size()) + " bench directories (renders stay there).");
+  context.notes.push_back(
+      "Merged from " + std::to_string(inputs.size()) +
+      " bench directories (renders stay there; the worst identities' training views are drawn "
+      "from them).");
   ICEF_RETURN_IF_ERROR(WriteReport(out_dir, records, context));
   log << "bench merge: " << records.size() << " runs; report: " << (out_dir / "report.md").string()
       << " (LaTeX tables: report.tex)\n";

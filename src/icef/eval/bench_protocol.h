@@ -114,8 +114,9 @@ Status RunBench(const BenchOptions& options, std::ostream& log, bool interactive
 
 // Builds one report in out_dir from the runs/ of several bench (shard) directories: each run's
 // metrics.json is copied to out_dir/runs/<name>/; of a run present in several inputs the first is
-// kept (with a warning on `log` when their metrics differ). Inputs with different bench settings
-// (bench.json, shard aside) are an error.
+// kept (with a warning on `log` when their metrics differ). Renders stay in the inputs; a validation
+// bench's worst identities' training-view sheets are drawn from there. Inputs with different bench
+// settings (bench.json, shard aside) are an error.
 Status MergeBench(const std::vector<std::filesystem::path>& inputs, const std::filesystem::path& out_dir,
                   std::ostream& log);
 

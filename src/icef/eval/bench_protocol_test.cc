@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "icef/io/atomic_file.h"
+#include "icef/io/image.h"
 
 namespace icef::eval {
 namespace {
@@ -207,6 +208,47 @@ TEST(BenchProtocolTest, MergesShardDirectories) {
   ASSERT_FALSE(differ.ok());
   EXPECT_NE(differ.message().find("settings differ"), std::string::npos) << differ.message();
   EXPECT_FALSE(MergeBench({dir / "missing"}, dir / "merged3", log).ok());
+  fs::remove_all(dir);
+}
+
+TEST(BenchProtocolTest, MergedValidationBenchDrawsTheWorstRunsTrainingViewsFromItsShard) {
+  // Two validation shards; the worst run by training-view fit (id102_k5_icef, in shard b) has its
+  // training-view pairs there. The merged report draws its sheet from shard b and links it.
+  const fs::path dir = TempDir("merge_sheet");
+  auto write_run = [&](const fs::path& bench, const RunId& id, double face_psnr) {
+    RunRecord r;
+    r.id = id;
+    r.metrics.method = id.method;
+    FrameMetrics f;
+    f.file_path = "f.png";
+    f.tier = Tier::kObserved;
+    f.psnr = face_psnr - 2;
+    r.metrics.frames = {f};
+    r.metrics.tiers = AggregateTiers(r.metrics.frames);
+    r.metrics.train_fit =
+        TrainingFit::Of({TrainFrameFit{"images/train_000.png", face_psnr, 300, 0.9, face_psnr, ""}});
+    fs::create_directories(bench / "runs" / id.Name());
+    ASSERT_TRUE(
+        WriteFileAtomic(bench / "runs" / id.Name() / "metrics.json", FormatJson(RunRecordJson(r))).ok());
+    ASSERT_TRUE(WriteFileAtomic(bench / "bench.json", R"({"validation": true, "steps": 10})").ok());
+  };
+  write_run(dir / "a", RunId{101, 5, "icef"}, 35);
+  write_run(dir / "b", RunId{102, 5, "icef"}, 30);
+  const fs::path renders = dir / "b" / "runs" / "id102_k5_icef" / "renders";
+  fs::create_directories(renders);
+  ASSERT_TRUE(WritePng(renders / "fit_train_000_vs_truth.png", Image(4, 2, 3, 0.5f)).ok());
+  ASSERT_TRUE(WritePng(renders / "fit_train_001_vs_truth.png", Image(4, 2, 3, 0.25f)).ok());
+  std::ostringstream log;
+  ASSERT_TRUE(MergeBench({dir / "a", dir / "b"}, dir / "merged", log).ok()) << log.str();
+  const Result<Image> sheet = ReadImage(dir / "merged" / "worst_id102_k5_icef_training_views.png");
+  ASSERT_TRUE(sheet.ok()) << sheet.status().message();
+  EXPECT_EQ(sheet->height, 4);
+  EXPECT_FALSE(fs::exists(dir / "merged" / "runs" / "id102_k5_icef" / "renders"));  // the renders stay in b
+  const Result<std::string> md = ReadFile(dir / "merged" / "report.md");
+  ASSERT_TRUE(md.ok());
+  EXPECT_NE(md->find("[worst_id102_k5_icef_training_views.png](worst_id102_k5_icef_training_views.png)"),
+            std::string::npos)
+      << *md;
   fs::remove_all(dir);
 }
 

@@ -1043,7 +1043,10 @@ Status WriteReport(const fs::path& dir, const std::vector<RunRecord>& runs, Repo
     for (const std::optional<WorstIdentity>& w : WorstIdentities(IdentityRows(pooled))) {
       if (!w) continue;
       const std::string run = w->worst_run->id.Name();
-      ICEF_ASSIGN_OR_RETURN(const std::optional<std::string> sheet, WriteTrainingViewSheet(dir, run));
+      const auto source = context.run_dirs.find(run);
+      ICEF_ASSIGN_OR_RETURN(
+          const std::optional<std::string> sheet,
+          WriteTrainingViewSheet(dir, run, source == context.run_dirs.end() ? fs::path() : source->second));
       if (sheet) context.run_sheets[run] = *sheet;
     }
   }

@@ -189,6 +189,9 @@ struct ReportContext {
   // Run name -> a picture of its training views beside their truth, relative to the report's
   // directory (WriteReport makes one for each worst identity's lowest run; eval/training_view_sheet.h).
   std::map<std::string, std::string> run_sheets;
+  // Where a run's directory (with its renders/) is when it is not DIR/runs/<name>: a merged bench's
+  // runs stay in the directories that ran them (run name -> that directory's runs/<name>).
+  std::map<std::string, std::filesystem::path> run_dirs;
 };
 
 // The verdict lines (markdown bullets): per novel tier, icef against the baselines (warp, nerface)

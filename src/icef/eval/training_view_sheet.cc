@@ -31,8 +31,10 @@ std::vector<fs::path> TrainingViewPairs(const fs::path& renders) {
 
 }  // namespace
 
-Result<std::optional<std::string>> WriteTrainingViewSheet(const fs::path& dir, const std::string& run) {
-  const std::vector<fs::path> pairs = TrainingViewPairs(dir / "runs" / run / "renders");
+Result<std::optional<std::string>> WriteTrainingViewSheet(const fs::path& dir, const std::string& run,
+                                                          const fs::path& run_dir) {
+  const std::vector<fs::path> pairs =
+      TrainingViewPairs((run_dir.empty() ? dir / "runs" / run : run_dir) / "renders");
   if (pairs.empty()) return std::optional<std::string>();
   std::vector<Image> rows;
   int width = 0, height = 0;
