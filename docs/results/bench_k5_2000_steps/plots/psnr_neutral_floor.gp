@@ -1,0 +1,35 @@
+# gnuplot psnr_neutral_floor.gp (run in this directory) draws psnr_neutral_floor.png, psnr_neutral_floor.svg and psnr_neutral_floor.pdf
+set terminal pngcairo noenhanced size 460,480 font "sans,9"
+set output "psnr_neutral_floor.png"
+set multiplot layout 1,1 title "psnr_neutral_floor against delta (mean +- std over 3 identities)"
+set xlabel "delta (distance to the nearest training expression)"
+set ylabel "PSNR of the ground-truth neutral, dB (a face that does not move)"
+set grid
+set key below horizontal box
+set offsets 0.05, 0.05, 0, 0
+set title "K = 5"
+plot 'psnr_neutral_floor.dat' index 0 using 1:2:3 with yerrorlines lw 2 pt 7 title "icef-prior"
+unset multiplot
+set terminal svg noenhanced size 460,480 font "sans,9"
+set output "psnr_neutral_floor.svg"
+set multiplot layout 1,1 title "psnr_neutral_floor against delta (mean +- std over 3 identities)"
+set xlabel "delta (distance to the nearest training expression)"
+set ylabel "PSNR of the ground-truth neutral, dB (a face that does not move)"
+set grid
+set key below horizontal box
+set offsets 0.05, 0.05, 0, 0
+set title "K = 5"
+plot 'psnr_neutral_floor.dat' index 0 using 1:2:3 with yerrorlines lw 2 pt 7 title "icef-prior"
+unset multiplot
+set terminal pdfcairo noenhanced size 3.07in,3.20in font "sans,7"
+set output "psnr_neutral_floor.pdf"
+set multiplot layout 1,1 title "psnr_neutral_floor against delta (mean +- std over 3 identities)"
+set xlabel "delta (distance to the nearest training expression)"
+set ylabel "PSNR of the ground-truth neutral, dB (a face that does not move)"
+set grid
+set key below horizontal box
+set offsets 0.05, 0.05, 0, 0
+set title "K = 5"
+plot 'psnr_neutral_floor.dat' index 0 using 1:2:3 with yerrorlines lw 2 pt 7 title "icef-prior"
+unset multiplot
+unset output
