@@ -10,6 +10,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libceres-dev  # the face-model fit (Ceres)
   libopencv-imgproc-dev libexif-dev  # icef track: GrabCut masks, crops (OpenCV); EXIF focal lengths
+  libavformat-dev libavcodec-dev libswscale-dev libavutil-dev  # icef track: video input; icef render --video
   python3-numpy python3-pil  # scripts/track_eval.py (tracking against synthetic truth; integration.track_test)
   libdlib-dev libdlib-data opencv-doc python3-skimage python-matplotlib-data  # eval: face alignment, test photos
   gnuplot-nox  # bench: report plots (PNG, SVG and PDF)

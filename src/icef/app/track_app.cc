@@ -6,8 +6,10 @@
 
 #include "icef/app/face_outline.h"
 #include "icef/core/parallel.h"
+#include "icef/core/progress.h"
 #include "icef/face/expression.h"
 #include "icef/landmarks/face_landmark_detector.h"
+#include "icef/video/video_reader.h"
 
 namespace icef {
 
@@ -167,20 +169,57 @@ Status RunRetrack(const TrackAppOptions& options, std::ostream& out) {
 
 }  // namespace
 
+Result<std::vector<track::TrackInput>> LoadTrackInputs(const TrackAppOptions& options, std::ostream& out) {
+  std::vector<track::TrackInput> inputs;
+  const bool any_video = std::any_of(options.photos.begin(), options.photos.end(),
+                                     [](const std::filesystem::path& p) { return LooksLikeVideo(p); });
+  if (!any_video) {
+    if (options.every > 0 || options.max_frames > 0)
+      return Status::Error("icef track: --every and --max-frames are for a video");
+    ICEF_ASSIGN_OR_RETURN(const std::vector<std::filesystem::path> photos, track::ExpandPhotoArguments(options.photos));
+    out << "icef track: " << photos.size() << " photo" << (photos.size() == 1 ? "" : "s") << "\n";
+    for (const auto& p : photos) inputs.push_back(track::TrackInput{p, p.string(), std::nullopt, std::nullopt});
+    return inputs;
+  }
+  if (options.photos.size() != 1) return Status::Error("icef track: give one video, or photos, not both");
+  const std::filesystem::path& video = options.photos[0];
+  ICEF_ASSIGN_OR_RETURN(const VideoInfo info, ProbeVideo(video));
+  VideoReadOptions ro;
+  ro.every = options.every;
+  ro.max_frames = options.max_frames > 0 ? options.max_frames : options.every > 0 ? 0 : kDefaultVideoFrames;
+  ICEF_RETURN_IF_ERROR(ro.Validate().WithContext("icef track"));
+  char head[160];
+  std::snprintf(head, sizeof head, "icef track: %s, %dx%d, %.1f s at %.2f fps (%s)", video.string().c_str(), info.width,
+                info.height, info.duration_s, info.fps, info.codec.c_str());
+  out << head << "\n";
+  ProgressBar bar("decode", std::max<int64_t>(info.frame_count_estimate, 1), out, options.interactive);
+  ICEF_ASSIGN_OR_RETURN(std::vector<VideoFrame> frames,
+                        ReadVideoFrames(video, ro, [&](int64_t decoded, int64_t) { bar.Update(decoded); }));
+  bar.Finish(std::to_string(frames.size()) + " frames kept");
+  for (VideoFrame& f : frames) {
+    char name[256];
+    std::snprintf(name, sizeof name, "%s@%.2fs", video.filename().string().c_str(), f.time_s);
+    inputs.push_back(track::TrackInput{video, name, std::move(f.image), f.time_s});
+  }
+  return inputs;
+}
+
 Status RunTrack(const TrackAppOptions& options, std::ostream& out) {
   if (options.keep_cameras) return RunRetrack(options, out);
-  ICEF_ASSIGN_OR_RETURN(const std::vector<std::filesystem::path> photos, track::ExpandPhotoArguments(options.photos));
+  ICEF_ASSIGN_OR_RETURN(std::vector<track::TrackInput> inputs, LoadTrackInputs(options, out));
   ICEF_ASSIGN_OR_RETURN(const FaceLandmarkDetector detector, FaceLandmarkDetector::Load(options.predictor));
-  out << "icef track: " << photos.size() << " photo" << (photos.size() == 1 ? "" : "s") << "\n";
+  // A video's frames without exactly one face (turned away, blurred, cut) are skipped, saying so.
+  track::TrackOptions track_options = options.track;
+  if (!inputs.empty() && inputs[0].time_s) track_options.skip_bad = true;
   ICEF_ASSIGN_OR_RETURN(track::TrackResult result,
-                        track::TrackPhotos(photos, options.track, detector, Executor(options.threads),
+                        track::TrackInputs(std::move(inputs), track_options, detector, Executor(options.threads),
                                            [&](const std::string& line) { out << line << "\n"; }));
   std::vector<std::pair<std::string, Image>> overlays;
   for (size_t i = 0; i < result.photos.size(); ++i) {
     const track::TrackedPhoto& p = result.photos[i];
     const track::TrackedFrame& f = result.fit.frames[i];
     const Vec3d ypr = f.YawPitchRollDeg();
-    out << std::fixed << std::setprecision(3) << "  " << p.source.filename().string() << " -> "
+    out << std::fixed << std::setprecision(3) << "  " << p.name << " -> "
         << (p.test ? "test" : "train") << "[" << p.frame_index << "]: landmark RMS " << f.rms_iod << " IOD, yaw "
         << std::setprecision(1) << ypr.x() << " pitch " << ypr.y() << " roll " << ypr.z() << ", focal "
         << p.photo_intrinsics.fl_x << " px (" << track::FocalSourceName(p.focal_source) << "), "
@@ -189,7 +228,7 @@ Status RunTrack(const TrackAppOptions& options, std::ostream& out) {
     char name[64];
     std::snprintf(name, sizeof(name), "track/overlay_%03zu.png", i);
     if (f.rms_iod > 0.05)
-      out << "  warning: " << p.source.string() << ": the face model fits its landmarks poorly (RMS " << f.rms_iod
+      out << "  warning: " << p.name << ": the face model fits its landmarks poorly (RMS " << f.rms_iod
           << " IOD > 0.05); check " << name << "\n";
     overlays.emplace_back(name, TrackOverlay(result, static_cast<int>(i)));
   }

@@ -27,7 +27,18 @@ struct TrackAppOptions {
   bool keep_cameras = false;
   track::RetrackLandmarks landmarks = track::RetrackLandmarks::kDetect;  // with keep_cameras
   bool fit_style = true;  // with keep_cameras and landmarks kDatasetModel (RetrackOptions::fit_style)
+  // A video (photos is one video file): which decoded frames are tracked (video/video_reader.h);
+  // without either, kDefaultVideoFrames spread over the whole video.
+  int every = 0;
+  int max_frames = 0;
+  bool interactive = false;  // redraw the decoding progress bar in place
 };
+
+// Frames tracked from a video when neither --every nor --max-frames is given.
+inline constexpr int kDefaultVideoFrames = 24;
+
+// The inputs of `icef track`: photo files (directories expanded), or the sampled frames of one video.
+Result<std::vector<track::TrackInput>> LoadTrackInputs(const TrackAppOptions& options, std::ostream& out);
 
 // The overlay of one tracked photo (see above), 384 pixels high.
 Image TrackOverlay(const track::TrackResult& result, int photo_index);

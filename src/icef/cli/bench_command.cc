@@ -1,6 +1,7 @@
 // icef bench --out DIR [--identities N] [--k 3,5,10] [--methods a,b] [--res R] [--steps S |
 //   --time-budget T] [--quick] [--validation] [--shard i/n] [--threads N] [--set section.key=value ...]
 // icef bench merge DIR... --out DIR   (or icef bench --merge DIR... --out DIR)
+// icef bench --real SOURCE... --out DIR [--k 3,5,10] [--methods a,b] [--test N] [--video-frames N] [--res R]
 // app/bench_app.h (merge: eval::MergeBench).
 #include <filesystem>
 #include <iostream>
@@ -9,6 +10,7 @@
 #include <vector>
 
 #include "icef/app/bench_app.h"
+#include "icef/app/real_bench_app.h"
 #include "icef/cli/commands.h"
 #include "icef/core/progress.h"
 #include "icef/eval/bench_protocol.h"
@@ -22,6 +24,9 @@ CommandFn RegisterBench(CLI::App& app) {
     std::vector<std::string> merge;
     std::vector<std::string> merge_inputs;
     std::string merge_out;
+    std::vector<std::filesystem::path> real;
+    int real_test = RealBenchOptions().test_frames;
+    int video_frames = RealBenchOptions().video_frames;
   };
   auto args = std::make_shared<Args>();
   eval::BenchOptions& o = args->options;
@@ -60,6 +65,16 @@ CommandFn RegisterBench(CLI::App& app) {
   app.add_option("--faceid-model", o.faceid_model_dir, "Face-identity model directory");
   app.add_option("--lpips-weights", o.lpips_weights, "LPIPS weights file (without it LPIPS is null)");
   app.add_flag("--keep-models", o.keep_models, "Keep each run's trained model under runs/<name>/model/");
+  app.add_option("--real", args->real,
+                 "Real media instead of synthetic identities: videos, photo folders or datasets from icef track. Each "
+                 "is tracked once; for each K the avatar trains on the K frames that cover pose and expression best "
+                 "and renders every held-out frame at its tracked camera and expression, scored against the real "
+                 "photo (face and head PSNR/SSIM, LPIPS, identity distance, real_expr_gain, tracking residual). "
+                 "Defaults: methods icef-prior,icef, 256 px, 1000 steps")
+      ->expected(1, -1);
+  app.add_option("--test", args->real_test, "With --real: held-out frames per source")->capture_default_str();
+  app.add_option("--video-frames", args->video_frames, "With --real: frames tracked per video, spread over it")
+      ->capture_default_str();
   app.add_option("--merge", args->merge, "Merge these bench directories into --out instead of running");
   CLI::App* merge = app.add_subcommand("merge", "Build one report from several bench directories (shards, or parts of the same bench over other identity seeds, methods or Ks)");
   merge->add_option("dirs", args->merge_inputs, "Bench directories")->required();
@@ -74,8 +89,33 @@ CommandFn RegisterBench(CLI::App& app) {
       if (out.empty()) return Status::Error("bench merge: --out is required");
       return eval::MergeBench(inputs, out, std::cout);
     }
-    BenchAppOptions options = args->app;
     const eval::BenchOptions& given = args->options;
+    if (!args->real.empty()) {
+      RealBenchOptions r;
+      r.sources = args->real;
+      r.out_dir = args->app.out;
+      if (args->app.quick) r.ApplyQuick();
+      if (!args->app.ks.empty()) {
+        ICEF_ASSIGN_OR_RETURN(r.ks, eval::ParseIntList(args->app.ks, "--k"));
+      }
+      if (!args->app.methods.empty()) r.methods = args->app.methods;
+      if (self->count("--test")) r.test_frames = args->real_test;
+      if (self->count("--video-frames")) r.video_frames = args->video_frames;
+      if (self->count("--res")) r.resolution = given.resolution;
+      if (self->count("--steps")) r.steps = given.steps;
+      if (self->count("--time-budget")) r.time_budget_seconds = given.time_budget_seconds;
+      r.config_path = given.config_path;
+      r.overrides.insert(r.overrides.end(), given.overrides.begin(), given.overrides.end());
+      r.threads = given.threads;
+      r.faceid_model_dir = given.faceid_model_dir;
+      r.lpips_weights = given.lpips_weights;
+      r.keep_models = given.keep_models;
+      r.interactive = interactive;
+      return RunRealBench(r, std::cout);
+    }
+    if (self->count("--test") || self->count("--video-frames"))
+      return Status::Error("--test and --video-frames go with --real (synthetic benches: --test-views)");
+    BenchAppOptions options = args->app;
     options.base = given;
     if (self->count("--identities")) options.identities = given.identities;
     if (self->count("--first-seed")) options.first_seed = given.first_identity_seed;

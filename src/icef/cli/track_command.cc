@@ -1,4 +1,5 @@
 // icef track PHOTOS... --out DATASET [--res N] [--focal PX] [--test N] [--skip-bad] [--threads N]
+// icef track VIDEO --frames K --test N --out DATASET [--every N | --max-frames N]
 // icef track DATASET --keep-cameras --out NEW
 // From a handful of photos of one person to a dataset (DESIGN.md §8): app/track_app.h does the work.
 #include <iostream>
@@ -11,6 +12,7 @@
 #include "icef/app/track_app.h"
 #include "icef/cli/commands.h"
 #include "icef/cli/validators.h"
+#include "icef/core/progress.h"
 #include "icef/landmarks/face_landmark_detector.h"
 
 namespace icef::cli {
@@ -19,7 +21,7 @@ CommandFn RegisterTrack(CLI::App& app) {
   auto options = std::make_shared<TrackAppOptions>();
   auto focal = std::make_shared<double>(0);
   app.description(
-      "Turn photos of one person into a dataset: detects the face and its 68 landmarks in each photo (exactly one "
+      "Turn photos or a video of one person into a dataset: detects the face and its 68 landmarks in each photo (exactly one "
       "face per photo), fits the face model to all photos at once (shared identity; per photo a head pose and "
       "expression weights), crops a square around the head, masks the head (GrabCut seeded by the fitted head, "
       "with what MediaPipe's selfie segmentation calls background as sure background), "
@@ -30,15 +32,31 @@ CommandFn RegisterTrack(CLI::App& app) {
       "With --keep-cameras, re-express an existing dataset (NerFace, instant-ngp, any expression space) in the face "
       "model's expressions: same cameras and images, the face model fitted to every frame's landmarks, with "
       "track/overlay_<split>_NNN.png to check the fit (every frame; at most 100, spread over a longer sequence).");
-  app.add_option("photos", options->photos, "Photos (PNG/JPEG) or directories of photos");
+  app.add_option("photos", options->photos,
+                 "Photos (PNG/JPEG) or directories of photos, or one video (.mp4, .mov, .mkv, .avi, .webm, .m4v)");
   app.add_option("--out", options->out, "Dataset directory to create (must not exist, or be empty)");
   app.add_option("--res", options->track.resolution, "Side of the square dataset images in pixels (default 256)");
   app.add_option("--focal", *focal,
                  "Focal length in pixels of the photos (default: the EXIF 35 mm-equivalent focal length, else a "
                  "35 mm-equivalent lens: 0.81 x the photo's diagonal)");
-  app.add_option("--test", options->track.num_test, "Hold out the last N photos as test frames (default 0)");
+  app.add_option("--test", options->track.num_test,
+                 "Hold out N test frames: the last N photos; with --frames, N of the frames not chosen for training, "
+                 "spread evenly in time order (default: 0; with --frames, all of them)")
+      ->check(kNonNegative);
+  app.add_option("--frames", options->track.num_train,
+                 "Choose N training frames for coverage of head pose and expression (the most frontal, neutral one "
+                 "first, then each time the frame farthest from those chosen; no blinks unless --allow-blink, no "
+                 "frame much blurrier than the median) instead of taking all photos but the --test ones")
+      ->check(kNonNegative);
+  app.add_flag("--allow-blink", options->track.allow_blink, "With --frames: a frame with an eye closed may be chosen");
+  app.add_option("--every", options->every, "A video: track every N-th decoded frame")->check(kPositive);
+  app.add_option("--max-frames", options->max_frames,
+                 "A video: track at most N frames, spread evenly over the whole video (default " +
+                     std::to_string(kDefaultVideoFrames) + " when --every is not given)")
+      ->check(kPositive);
   app.add_flag("--skip-bad", options->track.skip_bad,
-               "Skip photos without exactly one face (default: stop, naming the photo, and write nothing)");
+               "Skip photos without exactly one face (default: stop, naming the photo, and write nothing; a video's "
+               "frames are always skipped so)");
   auto segmentation = std::make_shared<std::string>("selfie");
   app.add_option("--segmentation", *segmentation,
                  "The dataset's alpha mask: selfie (GrabCut seeded by the fitted head, with what MediaPipe's selfie "
@@ -144,6 +162,7 @@ CommandFn RegisterTrack(CLI::App& app) {
     if (options->photos.empty()) return Status::Error("icef track: give the photos (or a dataset with --keep-cameras)");
     if (options->out.empty()) return Status::Error("icef track: --out DATASET is required");
     if (app.count("--focal")) options->track.focal = *focal;
+    options->interactive = StdoutIsTerminal();
     return RunTrack(*options, std::cout);
   };
 }

@@ -94,6 +94,14 @@ Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions
     ICEF_ASSIGN_OR_RETURN(const LandmarkDetectionReport report, DetectDatasetLandmarks(source, lo, executor));
     for (const FrameLandmarks& fl : report.frames) {
       Frame& f = (*Split(d, fl.split))[fl.index];
+      if (fl.outcome != LandmarkOutcome::kDetected && f.landmarks_2d) {
+        // The detector found no face (small frames at a three-quarter view): the dataset's own
+        // landmarks stand in, in their own convention.
+        const std::string name = FrameName(fl.split, fl.index, f);
+        result.fallbacks.push_back(name);
+        if (log) log(name + ": no face found; fitting the dataset's own landmarks_2d instead");
+        continue;
+      }
       f.landmarks_2d.reset();
       f.landmarks_2d_visible.reset();
       if (fl.outcome == LandmarkOutcome::kDetected) f.landmarks_2d = fl.detection.landmarks;

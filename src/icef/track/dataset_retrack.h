@@ -114,6 +114,8 @@ struct RetrackOptions {
 struct RetrackResult {
   Dataset dataset;                   // the source dataset re-expressed (root: the source's)
   std::vector<std::string> skipped;  // "train[3] images/...: no face found"
+  // Frames where the detector found no face and the dataset's own landmarks_2d were fitted instead.
+  std::vector<std::string> fallbacks;
   std::vector<std::string> frame_names;  // per fitted frame, in fit order: "train[0] images/..."
   int outlined_frames = 0;           // frames that added their outlines
   double photometric_weight = 0;     // the refit's weight as used (0: off)

@@ -17,6 +17,41 @@ namespace {
 
 namespace fs = std::filesystem;
 
+TEST(DatasetRetrackTest, FallsBackToTheDatasetsLandmarksWhereNoFaceIsFound) {
+  if (!fs::exists(kDefaultShapePredictorPath)) GTEST_SKIP() << kDefaultShapePredictorPath << " not installed";
+  const fs::path dir = fs::temp_directory_path() / ("icef_retrack_fallback_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  synth::SynthOptions so;
+  so.out_dir = dir / "src";
+  so.identity_seed = 5;
+  so.num_train = 3;
+  so.resolution = 192;
+  so.test_views = 1;
+  so.novel_per_tier = 1;
+  so.render.supersample = 1;
+  ASSERT_TRUE(synth::SynthesizeDataset(so, Executor(2)).ok());
+  Result<Dataset> source = LoadDataset(so.out_dir);
+  ASSERT_TRUE(source.ok()) << source.status().message();
+  ASSERT_TRUE(source->train[1].landmarks_2d.has_value());
+  // No face for the detector in training frame 1: a flat grey image.
+  ASSERT_TRUE(WritePng(so.out_dir / source->train[1].file_path, Image(192, 192, 3, 0.5f)).ok());
+  RetrackOptions o;
+  o.fit.photometric_weight = 0;
+  o.silhouette_points = 0;
+  std::vector<std::string> lines;
+  const Result<RetrackResult> r =
+      RetrackDataset(*source, o, Executor(2), [&](const std::string& line) { lines.push_back(line); });
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  ASSERT_EQ(r->fallbacks.size(), 1u);
+  EXPECT_NE(r->fallbacks[0].find("train[1]"), std::string::npos) << r->fallbacks[0];
+  EXPECT_TRUE(std::any_of(lines.begin(), lines.end(), [](const std::string& l) {
+    return l.find("no face found; fitting the dataset's own landmarks_2d") != std::string::npos;
+  }));
+  EXPECT_EQ(r->dataset.train.size(), 3u);
+  EXPECT_EQ(*r->dataset.train[1].landmarks_2d, *source->train[1].landmarks_2d);
+  fs::remove_all(dir);
+}
+
 TEST(DatasetRetrackTest, SyntheticDatasetKeepsItsCamerasAndGetsItsExpressionsBack) {
   if (!fs::exists(kDefaultShapePredictorPath)) GTEST_SKIP() << kDefaultShapePredictorPath << " not installed";
   const fs::path dir = fs::temp_directory_path() / ("icef_retrack_test_" + std::to_string(::getpid()));

@@ -16,13 +16,15 @@ Status HeadMaskOptions::Validate() const {
   if (!(band > 0 && band < 1)) return Status::Error("band must be in (0, 1)");
   if (iterations < 1) return Status::Error("iterations must be >= 1");
   if (!(person_background >= 0 && person_background < 1)) return Status::Error("person_background must be in [0, 1)");
+  if (!(person_foreground > person_background && person_foreground <= 1))
+    return Status::Error("person_foreground must be in (person_background, 1]");
   return Status::Ok();
 }
 
 std::string HeadMaskOptions::ToString() const {
   std::ostringstream os;
   os << "HeadMaskOptions(sure_inside=" << sure_inside << ", band=" << band << ", iterations=" << iterations
-     << ", person_background=" << person_background << ")";
+     << ", person_background=" << person_background << ", person_foreground=" << person_foreground << ")";
   return os.str();
 }
 
@@ -74,8 +76,12 @@ Image HeadMask(const Image& image, const Image& silhouette, const Image& outside
         label = cv::GC_BGD;
       } else if (inside.at<uint8_t>(y, x)) {
         label = cv::GC_PR_FGD;
+      } else if (dist_out.at<float>(y, x) < options.band * w) {
+        // Near the head: hair where the person segmentation sees the person (hair as dark as the
+        // background behind it is otherwise cut off flat along the skull), else probably background.
+        label = !person.empty() && person.At(x, y, 0) > options.person_foreground ? cv::GC_PR_FGD : cv::GC_PR_BGD;
       } else {
-        label = dist_out.at<float>(y, x) < options.band * w ? cv::GC_PR_BGD : cv::GC_BGD;
+        label = cv::GC_BGD;
       }
       fg += label == cv::GC_FGD || label == cv::GC_PR_FGD;
       bg += label == cv::GC_BGD || label == cv::GC_PR_BGD;

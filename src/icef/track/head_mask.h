@@ -4,7 +4,9 @@
 // GrabCut's colour models then move the boundary onto the image's own edges (hair beyond the
 // skull, the neck). Where a person segmentation is given (person_segmentation.h), what it calls
 // background with confidence is sure background too, unless deep inside the silhouette: GrabCut's
-// colour models alone keep background that resembles hair or skin (a door frame beside dark hair).
+// colour models alone keep background that resembles hair or skin (a door frame beside dark hair);
+// what it calls the person within the band around the silhouette is probable foreground (hair as
+// dark as the background behind it).
 // The largest connected component, holes filled, is the mask.
 #pragma once
 
@@ -24,6 +26,7 @@ struct HeadMaskOptions {
   double band = 0.12;          // outside pixels within this distance of the silhouette are probable background
   int iterations = 5;          // GrabCut iterations
   double person_background = 0.05;  // person probability below which a pixel outside the sure core is sure background
+  double person_foreground = 0.5;   // person probability above which a pixel in the band is probable foreground (hair)
 
   Status Validate() const;
   std::string ToString() const;

@@ -7,11 +7,15 @@
 #include <sstream>
 #include <system_error>
 
+#include "icef/data/frame_coverage.h"
 #include "icef/face/expression.h"
 #include "icef/face/face_model.h"
 #include "icef/face/shape_params.h"
 #include "icef/io/atomic_file.h"
 #include "icef/landmarks/face_mesh.h"
+#include "icef/track/dataset_retrack.h"
+
+#include <opencv2/imgproc.hpp>
 
 namespace icef::track {
 
@@ -45,32 +49,39 @@ struct Detected {
   Result<FaceDetection> detection = Status::Error("not run");
 };
 
-// Reads and detects every photo (in parallel, one detector per thread, each photo into its slot).
-// mesh: the face mesh's 68 landmarks (DetectFaceWithMesh) instead of dlib's.
-Result<std::vector<Detected>> DetectAll(const std::vector<fs::path>& photos, const FaceLandmarkDetector& detector,
+// Reads (where not decoded already) and detects every input (in parallel, one detector per thread,
+// each input into its slot). mesh: the face mesh's 68 landmarks (DetectFaceWithMesh) instead of dlib's.
+Result<std::vector<Detected>> DetectAll(std::vector<TrackInput>& inputs, const FaceLandmarkDetector& detector,
                                         const FaceMesh* mesh, const Executor& executor) {
-  std::vector<Detected> out(photos.size());
-  std::vector<Status> read_errors(photos.size());
-  ParallelFor(executor, static_cast<int64_t>(photos.size()), [&](int64_t begin, int64_t end, int) {
+  std::vector<Detected> out(inputs.size());
+  std::vector<Status> read_errors(inputs.size());
+  ParallelFor(executor, static_cast<int64_t>(inputs.size()), [&](int64_t begin, int64_t end, int) {
     const FaceLandmarkDetector local = detector.Clone();
     for (int64_t i = begin; i < end; ++i) {
-      Result<Image> image = ReadImage(photos[i]);
-      if (!image.ok()) {
-        read_errors[i] = image.status();
-        continue;
+      if (inputs[i].image) {
+        out[i].photo = std::move(*inputs[i].image);
+        inputs[i].image.reset();
+      } else {
+        Result<Image> image = ReadImage(inputs[i].source);
+        if (!image.ok()) {
+          read_errors[i] = image.status();
+          continue;
+        }
+        out[i].photo = Oriented(*image, ExifOrientation(inputs[i].source));
       }
-      const Image upright = Oriented(*image, ExifOrientation(photos[i]));
-      out[i].photo = upright.HasAlpha() ? CompositeOver(upright, Vec3f::Ones()) : upright;
+      if (out[i].photo.HasAlpha()) out[i].photo = CompositeOver(out[i].photo, Vec3f::Ones());
       out[i].detection = mesh ? DetectFaceWithMesh(local, *mesh, out[i].photo) : local.DetectFace(out[i].photo, /*averaged=*/true);
     }
   });
-  for (size_t i = 0; i < photos.size(); ++i)
+  for (size_t i = 0; i < inputs.size(); ++i)
     if (!read_errors[i].ok())
-      return Status::Error(photos[i].string() + ": cannot read the image: " + read_errors[i].message());
+      return Status::Error(inputs[i].source.string() + ": cannot read the image: " + read_errors[i].message());
   return out;
 }
 
-Intrinsics PhotoIntrinsics(const fs::path& path, const Image& photo, const TrackOptions& options, FocalSource* source) {
+// EXIF is read from photo files only (exif_path empty: a video frame).
+Intrinsics PhotoIntrinsics(const fs::path& exif_path, const Image& photo, const TrackOptions& options,
+                           FocalSource* source) {
   Intrinsics k;
   k.width = photo.width;
   k.height = photo.height;
@@ -79,7 +90,7 @@ Intrinsics PhotoIntrinsics(const fs::path& path, const Image& photo, const Track
   if (options.focal) {
     k.fl_x = *options.focal;
     *source = FocalSource::kFlag;
-  } else if (const auto exif = ExifFocalPixels(path, photo.width, photo.height)) {
+  } else if (const auto exif = exif_path.empty() ? std::nullopt : ExifFocalPixels(exif_path, photo.width, photo.height)) {
     k.fl_x = *exif;
     *source = FocalSource::kExif;
   } else {
@@ -159,7 +170,84 @@ void BuildFrame(const face::FaceModel& model, const TrackedFrame& tracked, const
   frame->landmarks_3d = std::vector<Vec3f>(tracked.landmarks_head.begin(), tracked.landmarks_head.end());
 }
 
+
+// Blinks: an eye-close weight above one half.
+bool IsBlink(const std::vector<float>& expression) {
+  return expression[face::kEyeCloseLeft] > 0.5f || expression[face::kEyeCloseRight] > 0.5f;
+}
+
+// Splits the tracked photos (TrackOptions::num_test, num_train): sets test and frame_index, and
+// drops the photos that are neither (with their fitted frames). Training frames keep input order.
+void AssignSplits(const TrackOptions& options, TrackResult* result) {
+  const int n = static_cast<int>(result->photos.size());
+  std::vector<int> role(n, 0);  // 0: left out, 1: train, 2: test
+  if (options.num_train <= 0) {
+    for (int i = 0; i < n; ++i) role[i] = i >= n - options.num_test ? 2 : 1;
+  } else {
+    std::vector<double> sharpness(n);
+    for (int i = 0; i < n; ++i) sharpness[i] = result->photos[i].sharpness;
+    std::vector<double> sorted = sharpness;
+    std::sort(sorted.begin(), sorted.end());
+    const double median = sorted[n / 2];
+    std::vector<CoverageCandidate> candidates(n);
+    for (int i = 0; i < n; ++i) {
+      const TrackedFrame& f = result->fit.frames[i];
+      const Mat4d head_from_cam = Inverse(f.cam_from_head);
+      candidates[i].view_direction = head_from_cam.block<3, 1>(0, 3).normalized();
+      candidates[i].expression = f.expression;
+      candidates[i].sharpness = median > 0 ? sharpness[i] / median : 1;
+      candidates[i].blink = IsBlink(f.expression);
+    }
+    CoverageOptions co;
+    co.allow_blink = options.allow_blink;
+    for (const int i : ChooseCoverageFrames(candidates, options.num_train, co)) role[i] = 1;
+    std::vector<int> rest;
+    for (int i = 0; i < n; ++i)
+      if (role[i] == 0) rest.push_back(i);
+    const int num_test = options.num_test > 0 ? options.num_test : static_cast<int>(rest.size());
+    for (const int r : SpreadFrames(static_cast<int>(rest.size()), num_test)) role[rest[r]] = 2;
+  }
+  std::vector<TrackedPhoto> photos;
+  std::vector<TrackedFrame> frames;
+  int num_train = 0, num_test = 0;
+  for (int i = 0; i < n; ++i) {
+    if (role[i] == 0) continue;
+    TrackedPhoto& p = result->photos[i];
+    p.test = role[i] == 2;
+    p.frame_index = p.test ? num_test++ : num_train++;
+    photos.push_back(std::move(p));
+    frames.push_back(std::move(result->fit.frames[i]));
+  }
+  result->photos = std::move(photos);
+  result->fit.frames = std::move(frames);
+}
+
 }  // namespace
+
+double FaceSharpness(const Image& photo, std::span<const Vec2f> landmarks) {
+  if (landmarks.empty()) return 0;
+  Vec2f lo = landmarks[0], hi = landmarks[0];
+  for (const Vec2f& p : landmarks) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  const int x0 = std::clamp(static_cast<int>(std::floor(lo.x())), 0, photo.width - 1);
+  const int y0 = std::clamp(static_cast<int>(std::floor(lo.y())), 0, photo.height - 1);
+  const int x1 = std::clamp(static_cast<int>(std::ceil(hi.x())), x0 + 1, photo.width);
+  const int y1 = std::clamp(static_cast<int>(std::ceil(hi.y())), y0 + 1, photo.height);
+  cv::Mat grey(y1 - y0, x1 - x0, CV_32F);
+  for (int y = y0; y < y1; ++y)
+    for (int x = x0; x < x1; ++x) {
+      const Vec3f c = photo.Rgb(x, y);
+      grey.at<float>(y - y0, x - x0) = 0.299f * c[0] + 0.587f * c[1] + 0.114f * c[2];
+    }
+  cv::Mat small, laplacian;
+  cv::resize(grey, small, cv::Size(96, 96), 0, 0, cv::INTER_AREA);
+  cv::Laplacian(small, laplacian, CV_32F);
+  cv::Scalar mean, stddev;
+  cv::meanStdDev(laplacian, mean, stddev);
+  return stddev[0] * stddev[0];
+}
 
 const char* FocalSourceName(FocalSource source) {
   switch (source) {
@@ -192,8 +280,16 @@ std::string TrackOptions::ToString() const {
 Result<TrackResult> TrackPhotos(const std::vector<fs::path>& photos, const TrackOptions& options,
                                 const FaceLandmarkDetector& detector, const Executor& executor,
                                 const std::function<void(const std::string&)>& log) {
+  std::vector<TrackInput> inputs;
+  for (const fs::path& p : photos) inputs.push_back(TrackInput{p, p.string(), std::nullopt, std::nullopt});
+  return TrackInputs(std::move(inputs), options, detector, executor, log);
+}
+
+Result<TrackResult> TrackInputs(std::vector<TrackInput> inputs, const TrackOptions& options,
+                                const FaceLandmarkDetector& detector, const Executor& executor,
+                                const std::function<void(const std::string&)>& log) {
   ICEF_RETURN_IF_ERROR(options.Validate().WithContext("track options"));
-  if (photos.empty()) return Status::Error("icef track: no photos given");
+  if (inputs.empty()) return Status::Error("icef track: no photos given");
   std::optional<FaceMesh> mesh;
   if (options.fit.detector == LandmarkDetector::kMesh) {
     ICEF_ASSIGN_OR_RETURN(FaceMesh loaded, FaceMesh::Load());
@@ -204,10 +300,13 @@ Result<TrackResult> TrackPhotos(const std::vector<fs::path>& photos, const Track
     ICEF_ASSIGN_OR_RETURN(PersonSegmenter loaded, PersonSegmenter::Load());
     segmenter = std::move(loaded);
   }
-  ICEF_ASSIGN_OR_RETURN(std::vector<Detected> detected, DetectAll(photos, detector, mesh ? &*mesh : nullptr, executor));
+  // Decoded frames carry no EXIF; photo files are read (and their EXIF) by name.
+  std::vector<bool> decoded(inputs.size());
+  for (size_t i = 0; i < inputs.size(); ++i) decoded[i] = inputs[i].image.has_value();
+  ICEF_ASSIGN_OR_RETURN(std::vector<Detected> detected, DetectAll(inputs, detector, mesh ? &*mesh : nullptr, executor));
 
   TrackResult result;
-  for (size_t i = 0; i < photos.size(); ++i) {
+  for (size_t i = 0; i < inputs.size(); ++i) {
     std::string why;
     if (!detected[i].detection.ok()) {
       why = "no face found";
@@ -215,23 +314,32 @@ Result<TrackResult> TrackPhotos(const std::vector<fs::path>& photos, const Track
       why = std::to_string(detected[i].detection->num_faces) + " faces found; icef track needs exactly one per photo";
     }
     if (!why.empty()) {
-      if (!options.skip_bad) return Status::Error(photos[i].string() + ": " + why + " (--skip-bad skips such photos)");
-      result.skipped.push_back(photos[i].string() + ": " + why);
-      if (log) log("skipped " + photos[i].string() + ": " + why);
+      const std::string label = inputs[i].Label();
+      if (!options.skip_bad) return Status::Error(label + ": " + why + " (--skip-bad skips such photos)");
+      result.skipped.push_back(label + ": " + why);
+      if (log) log("skipped " + label + ": " + why);
       continue;
     }
     TrackedPhoto p;
-    p.source = photos[i];
+    p.source = inputs[i].source;
+    p.name = inputs[i].Label();
+    p.time_s = inputs[i].time_s;
     p.photo = std::move(detected[i].photo);
     p.detection = std::move(*detected[i].detection);
-    p.photo_intrinsics = PhotoIntrinsics(photos[i], p.photo, options, &p.focal_source);
+    p.sharpness = FaceSharpness(p.photo, p.detection.landmarks);
+    p.photo_intrinsics = PhotoIntrinsics(decoded[i] ? fs::path() : inputs[i].source, p.photo, options, &p.focal_source);
     result.photos.push_back(std::move(p));
   }
   const int kept = static_cast<int>(result.photos.size());
-  if (kept - options.num_test < 1)
+  if (options.num_train <= 0 && kept - options.num_test < 1)
     return Status::Error("icef track: needs at least one training photo with a face besides the --test ones, got " +
                          std::to_string(kept) + " photo" + (kept == 1 ? "" : "s") + " with a face and --test " +
                          std::to_string(options.num_test));
+  if (options.num_train > 0 && kept < options.num_train + std::max(options.num_test, 1))
+    return Status::Error("icef track: --frames " + std::to_string(options.num_train) + " --test " +
+                         std::to_string(options.num_test) + " needs at least " +
+                         std::to_string(options.num_train + std::max(options.num_test, 1)) + " frames with a face, got " +
+                         std::to_string(kept));
 
   std::vector<TrackFrame> frames;
   for (const TrackedPhoto& p : result.photos)
@@ -257,6 +365,15 @@ Result<TrackResult> TrackPhotos(const std::vector<fs::path>& photos, const Track
     if (log) log(result.fit.BriefReport() + " (refit with the masks' outlines)");
   }
 
+  AssignSplits(options, &result);
+  const int used = static_cast<int>(result.photos.size());
+  if (log && options.num_train > 0) {
+    std::string line = "training frames chosen for coverage of pose and expression:";
+    for (const TrackedPhoto& p : result.photos)
+      if (!p.test) line += " " + p.name;
+    log(line);
+  }
+
   Dataset& d = result.dataset;
   d.expression_dim = face::kNumExpressions;
   d.expression_names = face::ExpressionNames();
@@ -266,13 +383,12 @@ Result<TrackResult> TrackPhotos(const std::vector<fs::path>& photos, const Track
   d.aabb.max += Vec3f::Constant(0.1f);
   d.background = Vec3f::Ones();
   d.tier_thresholds = std::array<double, 2>{kNearThreshold, kFarThreshold};
-  for (int i = 0; i < kept; ++i) {
+  d.train.resize(std::count_if(result.photos.begin(), result.photos.end(), [](const TrackedPhoto& p) { return !p.test; }));
+  d.test.resize(used - d.train.size());
+  for (int i = 0; i < used; ++i) {
     TrackedPhoto& p = result.photos[i];
-    p.test = i >= kept - options.num_test;
-    p.frame_index = p.test ? i - (kept - options.num_test) : i;
-    Frame frame;
-    BuildFrame(model, result.fit.frames[i], options, segmenter ? &*segmenter : nullptr, executor, &p, &frame);
-    (p.test ? d.test : d.train).push_back(std::move(frame));
+    BuildFrame(model, result.fit.frames[i], options, segmenter ? &*segmenter : nullptr, executor, &p,
+               &(p.test ? d.test : d.train)[p.frame_index]);
   }
   for (Frame& f : d.test) {
     f.delta = ExpressionDistance(f.expression, d.train);
@@ -294,6 +410,9 @@ Json TrackReportJson(const TrackResult& result) {
     const Vec3d ypr = f.YawPitchRollDeg();
     const Vec3d t = f.cam_from_head.block<3, 1>(0, 3);
     photos.push_back(Json{{"photo", p.source.string()},
+                          {"name", p.name},
+                          {"time_s", p.time_s ? Json(*p.time_s) : Json()},
+                          {"sharpness", p.sharpness},
                           {"file_path", frame.file_path},
                           {"split", p.test ? "test" : "train"},
                           {"focal_px", p.photo_intrinsics.fl_x},

@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <functional>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -32,7 +33,13 @@ namespace icef::track {
 struct TrackOptions {
   int resolution = 256;             // side of the square dataset images
   std::optional<double> focal;      // focal length in pixels of the photos (else EXIF, else the default)
-  int num_test = 0;                 // the last num_test photos become test frames
+  // Without num_train: the last num_test photos become test frames. With num_train > 0: that many
+  // training frames are chosen for coverage of head pose and expression (data/frame_coverage.h),
+  // and num_test of the others (spread evenly in input order; 0 = all of them) are held out; the
+  // rest are left out of the dataset.
+  int num_test = 0;
+  int num_train = 0;
+  bool allow_blink = false;         // with num_train: a frame with an eye closed may be a training frame
   bool skip_bad = false;            // skip photos without exactly one face instead of stopping
   double crop_margin = 1.15;        // crop side / the head box's projected extent
   int silhouette_points = 200;      // refit with this many mask edge points per photo (0: landmarks only)
@@ -51,8 +58,21 @@ struct TrackOptions {
 enum class FocalSource { kFlag, kExif, kDefault };
 const char* FocalSourceName(FocalSource source);
 
+// One image to track: a photo file, or a frame already decoded (a video's).
+struct TrackInput {
+  std::filesystem::path source;  // the photo, or the video the frame came from
+  std::string name;              // how logs and the report name it (empty: the source's file name)
+  std::optional<Image> image;    // the decoded frame (upright RGB); empty: read `source`
+  std::optional<double> time_s;  // a video frame's time
+  // The input's label: name, else the source's file name.
+  std::string Label() const { return name.empty() ? source.filename().string() : name; }
+};
+
 struct TrackedPhoto {
-  std::filesystem::path source;  // the photo
+  std::filesystem::path source;  // the photo (or the video of a frame)
+  std::string name;              // TrackInput::Label()
+  std::optional<double> time_s;  // a video frame's time
+  double sharpness = 0;          // FaceSharpness of the photo
   Image photo;                   // as read, turned upright by its EXIF orientation, alpha composited over white
   FaceDetection detection;       // in the photo's coordinates
   Intrinsics photo_intrinsics;
@@ -76,6 +96,15 @@ struct TrackResult {
 Result<TrackResult> TrackPhotos(const std::vector<std::filesystem::path>& photos, const TrackOptions& options,
                                 const FaceLandmarkDetector& detector, const Executor& executor,
                                 const std::function<void(const std::string&)>& log = nullptr);
+// The same for any inputs (photos and decoded video frames), in input (time) order.
+Result<TrackResult> TrackInputs(std::vector<TrackInput> inputs, const TrackOptions& options,
+                                const FaceLandmarkDetector& detector, const Executor& executor,
+                                const std::function<void(const std::string&)>& log = nullptr);
+
+// Fine detail of the face in a photo: the variance of the Laplacian of the grey face (the box of
+// its landmarks, resampled to 96 x 96 pixels). Only ratios between frames of one source mean
+// anything; 0 without landmarks.
+double FaceSharpness(const Image& photo, std::span<const Vec2f> landmarks);
 
 // The per-photo report (track/report.json): source, split, landmark residual, pose, expression.
 Json TrackReportJson(const TrackResult& result);

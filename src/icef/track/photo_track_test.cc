@@ -284,6 +284,40 @@ TEST(HeadMaskTest, SkinEdgesKeepTheFaceOutlineNotHair) {
   for (bool k : SkinEdges(image, mask, points, none, 2.0)) EXPECT_TRUE(k);
 }
 
+TEST(HeadMaskTest, HairAsDarkAsTheBackgroundStaysWhereTheSegmentationSeesThePerson) {
+  // A skin-coloured disk (the face: the silhouette) under a cap of dark brown hair (radius 20,
+  // above the disk) before a dark blue background: GrabCut's colour models, seeded with skin alone,
+  // cut the hair off flat along the silhouette; the person segmentation, which sees disk and hair,
+  // keeps it.
+  Image image(64, 64, 3), silhouette(64, 64, 1), person(64, 64, 1);
+  const auto in_disk = [](int x, int y, float r) {
+    const float dx = x + 0.5f - 32.f, dy = y + 0.5f - 36.f;
+    return dx * dx + dy * dy < r * r;
+  };
+  const auto in_hair = [&](int x, int y) { return in_disk(x, y, 20.f) && !in_disk(x, y, 14.f) && y < 34; };
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) {
+      const Vec3f c = (in_disk(x, y, 14.f) ? Vec3f(0.85f, 0.62f, 0.5f)
+                       : in_hair(x, y)     ? Vec3f(0.22f, 0.14f, 0.1f)
+                                           : Vec3f(0.1f, 0.1f, 0.25f)) +
+                      Vec3f::Constant(0.02f * ((x * 7 + y * 13) % 3 - 1));
+      for (int ch = 0; ch < 3; ++ch) image.At(x, y, ch) = c[ch];
+      silhouette.At(x, y, 0) = in_disk(x, y, 13.f) ? 1.f : 0.f;
+      person.At(x, y, 0) = in_disk(x, y, 14.5f) || in_hair(x, y) ? 0.95f : 0.01f;
+    }
+  int hair = 0;
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) hair += in_hair(x, y);
+  const auto kept = [&](const Image& mask) {
+    int n = 0;
+    for (int y = 0; y < 64; ++y)
+      for (int x = 0; x < 64; ++x) n += mask.At(x, y, 0) > 0.5f && in_hair(x, y);
+    return n;
+  };
+  EXPECT_LT(kept(HeadMask(image, silhouette, Image())), 0.2 * hair);          // cut off flat
+  EXPECT_GT(kept(HeadMask(image, silhouette, Image(), person)), 0.8 * hair);  // kept
+}
+
 TEST(HeadMaskTest, PersonSegmentationBackgroundIsSureBackground) {
   // A skin-coloured disk (radius 14 about (32, 32)) on a blue background, and touching it on the
   // right a skin-coloured bar (a door frame beside the head): GrabCut's colour models alone keep
