@@ -1,6 +1,6 @@
 #include "icef/nn/gemm.h"
 
-#if defined(__AVX512F__)
+#if defined(__AVX512F__) || (defined(__AVX2__) && defined(__FMA__))
 #include <immintrin.h>
 #endif
 
@@ -165,6 +165,160 @@ void GemmTNAcc<float>(int64_t n, int k, int m, const float* a, const float* b, f
 
 const char* GemmKernelName() { return "avx512"; }
 
+#elif defined(__AVX2__) && defined(__FMA__)
+namespace {
+
+// The same register blocking with 8-wide vectors (AVX2 has 16 ymm registers: R * MV accumulators,
+// MV columns of B and one broadcast of A must fit). Any row stride m: blocks of 8 columns, the
+// last m % 8 columns by scalar loops.
+
+// C[s, j0..j0+8*MV) = sum_p A[s, p] B[p, j] for R rows.
+template <int R, int MV>
+inline void NNBlock8(int k, int m, const float* a, const float* b, float* c) {
+  __m256 acc[R][MV];
+  for (int r = 0; r < R; ++r)
+    for (int v = 0; v < MV; ++v) acc[r][v] = _mm256_setzero_ps();
+  for (int p = 0; p < k; ++p) {
+    __m256 bv[MV];
+    for (int v = 0; v < MV; ++v) bv[v] = _mm256_loadu_ps(b + static_cast<int64_t>(p) * m + 8 * v);
+    for (int r = 0; r < R; ++r) {
+      const __m256 av = _mm256_broadcast_ss(a + static_cast<int64_t>(r) * k + p);
+      for (int v = 0; v < MV; ++v) acc[r][v] = _mm256_fmadd_ps(av, bv[v], acc[r][v]);
+    }
+  }
+  for (int r = 0; r < R; ++r)
+    for (int v = 0; v < MV; ++v) _mm256_storeu_ps(c + static_cast<int64_t>(r) * m + 8 * v, acc[r][v]);
+}
+
+// Columns [j0, j1) (a multiple of 8 * MV wide) of every row.
+template <int R, int MV>
+void NNPanel8(int64_t n, int k, int m, int j0, int j1, const float* a, const float* b, float* c) {
+  for (int j = j0; j < j1; j += 8 * MV) {
+    int64_t s = 0;
+    for (; s + R <= n; s += R) NNBlock8<R, MV>(k, m, a + s * k, b + j, c + s * m + j);
+    for (; s < n; ++s) NNBlock8<1, MV>(k, m, a + s * k, b + j, c + s * m + j);
+  }
+}
+
+// C[p, j0..j0+8*MV) += sum_s A[s, p] B[s, j] for R rows p.
+template <int R, int MV>
+inline void TNBlock8(int64_t n, int k, int m, const float* a, const float* b, float* c) {
+  __m256 acc[R][MV];
+  for (int r = 0; r < R; ++r)
+    for (int v = 0; v < MV; ++v) acc[r][v] = _mm256_loadu_ps(c + static_cast<int64_t>(r) * m + 8 * v);
+  for (int64_t s = 0; s < n; ++s) {
+    __m256 bv[MV];
+    for (int v = 0; v < MV; ++v) bv[v] = _mm256_loadu_ps(b + s * m + 8 * v);
+    for (int r = 0; r < R; ++r) {
+      const __m256 av = _mm256_broadcast_ss(a + s * k + r);
+      for (int v = 0; v < MV; ++v) acc[r][v] = _mm256_fmadd_ps(av, bv[v], acc[r][v]);
+    }
+  }
+  for (int r = 0; r < R; ++r)
+    for (int v = 0; v < MV; ++v) _mm256_storeu_ps(c + static_cast<int64_t>(r) * m + 8 * v, acc[r][v]);
+}
+
+template <int R, int MV>
+void TNPanel8(int64_t n, int k, int m, int j0, int j1, const float* a, const float* b, float* c) {
+  for (int j = j0; j < j1; j += 8 * MV) {
+    int p = 0;
+    for (; p + R <= k; p += R) TNBlock8<R, MV>(n, k, m, a + p, b + j, c + static_cast<int64_t>(p) * m + j);
+    for (; p < k; ++p) TNBlock8<1, MV>(n, k, m, a + p, b + j, c + static_cast<int64_t>(p) * m + j);
+  }
+}
+
+float HorizontalSum(__m256 v) {
+  const __m128 s = _mm_add_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));
+  const __m128 t = _mm_add_ps(s, _mm_movehl_ps(s, s));
+  return _mm_cvtss_f32(_mm_add_ss(t, _mm_shuffle_ps(t, t, 1)));
+}
+
+// C[n, m] = A[n, k] B[k, m] for m < 8 columns and k = 8 KV (the 3-wide output layers): vectorised
+// along k, one dot product per (row, column) from the columns of B gathered once.
+template <int KV>
+void NNSmallM8(int64_t n, int m, const float* a, const float* b, float* c) {
+  constexpr int k = 8 * KV;
+  alignas(32) float bt[8][k];
+  for (int j = 0; j < m; ++j)
+    for (int p = 0; p < k; ++p) bt[j][p] = b[int64_t{p} * m + j];
+  for (int64_t s = 0; s < n; ++s) {
+    __m256 av[KV];
+    for (int v = 0; v < KV; ++v) av[v] = _mm256_loadu_ps(a + s * k + 8 * v);
+    for (int j = 0; j < m; ++j) {
+      __m256 acc = _mm256_mul_ps(av[0], _mm256_load_ps(&bt[j][0]));
+      for (int v = 1; v < KV; ++v) acc = _mm256_fmadd_ps(av[v], _mm256_load_ps(&bt[j][8 * v]), acc);
+      c[s * m + j] = HorizontalSum(acc);
+    }
+  }
+}
+
+// C[k, m] += A[n, k]^T B[n, m] for m = M < 8 and k = 8 KV: C^T accumulated in registers.
+template <int M, int KV>
+void TNSmallM8(int64_t n, const float* a, const float* b, float* c) {
+  constexpr int k = 8 * KV;
+  __m256 acc[M][KV];
+  for (int j = 0; j < M; ++j)
+    for (int v = 0; v < KV; ++v) acc[j][v] = _mm256_setzero_ps();
+  for (int64_t s = 0; s < n; ++s) {
+    __m256 av[KV];
+    for (int v = 0; v < KV; ++v) av[v] = _mm256_loadu_ps(a + s * k + 8 * v);
+    for (int j = 0; j < M; ++j) {
+      const __m256 bj = _mm256_broadcast_ss(b + s * M + j);
+      for (int v = 0; v < KV; ++v) acc[j][v] = _mm256_fmadd_ps(bj, av[v], acc[j][v]);
+    }
+  }
+  alignas(32) float tmp[M][k];
+  for (int j = 0; j < M; ++j)
+    for (int v = 0; v < KV; ++v) _mm256_store_ps(&tmp[j][8 * v], acc[j][v]);
+  for (int p = 0; p < k; ++p)
+    for (int j = 0; j < M; ++j) c[p * M + j] += tmp[j][p];
+}
+
+}  // namespace
+
+template <>
+void GemmNN<float>(int64_t n, int k, int m, const float* a, const float* b, float* c) {
+  if (m < 8) {
+    if (k == 64) return NNSmallM8<8>(n, m, a, b, c);
+    if (k == 32) return NNSmallM8<4>(n, m, a, b, c);
+    if (k == 16) return NNSmallM8<2>(n, m, a, b, c);
+    return GemmNNGeneric(n, k, m, a, b, c);
+  }
+  const int wide = m / 16 * 16, full = m / 8 * 8;
+  NNPanel8<6, 2>(n, k, m, 0, wide, a, b, c);
+  NNPanel8<12, 1>(n, k, m, wide, full, a, b, c);
+  // The last m % 8 columns.
+  for (int64_t s = 0; s < n && full < m; ++s)
+    for (int j = full; j < m; ++j) {
+      float sum = 0;
+      for (int p = 0; p < k; ++p) sum += a[s * k + p] * b[static_cast<int64_t>(p) * m + j];
+      c[s * m + j] = sum;
+    }
+}
+
+template <>
+void GemmTNAcc<float>(int64_t n, int k, int m, const float* a, const float* b, float* c) {
+  if (m < 8) {
+    if (k == 64 && m == 3) return TNSmallM8<3, 8>(n, a, b, c);
+    if (k == 64 && m == 1) return TNSmallM8<1, 8>(n, a, b, c);
+    if (k == 32 && m == 3) return TNSmallM8<3, 4>(n, a, b, c);
+    if (k == 32 && m == 1) return TNSmallM8<1, 4>(n, a, b, c);
+    return GemmTNAccGeneric(n, k, m, a, b, c);
+  }
+  const int wide = m / 16 * 16, full = m / 8 * 8;
+  TNPanel8<6, 2>(n, k, m, 0, wide, a, b, c);
+  TNPanel8<12, 1>(n, k, m, wide, full, a, b, c);
+  // The last m % 8 columns.
+  if (full < m)
+    for (int64_t s = 0; s < n; ++s)
+      for (int p = 0; p < k; ++p) {
+        const float av = a[s * k + p];
+        for (int j = full; j < m; ++j) c[static_cast<int64_t>(p) * m + j] += av * b[s * m + j];
+      }
+}
+
+const char* GemmKernelName() { return "avx2"; }
+
 #else
 
 template <>
@@ -175,11 +329,7 @@ template <>
 void GemmTNAcc<float>(int64_t n, int k, int m, const float* a, const float* b, float* c) {
   GemmTNAccGeneric(n, k, m, a, b, c);
 }
-#if defined(__AVX2__)
-const char* GemmKernelName() { return "avx2 (auto-vectorised)"; }
-#else
 const char* GemmKernelName() { return "generic"; }
-#endif
 
 #endif
 

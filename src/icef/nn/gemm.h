@@ -2,8 +2,8 @@
 //   GemmNN:    C[n, m]  = A[n, k] · B[k, m]            (forward: X · Wt; backward data: dY · W)
 //   GemmTNAcc: C[k, m] += A[n, k]^T · B[n, m]          (weight gradient: X^T · dY)
 // Generic templates serve any scalar (double for gradient checks). The float versions use a
-// register-blocked AVX-512 micro-kernel when m is a multiple of 16 and the build targets AVX-512
-// (-march=native on an AVX-512 host, see docs/engine.md), else AVX2 / the generic loops.
+// register-blocked micro-kernel: AVX-512 (16-wide) when the build targets it (-march=native on an
+// AVX-512 host, see docs/engine.md), else AVX2 + FMA (8-wide), else the generic loops.
 #pragma once
 
 #include <cstdint>

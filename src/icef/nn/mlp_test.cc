@@ -88,8 +88,8 @@ INSTANTIATE_TEST_SUITE_P(Activations, MlpGradientTest,
                          [](const auto& info) { return ActivationName(info.param); });
 
 TEST(GemmTest, FloatKernelsMatchGenericForReferenceShapes) {
-  for (int m : {1, 3, 16, 19, 32, 40, 64, 80}) {
-    for (int k : {3, 32, 55, 64}) {
+  for (int m : {1, 3, 7, 8, 16, 19, 32, 40, 55, 64, 80}) {
+    for (int k : {3, 16, 32, 55, 64}) {
       const int64_t n = 37;
       std::vector<double> ad = RandomVector(n * k, 1, m, -1, 1), bd = RandomVector(k * m, 2, m, -1, 1);
       std::vector<float> a(ad.begin(), ad.end()), b(bd.begin(), bd.end());
