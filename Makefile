@@ -46,7 +46,7 @@ bench: deps
 # the unit-test binaries of the modules that read files and do the rendering arithmetic (a full
 # sanitizer build takes far longer on 2 cores) and runs their tests; any sanitizer report fails.
 SANITIZE_BUILD_DIR ?= build-asan
-SANITIZE_TARGETS ?= icef_core_test icef_math_test icef_io_test icef_data_test icef_render_test
+SANITIZE_TARGETS ?= icef_core_test icef_math_test icef_io_test icef_video_test icef_data_test icef_render_test
 SANITIZE_ENV = ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:strict_string_checks=1 \
 	UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
 

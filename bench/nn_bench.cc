@@ -1,4 +1,4 @@
-// Benchmarks of the nn building blocks on DESIGN.md §7's reference configuration (4096 rays x 32
+// Benchmarks of the nn building blocks on docs/design.md §7's reference configuration (4096 rays x 32
 // samples, 2 threads): hash encoding, each MLP, and the Eigen float32 GEMM rate that the MLP
 // figures are compared with (counter fraction_of_gemm = MLP FLOP rate / GEMM FLOP rate).
 #include <benchmark/benchmark.h>
@@ -19,7 +19,7 @@
 
 namespace icef::nn {
 
-// Threads of every benchmark: 2 (DESIGN.md §7), or ICEF_BENCH_THREADS (e.g. 1 to read per-core
+// Threads of every benchmark: 2 (docs/design.md §7), or ICEF_BENCH_THREADS (e.g. 1 to read per-core
 // CPU time on a busy machine).
 int BenchThreads() {
   static const int threads = [] {

@@ -1,4 +1,4 @@
-// The headline benchmarks on DESIGN.md §7's reference configuration (see nn/reference_model.h):
+// The headline benchmarks on docs/design.md §7's reference configuration (see nn/reference_model.h):
 // BM_ReferenceTrainStep (forward + backward + Adam over 4096 rays x 32 samples, 2 threads) and
 // BM_ReferenceInference, each with a samples_per_second counter (wall clock); plus peak RSS and the fraction
 // of the measured Eigen float32 GEMM rate (BM_GemmFp32) that the MLP work of the step reaches.

@@ -1,15 +1,18 @@
 #!/usr/bin/env python3
-"""Point the README's bench section at another report and rewrite its table cells from it.
+"""Point a Markdown file's bench section at another report and rewrite its table cells from it.
 
-Usage: scripts/readme_bench_tables.py README.md docs/results/<bench>/report.json
+Usage: scripts/readme_bench_tables.py FILE.md docs/results/<bench>/report.json
+  e.g. docs/results/README.md (the results page) or README.md (its headline table)
 
-The section between <!-- bench-results:begin REPORT --> and <!-- bench-results:end --> keeps its
-rows (K, tier, method) and columns; every cell is rewritten as "mean ± std" (or "mean" where the
-README shows no spread) of that (K, method, tier) cell of the new report's aggregate, with the
-decimals the README used, and the section's links to the old bench directory are pointed at the
-new one. tests/integration/readme_numbers_test.sh checks the result.
+The first section between <!-- bench-results:begin REPORT --> and <!-- bench-results:end --> keeps
+its rows (K, tier, method) and columns; every cell is rewritten as "mean ± std" (or "mean" where
+the file shows no spread) of that (K, method, tier) cell of the new report's aggregate, with the
+decimals the file used, and the section's links to the old bench directory are pointed at the
+new one. REPORT is written relative to FILE.md's directory, as its links are.
+tests/integration/readme_numbers_test.sh checks the result.
 """
 import json
+import os
 import re
 import sys
 
@@ -52,13 +55,13 @@ def main(readme_path, report_path):
             cols = cols[:3] + [rewrite_cell(t, cells[key][h]) for h, t in zip(header[3:], cols[3:])]
             line = line[: len(line) - len(line.lstrip())] + "| " + " | ".join(cols) + " |"
         lines.append(line)
-    old_dir, new_dir = old_report.rsplit("/", 1)[0], report_path.rsplit("/", 1)[0]
+    new_report = os.path.relpath(report_path, os.path.dirname(os.path.abspath(readme_path)))
+    old_dir, new_dir = os.path.dirname(old_report), os.path.dirname(new_report)
     section = "\n".join(lines).replace(old_dir + "/", new_dir + "/")
-    out = readme[: m.start()] + f"<!-- bench-results:begin {report_path} -->" + section + "<!-- bench-results:end -->"
+    out = readme[: m.start()] + f"<!-- bench-results:begin {new_report} -->" + section + "<!-- bench-results:end -->"
     out += readme[m.end():]
     with open(readme_path + ".tmp", "w") as f:
         f.write(out)
-    import os
     os.replace(readme_path + ".tmp", readme_path)
 
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-# The reference training step (src/icef/nn/reference_model.h, DESIGN.md §7) written in plain
+# The reference training step (src/icef/nn/reference_model.h, docs/design.md §7) written in plain
 # PyTorch, so that `make bench` can quote BM_ReferenceTrainStep against PyTorch measured in the same
 # run on the same cores. Same modules and sizes, same batch shape, same loss and optimiser:
 #

@@ -1,27 +1,33 @@
 #!/usr/bin/env bash
-# The README's benchmark summary quotes numbers; none may be typed by hand.
+# The measured figures in the docs quote numbers; none may be typed by hand. Two files are checked:
+# docs/results/README.md (the results page: the benches and the training curve) and README.md (its
+# headline table). Each must have at least one bench section; the results page also the curve.
 #
 # Benches: each section between <!-- bench-results:begin REPORT --> and <!-- bench-results:end -->
-# names the report.json it summarises. Its tables have columns K, tier, method and then metric
-# keys of report.json (psnr, expr_gain, id_distance_gt, ...), or K, method and then keys of the
-# report's training-view fit (face_psnr, face_psnr_min, psnr); every cell "mean", "mean ± std",
-# "mean [min, max]" or "mean ± std [min, max]" must equal that cell of the report's aggregate
-# (train_fit), rounded to the decimals shown. A decimal number anywhere else in a section is an
-# error: numbers live in checked tables.
+# names the report.json it summarises, as a path relative to the Markdown file, and must link the
+# report.md beside it. Its tables have columns K, tier, method and then metric keys of report.json
+# (psnr, expr_gain, id_distance_gt, ...), or K, method and then keys of the report's training-view
+# fit (face_psnr, face_psnr_min, psnr); every cell "mean", "mean ± std", "mean [min, max]" or
+# "mean ± std [min, max]" must equal that cell of the report's aggregate (train_fit), rounded to the
+# decimals shown. A decimal number anywhere else in a section is an error: numbers live in checked
+# tables. At least 10 numbers per section must be checked.
 # Training curve: every row "| step | seconds | PSNR |" between <!-- train-curve:begin LOG.jsonl -->
-# and <!-- train-curve:end --> must be a line of that committed training log (seconds to 0 and
-# PSNR to 2 decimals).
-# Usage: readme_numbers_test.sh [ICEF]
+# (a path relative to the Markdown file) and <!-- train-curve:end --> must be a line of that
+# committed training log (seconds to 0 and PSNR to 2 decimals).
+# scripts/readme_bench_tables.py rewrites a bench section's cells from another report.
+# Usage: readme_numbers_test.sh [ICEF ...]   (the arguments are ignored: nothing is run)
 set -euo pipefail
 root="$(cd "$(dirname "$0")/../.." && pwd)"
-readme="$root/README.md"
+results="$root/docs/results/README.md"
 
-python3 - "$root" "$readme" <<'PY'
-import json, re, sys
-root, readme = sys.argv[1], open(sys.argv[2]).read()
-sections = re.findall(r"<!-- bench-results:begin (\S+) -->(.*?)<!-- bench-results:end -->", readme, re.S)
+for doc in "$results" "$root/README.md"; do
+python3 - "$root" "$doc" <<'PY'
+import json, os, re, sys
+root, doc_path = sys.argv[1], sys.argv[2]
+doc, base, name_of_doc = open(doc_path).read(), os.path.dirname(doc_path), os.path.relpath(doc_path, root)
+sections = re.findall(r"<!-- bench-results:begin (\S+) -->(.*?)<!-- bench-results:end -->", doc, re.S)
 if not sections:
-    sys.exit("readme_numbers_test: README.md has no '<!-- bench-results:begin REPORT.json -->' section")
+    sys.exit(f"readme_numbers_test: {name_of_doc} has no '<!-- bench-results:begin REPORT.json -->' section")
 NUM = r"[-+]?\d+(?:\.\d+)?"
 CELL = re.compile(rf"^({NUM})(?:\s*±\s*({NUM}))?(?:\s*\[({NUM}),\s*({NUM})\])?$")
 
@@ -30,7 +36,10 @@ def decimals(text):
 
 errors = []
 for report_path, section in sections:
-    report = json.load(open(f"{root}/{report_path}"))
+    if not os.path.isfile(os.path.join(base, report_path)):
+        errors.append(f"{report_path}: no such file (paths are relative to {name_of_doc})")
+        continue
+    report = json.load(open(os.path.join(base, report_path)))
     if report_path.replace("report.json", "report.md") not in section:
         errors.append(f"the section of {report_path} does not link {report_path.replace('report.json', 'report.md')}")
     tiers = {(c["k"], c["method"], c["tier"]): c for c in report["aggregate"]}
@@ -65,7 +74,7 @@ for report_path, section in sections:
                     continue
                 want = f"{spread[stat]:.{decimals(value)}f}"
                 if float(value) != float(want):
-                    errors.append(f"{report_path}: row {name}: {key} {stat} is {value} in the README, {want} in the report")
+                    errors.append(f"{report_path}: row {name}: {key} {stat} is {value} in {name_of_doc}, {want} in the report")
                 checked += 1
     for line in outside:
         for n in re.findall(r"\d+\.\d+", line):
@@ -73,24 +82,25 @@ for report_path, section in sections:
     if checked < 10:
         errors.append(f"only {checked} numbers checked against {report_path}: is the table there?")
     elif len(errors) == errors_before:
-        print(f"readme_numbers_test: {checked} numbers of the README match {report_path} cell by cell")
+        print(f"readme_numbers_test: {checked} numbers of {name_of_doc} match {report_path} cell by cell")
 for e in errors:
-    print("readme_numbers_test:", e, file=sys.stderr)
+    print(f"readme_numbers_test: {name_of_doc}:", e, file=sys.stderr)
 if errors:
     sys.exit(1)
 PY
+done
 
-# The README's training curve.
-log_rel=$(sed -nE 's/.*<!-- train-curve:begin ([^ ]+) -->.*/\1/p' "$readme" | head -n 1)
-if [ -z "$log_rel" ] || [ ! -f "$root/$log_rel" ]; then
-  echo "readme_numbers_test: README.md has no '<!-- train-curve:begin LOG.jsonl -->' naming a committed log ('$log_rel')" >&2
+# The results page's training curve.
+log_rel=$(sed -nE 's/.*<!-- train-curve:begin ([^ ]+) -->.*/\1/p' "$results" | head -n 1)
+if [ -z "$log_rel" ] || [ ! -f "$(dirname "$results")/$log_rel" ]; then
+  echo "readme_numbers_test: docs/results/README.md has no '<!-- train-curve:begin LOG.jsonl -->' naming a committed log ('$log_rel')" >&2
   exit 1
 fi
-log="$root/$log_rel"
+log="$(dirname "$results")/$log_rel"
 missing=0
-rows=$(sed -n '/<!-- train-curve:begin /,/<!-- train-curve:end -->/p' "$readme" | grep -E '^ *\| [0-9]+ \|' || true)
+rows=$(sed -n '/<!-- train-curve:begin /,/<!-- train-curve:end -->/p' "$results" | grep -E '^ *\| [0-9]+ \|' || true)
 if [ -z "$rows" ]; then
-  echo "readme_numbers_test: README.md has no train-curve rows" >&2
+  echo "readme_numbers_test: docs/results/README.md has no train-curve rows" >&2
   missing=1
 fi
 while read -r step secs psnr; do
@@ -99,9 +109,9 @@ while read -r step secs psnr; do
   got_psnr=$(sed -nE 's/.*"psnr_observed":([0-9.eE+-]+).*/\1/p' <<<"$line")
   if [ -z "$line" ] || [ -z "$got_psnr" ] || [ "$(printf '%.0f' "$got_secs")" != "$secs" ] ||
      [ "$(printf '%.2f' "$got_psnr")" != "$psnr" ]; then
-    echo "readme_numbers_test: README curve row step $step ($secs s, $psnr dB) is not in $log" >&2
+    echo "readme_numbers_test: docs/results/README.md curve row step $step ($secs s, $psnr dB) is not in $log" >&2
     missing=1
   fi
 done < <(awk -F'|' '{gsub(/ /, "", $2); gsub(/ /, "", $3); gsub(/ /, "", $4); print $2, $3, $4}' <<<"$rows")
-[ $missing -eq 0 ] && echo "readme_numbers_test: the README's training curve matches the committed log"
+[ $missing -eq 0 ] && echo "readme_numbers_test: the training curve of docs/results/README.md matches $log_rel"
 exit $missing

@@ -20,7 +20,7 @@ CommandFn RegisterDemo(CLI::App& app) {
                  "Training time cap, seconds (0 = none); training stops at --steps or here")
       ->capture_default_str()
       ->check(kNonNegative);
-  app.add_option("--steps", o->steps, "Training steps (1000: the bench's and the README sheet's)")
+  app.add_option("--steps", o->steps, "Training steps (1000: the bench's and the demo sheet's in docs/results/README.md)")
       ->capture_default_str()
       ->check(kPositive);
   app.add_option("--threads", o->threads, "Worker threads (0 = all cores)")

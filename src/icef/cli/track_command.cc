@@ -1,7 +1,7 @@
 // icef track PHOTOS... --out DATASET [--res N] [--focal PX] [--test N] [--skip-bad] [--threads N]
 // icef track VIDEO --frames K --test N --out DATASET [--every N | --max-frames N]
 // icef track DATASET --keep-cameras --out NEW
-// From a handful of photos of one person to a dataset (DESIGN.md §8): app/track_app.h does the work.
+// From a handful of photos of one person to a dataset (docs/design.md §8): app/track_app.h does the work.
 #include <iostream>
 #include <memory>
 #include <optional>

@@ -1,4 +1,4 @@
-// The dataset format of DESIGN.md §4: a directory with transforms_train.json,
+// The dataset format of docs/design.md §4: a directory with transforms_train.json,
 // transforms_test.json and optionally transforms_val.json. Images are referenced by path and
 // loaded on demand (LoadFrameImage), but their existence, readability and size are validated when
 // the dataset is loaded.
@@ -19,7 +19,7 @@ namespace icef {
 
 constexpr int kNumLandmarks = 68;  // iBUG-68 layout
 
-// Extrapolation tiers of test frames (DESIGN.md §6).
+// Extrapolation tiers of test frames (docs/design.md §6).
 enum class Tier { kObserved, kNear, kModerate, kFar };
 const char* TierName(Tier tier);
 std::optional<Tier> ParseTier(const std::string& name);

@@ -1,5 +1,5 @@
 // `icef import`: converts an instant-ngp or NerFace dataset directory into our format
-// (DESIGN.md §4), copying or hard-linking its images.
+// (docs/design.md §4), copying or hard-linking its images.
 #pragma once
 
 #include <filesystem>

@@ -1,4 +1,4 @@
-// The per-model evaluation protocol of DESIGN.md §6 (`icef eval MODEL DATASET --out DIR`): every
+// The per-model evaluation protocol of docs/design.md §6 (`icef eval MODEL DATASET --out DIR`): every
 // test frame is rendered at its camera and expression and compared with its ground truth (PSNR,
 // SSIM over the full image composited on the background, LPIPS when weights are given), and its
 // identity is measured with the face-descriptor network: the Euclidean distance and cosine between

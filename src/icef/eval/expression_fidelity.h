@@ -1,4 +1,4 @@
-// Expression fidelity (DESIGN.md §6, docs/evaluation.md): how much of a test frame's expression a
+// Expression fidelity (docs/design.md §6, docs/evaluation.md): how much of a test frame's expression a
 // render reproduces, measured against the ground truth inside the frame's expression region.
 //
 // - Expression region: the pixels within `dilation` pixels of the 2D convex hull of the frame's

@@ -1,4 +1,4 @@
-// Full-reference image metrics on [0, 1] images (DESIGN.md §6).
+// Full-reference image metrics on [0, 1] images (docs/design.md §6).
 //
 // Both images must have the same size and channel count; RGB and RGBA images are compared on
 // their RGB channels (composite RGBA over a background first if alpha matters), grey images on

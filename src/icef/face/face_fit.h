@@ -1,4 +1,4 @@
-// Fitting the face model to a subject (DESIGN.md §2.1): shape parameters shared by all frames and
+// Fitting the face model to a subject (docs/design.md §2.1): shape parameters shared by all frames and
 // one similarity transform head_from_world (dataset world frame -> head frame), from the 68
 // landmarks of frames whose expressions are known (weights in the face model's expression order).
 // Landmarks are 3D (world frame) when a frame has them, else 2D (pixels) reprojected through the

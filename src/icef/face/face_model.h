@@ -82,7 +82,7 @@ class FaceModel {
 
   // Observation -> canonical point for the expression (identity where no term is active).
   Vec3f Warp(const Vec3f& x, const ExpressionState& state) const;
-  // The face model's whole observation -> canonical map for a deformation model (DESIGN.md §2.1):
+  // The face model's whole observation -> canonical map for a deformation model (docs/design.md §2.1):
   // Warp, then the eyelid slide. In the surface itself a closing eye is a lid cap whose edge angle
   // changes (not a warp); the slide stands for it as a warp: a point on the closing upper lid, at
   // elevation theta about the eye centre's x axis between the state's lid edge and the top of the

@@ -1,4 +1,4 @@
-// Confidence of the learned deformation at an expression (DESIGN.md §2):
+// Confidence of the learned deformation at an expression (docs/design.md §2):
 //   beta_n = argmin_k ||beta - beta_k||_2 over the observed (training) expressions,
 //   delta  = ||beta - beta_n||_2,   kappa = exp(-delta / lambda)
 // so kappa = 1 at a training expression and tends to 0 as beta moves away from all of them.

@@ -1,4 +1,4 @@
-// The deformation of DESIGN.md §2 and §2.1 as one component: an observation point x at expression
+// The deformation of docs/design.md §2 and §2.1 as one component: an observation point x at expression
 // beta maps to the canonical point x + offset with
 //   training (beta a training expression, kappa = 1):  offset = (P(x, beta) - x) + R_phi(x, beta)
 //   any expression (confidence-weighted warping):       offset = (P(x, beta) - x)

@@ -1,4 +1,4 @@
-// The expression-conditioned deformation field of DESIGN.md §2:
+// The expression-conditioned deformation field of docs/design.md §2:
 //   D_phi(x, beta) = x + g_phi(enc(x_u), beta),   x_u = 2 (x - aabb.min) / aabb.extent - 1
 // an observation-space point x (world frame) maps to canonical space for expression beta. enc is a
 // frequency encoding of x_u (coarse-to-fine annealing via SetAnnealing), g an MLP whose output is

@@ -1,4 +1,4 @@
-// A fixed, known part of the deformation (DESIGN.md §2.1): P(x, beta), an observation point's
+// A fixed, known part of the deformation (docs/design.md §2.1): P(x, beta), an observation point's
 // canonical point as a face model predicts it. It has no parameters, so it is only evaluated,
 // never differentiated. The learned residual R_phi (DeformationField) is added on top of it.
 #pragma once

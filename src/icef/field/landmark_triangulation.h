@@ -1,5 +1,5 @@
 // Triangulation of the 68 facial landmarks from their 2D positions in K calibrated views
-// (DESIGN.md §2, expression-region mask): a linear least-squares (DLT) solution per landmark,
+// (docs/design.md §2, expression-region mask): a linear least-squares (DLT) solution per landmark,
 // optionally refined by Gauss-Newton on the reprojection error. Cameras follow math/camera.h (NeRF
 // convention); 2D landmarks are image coordinates with pixel centres at +0.5 (Camera::Project).
 #pragma once

@@ -1,4 +1,4 @@
-// Expression shading from the face model (DESIGN.md §2.1; docs/face_model.md "Shading"): the light
+// Expression shading from the face model (docs/design.md §2.1; docs/face_model.md "Shading"): the light
 // on a surface that an expression turns, which no warp of a static canonical field can show.
 //
 // A canonical field's colours carry the light of the canonical (neutral) surface. Where an

@@ -1,4 +1,4 @@
-// Expression-region mask M(x) in [0, 1] (DESIGN.md §2): 1 in the mouth, eye and brow regions, 0
+// Expression-region mask M(x) in [0, 1] (docs/design.md §2): 1 in the mouth, eye and brow regions, 0
 // elsewhere, smooth in between. Built once from the 68 iBUG landmarks in the world frame:
 //  - each region is a union of capsules (radius = the region's margin) around its landmark
 //    polylines: brows 17-21 and 22-26 (open), eyes 36-41 and 42-47 (closed loops, filled by spokes

@@ -1,4 +1,4 @@
-// The static canonical radiance field F_static(x_c, d) -> (rgb, sigma) of DESIGN.md §2: a
+// The static canonical radiance field F_static(x_c, d) -> (rgb, sigma) of docs/design.md §2: a
 // multiresolution hash grid over the aabb, a density MLP and a colour MLP fed with the density
 // MLP's output and the spherical-harmonics encoding of the view direction. It never receives the
 // expression beta (condition_dims = 0), which is what makes identity expression-invariant by

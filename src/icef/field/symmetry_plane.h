@@ -1,5 +1,5 @@
 // The face's left-right symmetry plane, fitted to the 68 iBUG landmarks in the world frame: the
-// few-shot prior of the trainer's symmetry loss (DESIGN.md §3's auxiliary terms) mirrors
+// few-shot prior of the trainer's symmetry loss (the auxiliary terms of docs/design.md §2.2) mirrors
 // canonical-space samples across it.
 //
 // Fit: every landmark pair that swaps under mirroring (jaw 0-16, brows 17-26, nose 31-35, eyes

@@ -12,7 +12,7 @@
 namespace icef {
 
 namespace {
-// The face model's open-mouth interior (DESIGN.md §2.1): an absorbing volume. Its density makes a
+// The face model's open-mouth interior (docs/design.md §2.1): an absorbing volume. Its density makes a
 // cavity sample opaque within about a hundredth of the aabb. Its colour is learned, three values
 // through a sigmoid, from the open mouths the training frames show (a frame that shows none passes
 // it no gradient, and the colour keeps its start, a dark red-brown mouth interior).

@@ -1,4 +1,4 @@
-// One method of DESIGN.md §2 = fields + renderer + losses. AvatarModel owns the parameter slab, the
+// One method of docs/design.md §2 = fields + renderer + losses. AvatarModel owns the parameter slab, the
 // static canonical field, the deformation field (absent for `nerface`), the region mask M, the
 // expression confidence and the occupancy grid, and provides the two things everything else needs:
 //   - TrainForwardBackward: loss terms of a batch of training rays, gradients accumulated into the
@@ -84,7 +84,7 @@ class AvatarModel {
   void Render(std::span<const Ray> rays, std::span<const float> beta, const Vec3f& background,
               const Executor& executor, RenderOutput* out, const OccupancyGrid* occupancy = nullptr) const;
 
-  // The occupancy for rendering expression beta (DESIGN.md §3): the training grid plus every cell
+  // The occupancy for rendering expression beta (docs/design.md §3): the training grid plus every cell
   // whose canonical point D_final(x, beta) holds density above the threshold inside the region the
   // visual hull allowed in training (the hull is looked up at the canonical point, through the
   // warp). Geometry a new expression moves outside the training silhouettes (an opened jaw) is

@@ -451,7 +451,7 @@ TEST(AvatarModelTest, ImportanceSamplingTrainsOnTheResampledSamples) {
 namespace icef {
 namespace {
 
-// No clipping of new expressions (DESIGN.md §3): geometry that an expression's warp moves out of
+// No clipping of new expressions (docs/design.md §3): geometry that an expression's warp moves out of
 // the training grid (and out of the visual hull carved in training) is rendered, because the
 // render-time grid is built for the rendered expression and the hull is looked up at canonical
 // points. The setup is a hand-made warp that shifts everything down by 0.2 * beta_0 (an "opening

@@ -1,4 +1,4 @@
-// The face-model prior P of DESIGN.md §2.1 as a DeformationPrior: the fitted face model's warp
+// The face-model prior P of docs/design.md §2.1 as a DeformationPrior: the fitted face model's warp
 // carried into the dataset's world frame, P(x, beta) = S^-1 W(S x, beta) with S = head_from_world,
 // and its mouth cavity, in the fit's expression style (the generic one unless the style was fitted
 // to the training frames' landmarks: model.prior_style).

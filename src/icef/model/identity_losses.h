@@ -1,4 +1,4 @@
-// The identity-preservation terms of DESIGN.md §2, on per-sample warp offsets g = D_phi(x) - x
+// The identity-preservation terms of docs/design.md §2, on per-sample warp offsets g = D_phi(x) - x
 // (world frame) and mask values M(x) at observation-space samples x. Offsets are measured in
 // half-extent units of the aabb (u = g / half_extent per axis), so the weights do not depend on
 // the scene's scale.

@@ -257,7 +257,7 @@ double SymmetryTerm::Evaluate(LossContext& ctx, double weight) {
   return loss;
 }
 
-// L_id and L_smooth (model/identity_losses.h) act on the learned residual R_phi only (DESIGN.md
+// L_id and L_smooth (model/identity_losses.h) act on the learned residual R_phi only (docs/design.md
 // §2.1): what the face-model prior knows is not penalised.
 double IdentityWeight(const LossContext& ctx, double lambda) {
   return ctx.residual_field && ctx.traits.identity_losses ? lambda : 0.0;

@@ -1,4 +1,4 @@
-// The training objective as a list of loss terms (DESIGN.md §2):
+// The training objective as a list of loss terms (docs/design.md §2):
 //   L = L_photo + lambda_mask L_mask + lambda_id L_id + lambda_smooth L_smooth
 //       + lambda_distortion L_dist + lambda_occlusion L_occ + lambda_symmetry L_sym
 //       + lambda_depth_prior L_depth.

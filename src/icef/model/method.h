@@ -1,4 +1,4 @@
-// The methods compared (DESIGN.md §2): one engine, one code path, differing only in these switches.
+// The methods compared (docs/design.md §2): one engine, one code path, differing only in these switches.
 //
 //   icef          deformation + static field + L_id + L_smooth + confidence-weighted warping
 //   icef-no-id    as icef with lambda_id = lambda_smooth = 0
@@ -9,7 +9,7 @@
 //   warp          deformation + static field only: no L_id, no L_smooth, no confidence
 //   nerface       no deformation: beta is concatenated into the static field's density-MLP input
 //                 (no canonical space, so the left-right symmetry prior does not apply to it)
-//   icef-prior    icef on the face-model prior (DESIGN.md §2.1): D = P + R_phi, L_id / L_smooth on
+//   icef-prior    icef on the face-model prior (docs/design.md §2.1): D = P + R_phi, L_id / L_smooth on
 //                 R_phi, confidence blends R_phi with its linearisation R_lin
 //   warp-prior    the face-model prior plus an unregularised residual (no L_id, no L_smooth, no
 //                 confidence)

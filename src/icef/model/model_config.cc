@@ -102,7 +102,7 @@ void BindFlatSpellings(ConfigSchema& s) {
 void ModelConfig::Bind(ConfigSchema& s) {
   s.String("method", &method,
            "method: icef, icef-no-id, icef-no-conf, icef-uniform, warp, nerface, icef-prior or warp-prior "
-           "(DESIGN.md §2, §2.1)");
+           "(docs/design.md §2, §2.1)");
   s.Block("static_field", [this](ConfigSchema& b) { BindStaticField(b, &static_field); });
   s.Block("deformation", [this](ConfigSchema& b) { BindDeformation(b, &deformation); });
   s.Block("confidence", [this](ConfigSchema& b) {

@@ -1,4 +1,4 @@
-// Prior-guided deformation (DESIGN.md §2.1) with a hand-made prior: D = P + R_phi, L_id and
+// Prior-guided deformation (docs/design.md §2.1) with a hand-made prior: D = P + R_phi, L_id and
 // L_smooth act on R_phi only, confidence blends R_phi only, the mouth cavity is dark and opaque,
 // and the training gradient still matches finite differences with a prior under the residual.
 #include <gtest/gtest.h>

@@ -1,7 +1,7 @@
 // The deformation network's building block: y = Mlp([freq(x), c]), a frequency-encoded input x
 // [n, d] concatenated with a conditioning vector c [n, dc] (the expression beta), then an Mlp
 // whose input width is D + dc (D = encoding output). Forward, backward (parameter gradients and
-// d/dx, d/dc) and the forward-mode JVP  jy = J_x y · vx + J_c y · vc  in one pass (DESIGN.md §2:
+// d/dx, d/dc) and the forward-mode JVP  jy = J_x y · vx + J_c y · vc  in one pass (docs/design.md §2:
 // the linearised deformation uses vc = beta - beta_n, vx = 0; a smoothness loss may use vx).
 // Residual outputs (D(x) = x + g) are the caller's business: it adds x (and vx) itself.
 #pragma once

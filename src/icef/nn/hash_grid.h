@@ -36,7 +36,7 @@ struct HashGridOptions {
   std::string ToString() const;
 };
 
-// DESIGN.md §7's reference configuration (instant-ngp's: T = 2^19, finest resolution 1024), which
+// docs/design.md §7's reference configuration (instant-ngp's: T = 2^19, finest resolution 1024), which
 // the reference model and the engine benchmarks use; the avatar's default grid is smaller.
 inline HashGridOptions ReferenceHashGridOptions() {
   HashGridOptions o;

@@ -23,7 +23,7 @@ TEST(HashGridLayoutTest, ReferenceConfigurationIsDenseAtLevelsZeroToFive) {
   EXPECT_EQ(g.levels[6].entries, 1 << 19);
   EXPECT_EQ(g.levels[6].offset, (g.levels[5].offset + g.levels[5].entries + 7) / 8 * 8);
   for (const HashGridLevel& lv : g.levels) EXPECT_EQ(lv.offset % 8, 0);
-  // About 11.4 M parameters (DESIGN.md §7).
+  // About 11.4 M parameters (docs/design.md §7).
   EXPECT_GT(g.num_params(), 11'300'000);
   EXPECT_LT(g.num_params(), 11'600'000);
 }

@@ -1,4 +1,4 @@
-// DESIGN.md §7's reference configuration composed from the nn pieces and fused per tile: the
+// docs/design.md §7's reference configuration composed from the nn pieces and fused per tile: the
 // workload of the benchmarks (bench/reference_bench.cc) and of the determinism test. It is not a
 // renderer: a simple stand-in loss replaces volume rendering.
 //

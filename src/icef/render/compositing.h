@@ -1,4 +1,4 @@
-// Volume compositing (DESIGN.md §3), forward and hand-written backward, templated on the scalar
+// Volume compositing (docs/design.md §3), forward and hand-written backward, templated on the scalar
 // type (float for training, double for gradient checks). Per ray with samples i = 0..n-1 (sorted
 // by t, as RaySamples lays them out):
 //   alpha_i = 1 - exp(-sigma_i dt_i),  T_i = prod_{j<i} (1 - alpha_j),  w_i = T_i alpha_i

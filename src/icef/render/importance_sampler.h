@@ -1,4 +1,4 @@
-// Importance resampling of training rays (DESIGN.md §3): a coarse pass of samples (SampleRays) and
+// Importance resampling of training rays (docs/design.md §3): a coarse pass of samples (SampleRays) and
 // the density at each tell where each ray's compositing weight lies; the fine samples subdivide the
 // coarse intervals in proportion to that weight, so the strata are finest at the surface, where a
 // stratum's depth decides how sharply the field learns the face, and coarse in empty space and

@@ -1,4 +1,4 @@
-// Occupancy grid in observation space (DESIGN.md §3): a dense density grid over the aabb whose
+// Occupancy grid in observation space (docs/design.md §3): a dense density grid over the aabb whose
 // occupied cells (density above a threshold, dilated) are where the sampler puts samples. The grid
 // knows no fields: Update() takes a caller-provided density query over a batch of world positions.
 // Covering all training expressions is the caller's job (query each expression and take the max).

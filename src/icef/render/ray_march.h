@@ -1,4 +1,4 @@
-// Front-to-back compositing in rounds, with early ray termination for inference (DESIGN.md §3).
+// Front-to-back compositing in rounds, with early ray termination for inference (docs/design.md §3).
 // CompositeForward needs every sample's density and colour before it composites; a renderer that
 // evaluates the fields only where they can still change a pixel marches instead:
 //

@@ -1,4 +1,4 @@
-// Ray samples within the ray/aabb interval (DESIGN.md §3), laid out for batched field evaluation:
+// Ray samples within the ray/aabb interval (docs/design.md §3), laid out for batched field evaluation:
 // all samples of all rays in one flat array, ray r owning [ray_offset[r], ray_offset[r] +
 // ray_count[r]). Samples are interval midpoints: sample i covers [t_i - dt_i/2, t_i + dt_i/2], the
 // intervals of one ray are contiguous and sorted by t (skipped samples leave gaps).

@@ -1,4 +1,4 @@
-// `icef synth`: a dataset in the DESIGN.md §4 format rendered from the procedural head of one
+// `icef synth`: a dataset in the docs/design.md §4 format rendered from the procedural head of one
 // identity. Training frames: K distinct views (yaw within ±max_yaw, pitch within ±max_pitch), each
 // with its own moderate random expression. Test frames: V held-out views, at every training
 // expression (tier "observed", delta = 0) and at novel expressions in the near, moderate and far

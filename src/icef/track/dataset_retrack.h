@@ -1,4 +1,4 @@
-// `icef track DATASET --keep-cameras --out NEW` (DESIGN.md §8): an existing dataset (NerFace's
+// `icef track DATASET --keep-cameras --out NEW` (docs/design.md §8): an existing dataset (NerFace's
 // 76-D Face2Face vectors, instant-ngp, any other expression space) re-expressed in the face model's
 // expression space, so the prior-guided methods apply to it. Its cameras, images, aabb, background
 // and test tiers stay; the face model is fitted to the 2D landmarks of every frame (dlib's,

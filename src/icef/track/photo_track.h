@@ -1,4 +1,4 @@
-// `icef track PHOTOS... --out DATASET` (DESIGN.md §8): a dataset in the §4 format from a handful of
+// `icef track PHOTOS... --out DATASET` (docs/design.md §8): a dataset in the §4 format from a handful of
 // photos of one person. Per photo: exactly one face and its 68 landmarks (dlib); one joint fit of
 // the face model (track_fit.h: shared identity, per-photo head pose and expression); a square crop
 // around the fitted head resampled to the dataset's resolution; a foreground mask (head_mask.h,

@@ -1,4 +1,4 @@
-// The tracker's image term (DESIGN.md §8): what the photometric refit of track_fit.h needs besides
+// The tracker's image term (docs/design.md §8): what the photometric refit of track_fit.h needs besides
 // the face model. Landmarks alone read expressions poorly (dlib's mouth and lid points barely move
 // on some faces); the photos themselves show them. The refit samples points of the subject's
 // neutral face (canonical space), carries each into every photo through the face model's warp at

@@ -1,4 +1,4 @@
-// The tracker's fit (DESIGN.md §8): the face model fitted to the 2D landmarks of several images of
+// The tracker's fit (docs/design.md §8): the face model fitted to the 2D landmarks of several images of
 // one person at once. Identity (the shape scales) is shared; each image gets its own expression
 // weights (in [0, max_expression]) and either its own head pose (photos: nothing is known of the
 // cameras but their intrinsics) or, with known cameras (`icef track --keep-cameras`), one
