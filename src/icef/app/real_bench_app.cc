@@ -12,6 +12,7 @@
 #include "icef/core/progress.h"
 #include "icef/data/dataset.h"
 #include "icef/data/frame_coverage.h"
+#include "icef/eval/bench_protocol.h"
 #include "icef/eval/face_identity.h"
 #include "icef/eval/lpips.h"
 #include "icef/eval/real_protocol.h"
@@ -190,20 +191,7 @@ void RealBenchOptions::ApplyQuick() {
   resolution = 64;
   steps = 20;
   time_budget_seconds = 0;
-  const std::vector<std::string> tiny = {"model.static_field.grid.num_levels=6",
-                                         "model.static_field.grid.log2_table_size=12",
-                                         "model.static_field.grid.finest_resolution=64",
-                                         "model.static_field.density_hidden=32",
-                                         "model.static_field.color_hidden=[32]",
-                                         "model.deformation.hidden=[32, 32]",
-                                         "model.sampler.num_samples=24",
-                                         "model.occupancy.resolution=32",
-                                         "train.batch_rays=512",
-                                         "train.depth_prior_view_rays=64",
-                                         "train.anneal_steps=10",
-                                         "train.occupancy_warmup=16",
-                                         "train.occupancy_every=8",
-                                         "train.log_every=10"};
+  const std::vector<std::string> tiny = eval::TinyModelOverrides();
   overrides.insert(overrides.begin(), tiny.begin(), tiny.end());
 }
 

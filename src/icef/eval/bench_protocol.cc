@@ -21,6 +21,23 @@ namespace fs = std::filesystem;
 
 namespace icef::eval {
 
+std::vector<std::string> TinyModelOverrides() {
+  return {"model.static_field.grid.num_levels=6",
+          "model.static_field.grid.log2_table_size=12",
+          "model.static_field.grid.finest_resolution=64",
+          "model.static_field.density_hidden=32",
+          "model.static_field.color_hidden=[32]",
+          "model.deformation.hidden=[32, 32]",
+          "model.sampler.num_samples=24",
+          "model.occupancy.resolution=32",
+          "train.batch_rays=512",
+          "train.depth_prior_view_rays=64",  // the default's 1/8 of batch_rays
+          "train.anneal_steps=10",
+          "train.occupancy_warmup=16",
+          "train.occupancy_every=8",
+          "train.log_every=10"};
+}
+
 void BenchOptions::ApplyQuick() {
   identities = 1;
   ks = {3};
@@ -31,20 +48,7 @@ void BenchOptions::ApplyQuick() {
   steps = 20;
   time_budget_seconds = 0;
   // A tiny model (the user's --set overrides still come after these).
-  const std::vector<std::string> tiny = {"model.static_field.grid.num_levels=6",
-                                         "model.static_field.grid.log2_table_size=12",
-                                         "model.static_field.grid.finest_resolution=64",
-                                         "model.static_field.density_hidden=32",
-                                         "model.static_field.color_hidden=[32]",
-                                         "model.deformation.hidden=[32, 32]",
-                                         "model.sampler.num_samples=24",
-                                         "model.occupancy.resolution=32",
-                                         "train.batch_rays=512",
-                                         "train.depth_prior_view_rays=64",  // the default's 1/8 of batch_rays
-                                         "train.anneal_steps=10",
-                                         "train.occupancy_warmup=16",
-                                         "train.occupancy_every=8",
-                                         "train.log_every=10"};
+  const std::vector<std::string> tiny = TinyModelOverrides();
   overrides.insert(overrides.begin(), tiny.begin(), tiny.end());
 }
 

@@ -1,4 +1,4 @@
-// The whole benchmark of DESIGN.md §6 (`icef bench`): for each identity seed x K x method,
+// The whole benchmark of docs/design.md §6 (`icef bench`): for each identity seed x K x method,
 // synthesise the dataset (once per identity x K, cached in OUT/data/), train with the same budget,
 // evaluate (eval/evaluate.h) and write OUT/runs/<id>_k<K>_<method>/metrics.json; then aggregate
 // into OUT/report.md + report.json + plots (eval/report.h). Resumable: a run whose metrics.json
@@ -97,6 +97,9 @@ struct BenchOptions {
   std::string ToString() const;
   Json ToJson() const;  // what report.md / bench.json show (no paths)
 };
+
+// The --quick bench's tiny model, as "section.key=value" overrides (seconds a run, for CI).
+std::vector<std::string> TinyModelOverrides();
 
 // Parses "i/n" (0 <= i < n).
 Status ParseShard(const std::string& text, int* index, int* count);

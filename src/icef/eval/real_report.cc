@@ -8,6 +8,7 @@
 #include <set>
 #include <sstream>
 
+#include "icef/eval/report.h"
 #include "icef/io/atomic_file.h"
 #include "icef/io/image.h"
 
@@ -22,12 +23,6 @@ std::string Fmt(const std::optional<double>& v, const char* format) {
   char buf[32];
   std::snprintf(buf, sizeof buf, format, *v);
   return buf;
-}
-
-std::string ShellQuote(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
 }
 
 std::string LatexEscape(const std::string& s) {
@@ -101,7 +96,7 @@ Result<std::vector<std::string>> WriteRealPlots(const fs::path& dir, const std::
   std::error_code ec;
   fs::create_directories(plot_dir, ec);
   if (ec) return Status::Error(plot_dir.string() + ": cannot create directory: " + ec.message());
-  const bool have_gnuplot = std::system("command -v gnuplot >/dev/null 2>&1") == 0;
+  const bool have_gnuplot = HaveGnuplot();
   const std::vector<std::pair<std::string, std::string>> metrics = {
       {"face_psnr", "face PSNR against the held-out photo (dB, higher = better)"},
       {"real_expr_gain", "real_expr_gain (1 = the tracked expression closes the gap, 0 = no change)"}};
@@ -135,12 +130,7 @@ Result<std::vector<std::string>> WriteRealPlots(const fs::path& dir, const std::
        << plot.str() << "unset output\n";
     ICEF_RETURN_IF_ERROR(WriteFileAtomic(plot_dir / (metric + ".gp"), gp.str()));
     if (!have_gnuplot) continue;
-    const std::string cmd = "cd " + ShellQuote(plot_dir.string()) + " && gnuplot " + ShellQuote(metric + ".gp") +
-                            " >" + ShellQuote(metric + ".log") + " 2>&1";
-    if (std::system(cmd.c_str()) != 0)
-      return Status::Error((plot_dir / (metric + ".gp")).string() + ": gnuplot failed (see " +
-                           (plot_dir / (metric + ".log")).string() + ")");
-    fs::remove(plot_dir / (metric + ".log"), ec);
+    ICEF_RETURN_IF_ERROR(RunGnuplot(plot_dir, metric));
     pngs.push_back("plots/" + metric + ".png");
   }
   if (!have_gnuplot && note) *note = "Plots not drawn: gnuplot is not installed; run `gnuplot X.gp` in plots/.";

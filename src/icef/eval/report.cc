@@ -975,6 +975,19 @@ std::string PlotCommands(const Aggregate& a, Metric m, const std::string& dat) {
 
 }  // namespace
 
+bool HaveGnuplot() { return std::system("command -v gnuplot >/dev/null 2>&1") == 0; }
+
+Status RunGnuplot(const fs::path& plot_dir, const std::string& name) {
+  const std::string cmd = "cd " + ShellQuote(plot_dir.string()) + " && gnuplot " + ShellQuote(name + ".gp") + " >" +
+                          ShellQuote(name + ".log") + " 2>&1";
+  if (std::system(cmd.c_str()) != 0)
+    return Status::Error((plot_dir / (name + ".gp")).string() + ": gnuplot failed (see " +
+                         (plot_dir / (name + ".log")).string() + ")");
+  std::error_code ec;
+  fs::remove(plot_dir / (name + ".log"), ec);
+  return Status::Ok();
+}
+
 Result<std::vector<std::string>> WritePlots(const fs::path& dir, const Aggregate& a, std::string* note) {
   std::vector<std::string> pngs;
   if (a.ks.empty() || a.methods.empty()) return pngs;
@@ -982,7 +995,7 @@ Result<std::vector<std::string>> WritePlots(const fs::path& dir, const Aggregate
   std::error_code ec;
   fs::create_directories(plot_dir, ec);
   if (ec) return Status::Error(plot_dir.string() + ": cannot create directory: " + ec.message());
-  const bool have_gnuplot = std::system("command -v gnuplot >/dev/null 2>&1") == 0;
+  const bool have_gnuplot = HaveGnuplot();
   const int width = 380 * static_cast<int>(a.ks.size()) + 80;
   for (Metric m : AllMetrics()) {
     bool any = false;
@@ -1023,12 +1036,7 @@ Result<std::vector<std::string>> WritePlots(const fs::path& dir, const Aggregate
        << commands << "unset output\n";
     ICEF_RETURN_IF_ERROR(WriteFileAtomic(plot_dir / (name + ".gp"), gp.str()));
     if (!have_gnuplot) continue;
-    const std::string cmd = "cd " + ShellQuote(plot_dir.string()) + " && gnuplot " + ShellQuote(name + ".gp") +
-                            " >" + ShellQuote(name + ".log") + " 2>&1";
-    if (std::system(cmd.c_str()) != 0)
-      return Status::Error((plot_dir / (name + ".gp")).string() + ": gnuplot failed (see " +
-                           (plot_dir / (name + ".log")).string() + ")");
-    fs::remove(plot_dir / (name + ".log"), ec);
+    ICEF_RETURN_IF_ERROR(RunGnuplot(plot_dir, name));
     pngs.push_back("plots/" + name + ".png");
   }
   if (!have_gnuplot && note)

@@ -1,4 +1,4 @@
-// The bench report (DESIGN.md §6): per tier, per method, per K, the mean and spread (sample std,
+// The bench report (docs/design.md §6): per tier, per method, per K, the mean and spread (sample std,
 // min, max) over identities of every metric, computed from the per-run metrics.json files; a
 // verdict on the paper's claim (does icef beat the baselines in the far tier on identity
 // similarity and PSNR?) derived from those numbers; written as report.md + report.json (+ report.tex,
@@ -96,7 +96,7 @@ struct Comparison {
   Json ToJson() const;
 };
 
-// The verdict rule (DESIGN.md §6): method A is better than B in a tier only where A reproduces at
+// The verdict rule (docs/design.md §6): method A is better than B in a tier only where A reproduces at
 // least kMinExpressionGain of the expression, its expr_gain is not lower than B's beyond the spread
 // over identities (max of the two sample stds, at least kGainTolerance), and it is better on both
 // id_distance_gt and PSNR. A face that does not move (expr_gain 0) therefore never wins.
@@ -207,6 +207,11 @@ Json ReportJson(const Aggregate& aggregate, const std::vector<RunRecord>& runs, 
 // line per method with std error bars) for each metric with values. Returns the PNG paths
 // relative to dir; when gnuplot is not installed, only the .dat/.gp files are written and
 // `*note` says so.
+// Whether gnuplot is on the PATH; RunGnuplot runs plot_dir/NAME.gp in plot_dir (its output to
+// NAME.log, removed on success; the error names the script and the log).
+bool HaveGnuplot();
+Status RunGnuplot(const std::filesystem::path& plot_dir, const std::string& name);
+
 Result<std::vector<std::string>> WritePlots(const std::filesystem::path& dir, const Aggregate& aggregate,
                                             std::string* note);
 
