@@ -114,4 +114,40 @@ while read -r step secs psnr; do
   fi
 done < <(awk -F'|' '{gsub(/ /, "", $2); gsub(/ /, "", $3); gsub(/ /, "", $4); print $2, $3, $4}' <<<"$rows")
 [ $missing -eq 0 ] && echo "readme_numbers_test: the training curve of docs/results/README.md matches $log_rel"
+
+# Real media: each table between <!-- real-results:begin REPORT.json --> and <!-- real-results:end -->
+# (icef bench --real's report.json, a path relative to the Markdown file) has columns source, K,
+# method, then keys of a run's means (face_psnr, face_psnr_nearest, real_expr_gain, ...); every
+# cell must equal that run's mean, rounded to the decimals shown.
+for doc in "$results" "$root/README.md"; do
+python3 - "$root" "$doc" <<'PY' || missing=1
+import json, os, re, sys
+root, doc_path = sys.argv[1], sys.argv[2]
+doc, base, name = open(doc_path).read(), os.path.dirname(doc_path), os.path.relpath(doc_path, root)
+errors, checked = [], 0
+for report_path, section in re.findall(r"<!-- real-results:begin (\S+) -->(.*?)<!-- real-results:end -->", doc, re.S):
+    runs = {(r["source"], r["k"], r["method"]): r for r in json.load(open(os.path.join(base, report_path)))["runs"]}
+    rows = [[c.strip() for c in line.strip().strip("|").split("|")] for line in section.splitlines() if line.startswith("|")]
+    header, body = rows[0], [r for r in rows[2:]]
+    if header[:3] != ["source", "K", "method"]:
+        errors.append(f"{name}: real-results table must start with source | K | method, got {header[:3]}")
+        continue
+    for row in body:
+        key = (row[0], int(row[1]), row[2].strip("`"))
+        if key not in runs:
+            errors.append(f"{name}: {key} is not a run of {report_path}")
+            continue
+        for col, cell in zip(header[3:], row[3:]):
+            want = runs[key]["metrics"]["means"][col.strip("`")]
+            digits = len(cell.split(".")[1]) if "." in cell else 0
+            if want is None or f"{want:.{digits}f}" != cell:
+                errors.append(f"{name}: {key} {col}: the table says {cell}, {report_path} has {want}")
+            checked += 1
+for e in errors:
+    print("readme_numbers_test:", e, file=sys.stderr)
+if checked and not errors:
+    print(f"readme_numbers_test: {checked} real-media numbers of {name} match their report")
+sys.exit(1 if errors else 0)
+PY
+done
 exit $missing

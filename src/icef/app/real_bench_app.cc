@@ -99,8 +99,12 @@ Result<Dataset> TrackSource(const RealBenchOptions& o, const fs::path& source, c
   if (IsDatasetDir(t.out)) {
     Result<std::string> have = ReadFile(dir / "track_options.txt");
     if (have.ok() && *have == stamp) return LoadDataset(t.out);
-    fs::remove_all(t.out, ec);
   }
+  // Tracked anew: the K datasets and runs made from an earlier tracking are stale.
+  fs::remove_all(dir, ec);
+  const fs::path runs = dir.parent_path().parent_path() / "runs";
+  for (const auto& entry : fs::directory_iterator(runs, ec))
+    if (entry.path().filename().string().rfind(dir.filename().string() + "_k", 0) == 0) fs::remove_all(entry.path(), ec);
   fs::create_directories(dir, ec);
   if (ec) return Status::Error(dir.string() + ": cannot create directory: " + ec.message());
   ICEF_RETURN_IF_ERROR(RunTrack(t, log).WithContext(source.string()));

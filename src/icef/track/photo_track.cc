@@ -260,6 +260,7 @@ const char* FocalSourceName(FocalSource source) {
 
 Status TrackOptions::Validate() const {
   if (resolution < 32 || resolution > 4096) return Status::Error("resolution must be in [32, 4096]");
+  if (num_train < 0) return Status::Error("the number of training frames must be >= 0");
   if (focal && !(*focal > 0 && std::isfinite(*focal))) return Status::Error("focal must be a finite number > 0");
   if (num_test < 0) return Status::Error("the number of test photos must be >= 0");
   if (!(crop_margin >= 1 && crop_margin <= 3)) return Status::Error("crop_margin must be in [1, 3]");
@@ -271,7 +272,8 @@ Status TrackOptions::Validate() const {
 std::string TrackOptions::ToString() const {
   std::ostringstream os;
   os << "TrackOptions(resolution=" << resolution << ", focal=" << (focal ? std::to_string(*focal) : "auto")
-     << ", num_test=" << num_test << ", skip_bad=" << skip_bad << ", crop_margin=" << crop_margin
+     << ", num_test=" << num_test << ", num_train=" << num_train << ", allow_blink=" << allow_blink
+     << ", skip_bad=" << skip_bad << ", crop_margin=" << crop_margin
      << ", silhouette_points=" << silhouette_points << ", segmentation=" << static_cast<int>(segmentation) << ", "
      << fit.ToString() << ", " << mask.ToString() << ")";
   return os.str();
