@@ -161,7 +161,10 @@ TEST(LossesTest, EachTermsGradientIsItsWeightTimesItsDerivative) {
     EXPECT_GT(std::abs(value), 0.0) << c.term;
     std::vector<double> added(g_on.size());
     for (size_t i = 0; i < added.size(); ++i) added[i] = double(g_on[i]) - double(g_off[i]);
-    const testing::ParameterGradientCheck check;
+    // The distortion term has kinks near many parameters, how many depends on the float sums'
+    // order (the host's GEMM kernel): 24 candidates leave at least min_checked smooth ones.
+    testing::ParameterGradientCheck check;
+    check.top_k = 24;
     const auto report = check.Run(store.params(), added, [&] {
       return on.*c.lambda * model->TrainForwardBackward(batch, on, 3, 0, ex).Get(c.term);
     });
