@@ -9,6 +9,7 @@ PACKAGES=(
   libpng-dev libjpeg62-turbo-dev zlib1g-dev  # image reading (libpng, libjpeg-turbo)
   libgtest-dev libgmock-dev libbenchmark-dev
   libceres-dev  # the face-model fit (Ceres)
+  libnanoflann-dev  # closest points on the face model's mesh (the volumetric prior warp)
   libopencv-imgproc-dev libexif-dev  # icef track: GrabCut masks, crops (OpenCV); EXIF focal lengths
   libavformat-dev libavcodec-dev libswscale-dev libavutil-dev  # icef track: video input; icef render --video
   python3-numpy python3-pil  # scripts/track_eval.py (tracking against synthetic truth; integration.track_test)

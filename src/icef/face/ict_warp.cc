@@ -1,0 +1,416 @@
+#include "icef/face/ict_warp.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <nanoflann.hpp>
+#include <sstream>
+#include <string_view>
+
+namespace icef::face {
+
+namespace {
+
+// The parts of the warp's surface (ict_warp.h says why these).
+constexpr std::string_view kSurfaceParts[] = {
+    "face",  "head_neck",   "mouth_socket", "eye_socket_left", "eye_socket_right", "gums_tongue",
+    "teeth", "sclera_left", "iris_left",    "sclera_right",    "iris_right"};
+
+// Most KD-tree points per triangle edge (a triangle gets at most kMaxSubdivisions^2).
+constexpr int kMaxSubdivisions = 64;
+
+using Corners = std::array<Vec3f, 3>;
+
+Corners TriangleCorners(const std::vector<Vec3f>& mesh, const std::array<uint32_t, 3>& t) {
+  return {mesh[t[0]], mesh[t[1]], mesh[t[2]]};
+}
+
+Vec3f AtBarycentric(const Corners& c, const Vec3f& b) { return b[0] * c[0] + b[1] * c[1] + b[2] * c[2]; }
+
+// The farthest corner's distance from the centroid: every point of the triangle is this close to it.
+float CentroidRadius(const Corners& c) {
+  const Vec3f centroid = (c[0] + c[1] + c[2]) / 3.f;
+  return std::max({(c[0] - centroid).norm(), (c[1] - centroid).norm(), (c[2] - centroid).norm()});
+}
+
+// Barycentric coordinates of the point of triangle c closest to p (Ericson, Real-Time Collision
+// Detection, 5.1.5: Voronoi regions of the corners, then of the edges, else the interior).
+Vec3f ClosestBarycentric(const Vec3f& p, const Corners& c) {
+  const Vec3f ab = c[1] - c[0], ac = c[2] - c[0], ap = p - c[0];
+  const float d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return {1, 0, 0};
+  const Vec3f bp = p - c[1];
+  const float d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return {0, 1, 0};
+  const float vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) {
+    const float v = d1 / (d1 - d3);
+    return {1 - v, v, 0};
+  }
+  const Vec3f cp = p - c[2];
+  const float d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return {0, 0, 1};
+  const float vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) {
+    const float w = d2 / (d2 - d6);
+    return {1 - w, 0, w};
+  }
+  const float va = d3 * d6 - d5 * d4;
+  if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) {
+    const float w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    return {0, 1 - w, w};
+  }
+  const float sum = va + vb + vc;
+  if (!(sum > 0)) {  // degenerate (no area): the nearest corner
+    const float e[3] = {ap.squaredNorm(), bp.squaredNorm(), cp.squaredNorm()};
+    const int k = static_cast<int>(std::min_element(e, e + 3) - e);
+    return Vec3f::Unit(k);
+  }
+  const float v = vb / sum, w = vc / sum;
+  return {1 - v - w, v, w};
+}
+
+// An orthonormal frame of a triangle (first edge, in-plane perpendicular, face normal) and the
+// in-plane coordinates of its two edges from corner 0 (columns); false when degenerate.
+bool TriangleFrame(const Corners& c, Mat3f* frame, Eigen::Matrix2f* edges) {
+  const Vec3f e1 = c[1] - c[0], e2 = c[2] - c[0], n = e1.cross(e2);
+  const float l1 = e1.norm(), ln = n.norm();
+  if (!(l1 > 0 && ln > 0)) return false;
+  const Vec3f t1 = e1 / l1, nn = n / ln, t2 = nn.cross(t1);
+  frame->col(0) = t1;
+  frame->col(1) = t2;
+  frame->col(2) = nn;
+  *edges << l1, e2.dot(t1), 0, e2.dot(t2);
+  return true;
+}
+
+// The rotation carrying triangle `from` onto `to` as a quaternion (x, y, z, w), w >= 0: face normal
+// onto face normal and, in the plane, the rotation part (polar decomposition) of the triangle's 2D
+// affine map. The identity, exactly, when the triangles are equal or either is degenerate.
+Vec4f TriangleRotation(const Corners& from, const Corners& to) {
+  const Vec4f identity(0, 0, 0, 1);
+  Mat3f frame_from, frame_to;
+  Eigen::Matrix2f edges_from, edges_to;
+  if (from == to || !TriangleFrame(from, &frame_from, &edges_from) ||
+      !TriangleFrame(to, &frame_to, &edges_to))
+    return identity;
+  const Eigen::Matrix2f a = edges_to * edges_from.inverse();
+  const float angle = std::atan2(a(1, 0) - a(0, 1), a(0, 0) + a(1, 1));
+  Mat3f in_plane = Mat3f::Identity();
+  in_plane.topLeftCorner<2, 2>() << std::cos(angle), -std::sin(angle), std::sin(angle), std::cos(angle);
+  const Vec4f q = Eigen::Quaternionf(Mat3f(frame_to * in_plane * frame_from.transpose())).coeffs();
+  return q[3] < 0 ? Vec4f(-q) : q;
+}
+
+// The rotation of a sum of same-hemisphere quaternions: normalised, and the identity exactly when the
+// sum has no vector part (a sum of identities).
+Mat3f RotationOfSum(const Vec4f& q) {
+  if (q.head<3>() == Vec3f::Zero()) return Mat3f::Identity();
+  const Vec4f n = q.normalized();
+  return Eigen::Quaternionf(n[3], n[0], n[1], n[2]).toRotationMatrix();
+}
+
+// 1 up to inner, a smoothstep down to 0 at outer, 0 beyond.
+float Falloff(float distance, float inner, float outer) {
+  if (distance <= inner) return 1.f;
+  if (distance >= outer) return 0.f;
+  const float s = (outer - distance) / (outer - inner);
+  return s * s * (3.f - 2.f * s);
+}
+
+}  // namespace
+
+Status IctWarpOptions::Validate() const {
+  if (!std::isfinite(inner_radius) || !(inner_radius >= 0))
+    return Status::Error("inner_radius must be a finite number >= 0 (cm), got " +
+                         std::to_string(inner_radius));
+  if (!std::isfinite(outer_radius) || !(outer_radius > inner_radius))
+    return Status::Error("outer_radius must be a finite number > inner_radius (cm), got " +
+                         std::to_string(outer_radius));
+  if (!std::isfinite(tree_point_spacing) || !(tree_point_spacing >= 0.01f))
+    return Status::Error("tree_point_spacing must be a finite number >= 0.01 (cm), got " +
+                         std::to_string(tree_point_spacing));
+  return Status::Ok();
+}
+
+std::string IctWarpOptions::ToString() const {
+  std::ostringstream os;
+  os << "IctWarpOptions(inner_radius=" << inner_radius << ", outer_radius=" << outer_radius
+     << ", tree_point_spacing=" << tree_point_spacing << ")";
+  return os.str();
+}
+
+std::string IctWarpClosest::ToString() const {
+  std::ostringstream os;
+  os << "IctWarpClosest(triangle=" << triangle << ", barycentric=[" << barycentric[0] << ", "
+     << barycentric[1] << ", " << barycentric[2] << "], distance=" << distance << ")";
+  return os.str();
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// IctWarp
+
+Result<IctWarp> IctWarp::Create(const IctModel& model, std::span<const float> identity,
+                                const IctWarpOptions& options) {
+  ICEF_RETURN_IF_ERROR(options.Validate().WithContext("IctWarpOptions"));
+  if (identity.size() > static_cast<size_t>(model.num_identities()))
+    return Status::Error(std::to_string(identity.size()) + " identity coefficients for a model with " +
+                         std::to_string(model.num_identities()));
+  std::vector<bool> on_surface(model.part_names().size(), false);
+  for (std::string_view part : kSurfaceParts) {
+    const int index = model.PartIndex(part);
+    if (index < 0)
+      return Status::Error(model.path().string() + ": the face model has no part '" + std::string(part) +
+                           "'");
+    on_surface[index] = true;
+  }
+  IctWarp warp;
+  warp.model_ = &model;
+  warp.options_ = options;
+  warp.neutral_ = model.Mesh(identity, {});
+  const std::vector<uint8_t>& labels = model.part_labels();
+  for (const auto& t : model.triangles())
+    if (on_surface[labels[t[0]]] && on_surface[labels[t[1]]] && on_surface[labels[t[2]]])
+      warp.triangles_.push_back(t);
+  return warp;
+}
+
+PosedIctWarp IctWarp::Pose(std::span<const float> expression) const {
+  return PosedIctWarp(*this, expression);
+}
+
+std::string IctWarp::ToString() const {
+  std::ostringstream os;
+  os << "IctWarp(triangles=" << triangles_.size() << " of " << model_->triangles().size() << ", "
+     << options_.ToString() << ")";
+  return os.str();
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// PosedIctWarp
+
+// The KD-tree's points on the posed surface, and nanoflann's dataset interface to them. Heap-held:
+// the index refers to it.
+struct PosedIctWarp::Tree {
+  using Index =
+      nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, Tree>, Tree, 3, uint32_t>;
+  struct Point {
+    Vec3f position;     // head frame, cm
+    uint32_t triangle;  // the surface triangle it lies on
+    float cover;        // cm: its sub-triangle lies this close to it
+  };
+  std::vector<Point> points;  // in the index's leaf order once built (Build)
+  std::unique_ptr<Index> index;
+
+  size_t kdtree_get_point_count() const { return points.size(); }
+  float kdtree_get_pt(uint32_t i, size_t dim) const {
+    return points[i].position[static_cast<Eigen::Index>(dim)];
+  }
+  template <class Box>
+  bool kdtree_get_bbox(Box&) const {
+    return false;
+  }
+
+  // Builds the index, then stores the points in its leaf order (and makes its permutation the
+  // identity): a leaf's points are then read from consecutive memory.
+  void Build() {
+    index = std::make_unique<Index>(3, *this, nanoflann::KDTreeSingleIndexAdaptorParams(10));
+    std::vector<Point> ordered(points.size());
+    for (size_t i = 0; i < points.size(); ++i) {
+      ordered[i] = points[index->vAcc[i]];
+      index->vAcc[i] = static_cast<uint32_t>(i);
+    }
+    points = std::move(ordered);
+  }
+};
+
+namespace {
+
+// A nanoflann result set that finds the closest triangle within outer_radius. Each KD-tree point
+// found hands over its triangle unless |x - point| - cover rules it out; the triangle's exact
+// distance is computed; the search radius shrinks to (best distance + largest cover), within which
+// lies a point of every triangle closer than the best one.
+class ClosestTriangleSearch {
+ public:
+  using DistanceType = float;
+  using IndexType = uint32_t;
+
+  ClosestTriangleSearch(const Vec3f& x, const std::vector<Vec3f>& mesh,
+                        const std::vector<std::array<uint32_t, 3>>& triangles, const PosedIctWarp::Tree& tree,
+                        float max_cover, float outer)
+      : x_(x),
+        mesh_(mesh),
+        triangles_(triangles),
+        tree_(tree),
+        max_cover_(max_cover),
+        limit_(outer),
+        outer_(outer) {
+    SetLimit(outer);
+  }
+
+  bool full() const { return true; }
+  float worstDist() const { return radius_sq_; }
+  bool addPoint(float distance_sq, uint32_t point) {
+    const PosedIctWarp::Tree::Point& found = tree_.points[point];
+    const uint32_t t = found.triangle;
+    if (t == last_) return true;  // the points of a triangle come in runs
+    if (std::sqrt(distance_sq) - found.cover > Margin(limit_)) return true;
+    last_ = t;
+    const Corners corners = TriangleCorners(mesh_, triangles_[t]);
+    const Vec3f b = ClosestBarycentric(x_, corners);
+    const float d_sq = (x_ - AtBarycentric(corners, b)).squaredNorm();
+    if (d_sq < best_sq_ || (d_sq == best_sq_ && static_cast<int32_t>(t) < best_.triangle)) {
+      best_sq_ = d_sq;
+      best_.triangle = static_cast<int32_t>(t);
+      best_.barycentric = b;
+      SetLimit(std::sqrt(d_sq));
+    }
+    return true;
+  }
+
+  IctWarpClosest Result() const {
+    if (best_.triangle < 0 || !(std::sqrt(best_sq_) < outer_)) return {};
+    IctWarpClosest result = best_;
+    result.distance = std::sqrt(best_sq_);
+    return result;
+  }
+
+ private:
+  // A relative and an absolute margin over float rounding: a triangle as close as the best one up to
+  // rounding is still evaluated, so the smallest (distance, index) wins whatever the visiting order.
+  static float Margin(float distance) { return distance * (1.f + 1e-5f) + 1e-5f; }
+  void SetLimit(float distance) {
+    limit_ = std::min(distance, outer_);
+    const float radius = Margin(limit_ + max_cover_);
+    radius_sq_ = radius * radius;
+  }
+
+  const Vec3f& x_;
+  const std::vector<Vec3f>& mesh_;
+  const std::vector<std::array<uint32_t, 3>>& triangles_;
+  const PosedIctWarp::Tree& tree_;
+  const float max_cover_;
+  float limit_, radius_sq_ = 0;
+  const float outer_;
+  uint32_t last_ = UINT32_MAX;
+  float best_sq_ = std::numeric_limits<float>::infinity();
+  IctWarpClosest best_;
+};
+
+// Per vertex of the surface, the area-weighted sum of its triangles' rotations from `from` to `to`
+// (quaternions, w >= 0; summed in triangle order), normalised; (0, 0, 0, 1) elsewhere.
+std::vector<Vec4f> VertexRotations(const std::vector<Vec3f>& from, const std::vector<Vec3f>& to,
+                                   const std::vector<std::array<uint32_t, 3>>& triangles) {
+  std::vector<Vec4f> sums(from.size(), Vec4f::Zero());
+  for (const auto& t : triangles) {
+    const Corners c = TriangleCorners(from, t);
+    const Vec4f q = TriangleRotation(c, TriangleCorners(to, t));
+    const float area = 0.5f * (c[1] - c[0]).cross(c[2] - c[0]).norm();
+    for (uint32_t v : t) sums[v] += area * q;
+  }
+  for (Vec4f& q : sums) {
+    if (q.head<3>() == Vec3f::Zero())
+      q = Vec4f(0, 0, 0, 1);  // all identities, or off the surface
+    else
+      q.normalize();
+  }
+  return sums;
+}
+
+}  // namespace
+
+PosedIctWarp::PosedIctWarp(const IctWarp& warp, std::span<const float> expression)
+    : warp_(&warp),
+      expression_(expression.begin(), expression.end()),
+      posed_(warp.neutral_),
+      tree_(std::make_unique<Tree>()) {
+  const IctModel& model = *warp.model_;
+  ICEF_CHECK(expression.size() <= static_cast<size_t>(model.num_expressions()),
+             std::to_string(expression.size()) + " expression weights for " +
+                 std::to_string(model.num_expressions()) + " blendshapes");
+  for (size_t e = 0; e < expression.size(); ++e) {
+    ICEF_CHECK(std::isfinite(expression[e]), "expression weight " + std::to_string(e) + " is not finite");
+    if (expression[e] == 0.f) continue;
+    const std::span<const Vec3f> delta = model.ExpressionDelta(static_cast<int>(e));
+    for (size_t v = 0; v < posed_.size(); ++v) posed_[v] += expression[e] * delta[v];
+  }
+  vertex_rotations_ = VertexRotations(posed_, warp.neutral_, warp.triangles_);
+  // KD-tree points: the centroids of an m x m subdivision of each triangle, in units of its edges
+  // from corner 0: the upright sub-triangles (i, j), (i+1, j), (i, j+1) and the inverted ones
+  // (i+1, j), (i, j+1), (i+1, j+1). A sub-triangle is the triangle scaled by 1/m (or its point
+  // reflection), so it lies within CentroidRadius / m of its centroid.
+  for (size_t t = 0; t < warp.triangles_.size(); ++t) {
+    const Corners c = TriangleCorners(posed_, warp.triangles_[t]);
+    const float radius = CentroidRadius(c);
+    const int m = std::clamp(static_cast<int>(std::ceil(radius / warp.options_.tree_point_spacing)), 1,
+                             kMaxSubdivisions);
+    for (int i = 0; i < m; ++i) {
+      for (int j = 0; i + j < m; ++j) {
+        for (float shift : {1.f / 3.f, 2.f / 3.f}) {
+          if (shift > 0.5f && i + j > m - 2) continue;
+          const float u = (i + shift) / static_cast<float>(m), v = (j + shift) / static_cast<float>(m);
+          const float cover = radius / static_cast<float>(m);
+          tree_->points.push_back(
+              {AtBarycentric(c, Vec3f(1.f - u - v, u, v)), static_cast<uint32_t>(t), cover});
+          max_cover_ = std::max(max_cover_, cover);
+        }
+      }
+    }
+  }
+  tree_->Build();
+}
+
+PosedIctWarp::PosedIctWarp(PosedIctWarp&&) noexcept = default;
+PosedIctWarp& PosedIctWarp::operator=(PosedIctWarp&&) noexcept = default;
+PosedIctWarp::~PosedIctWarp() = default;
+
+IctWarpClosest PosedIctWarp::Closest(const Vec3f& x) const {
+  ClosestTriangleSearch search(x, posed_, warp_->triangles_, *tree_, max_cover_,
+                               warp_->options_.outer_radius);
+  tree_->index->findNeighbors(search, x.data(), nanoflann::SearchParams());
+  return search.Result();
+}
+
+Vec3f PosedIctWarp::Offset(const Vec3f& x) const {
+  const IctWarpClosest closest = Closest(x);
+  if (closest.triangle < 0) return Vec3f::Zero();
+  const IctWarpOptions& options = warp_->options_;
+  const float weight = Falloff(closest.distance, options.inner_radius, options.outer_radius);
+  if (weight == 0.f) return Vec3f::Zero();
+  const std::array<uint32_t, 3>& triangle = warp_->triangles_[closest.triangle];
+  const Vec3f& b = closest.barycentric;
+  const Vec3f p = AtBarycentric(TriangleCorners(posed_, triangle), b);
+  const Vec3f p_canonical = AtBarycentric(TriangleCorners(warp_->neutral_, triangle), b);
+  const Mat3f rotation =
+      RotationOfSum(b[0] * vertex_rotations_[triangle[0]] + b[1] * vertex_rotations_[triangle[1]] +
+                    b[2] * vertex_rotations_[triangle[2]]);
+  const Vec3f along = x - p;
+  // mapped - x = (p' - p) + (R - I)(x - p), summed in this order: exactly 0 where nothing moves.
+  return weight * ((p_canonical - p) + (rotation * along - along));
+}
+
+void PosedIctWarp::Offsets(const Executor& executor, int64_t n, const float* positions,
+                           float* offsets) const {
+  ParallelForChunks(executor, n, BalancedChunk(n, 64, 4096), [&](int64_t begin, int64_t end) {
+    for (int64_t i = begin; i < end; ++i) {
+      const Vec3f offset = Offset(Eigen::Map<const Vec3f>(positions + 3 * i));
+      Eigen::Map<Vec3f>(offsets + 3 * i) = offset;
+    }
+  });
+}
+
+std::string PosedIctWarp::ToString() const {
+  std::ostringstream os;
+  os << "PosedIctWarp(expression={";
+  const std::vector<std::string>& names = warp_->model_->expression_names();
+  bool first = true;
+  for (size_t e = 0; e < expression_.size(); ++e) {
+    if (expression_[e] == 0.f) continue;
+    os << (first ? "" : ", ") << names[e] << "=" << expression_[e];
+    first = false;
+  }
+  os << "}, tree_points=" << tree_->points.size() << ", max_cover=" << max_cover_ << " cm)";
+  return os.str();
+}
+
+}  // namespace icef::face
