@@ -1,0 +1,365 @@
+#include "icef/model/ict_prior.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <random>
+
+namespace icef {
+namespace {
+
+using face::IctModel;
+
+// The model at DefaultPath(), loaded once; nullptr when the file is absent (tests skip).
+std::shared_ptr<const IctModel> Model() {
+  static const std::shared_ptr<const IctModel> model = []() -> std::shared_ptr<const IctModel> {
+    const std::filesystem::path path = IctModel::DefaultPath();
+    if (!std::filesystem::exists(path)) return nullptr;
+    Result<IctModel> loaded = IctModel::Load(path);
+    EXPECT_TRUE(loaded.ok()) << loaded.status().message();
+    return loaded.ok() ? std::make_shared<const IctModel>(std::move(loaded).value()) : nullptr;
+  }();
+  return model;
+}
+
+// The world frame of the tests: world_from_head has scale 0.01 (cm -> m), a rotation and a
+// translation; head_from_world is its inverse.
+face::Similarity HeadFromWorld() {
+  const Mat3d world_from_head_rotation = Eigen::AngleAxisd(0.5, Vec3d(1, 2, -1).normalized()).matrix();
+  const Vec3d world_from_head_translation(0.12, -0.3, 1.5);
+  face::Similarity s;
+  s.scale = 100.0;
+  s.rotation = world_from_head_rotation.transpose();
+  s.translation = -s.scale * (s.rotation * world_from_head_translation);
+  return s;
+}
+
+// The prior of the mean identity in that world frame, built once.
+const IctPrior* Prior() {
+  static const IctPrior* prior = []() -> const IctPrior* {
+    if (Model() == nullptr) return nullptr;
+    return IctPrior::Create(Model(), {}, HeadFromWorld()).value().release();
+  }();
+  return prior;
+}
+
+#define ICT_PRIOR_OR_SKIP(p)                                                              \
+  const IctPrior* p##_ptr = Prior();                                                      \
+  if (p##_ptr == nullptr) GTEST_SKIP() << "no face model at " << IctModel::DefaultPath(); \
+  const IctPrior& p = *p##_ptr
+
+std::vector<float> Weights(std::string_view text) {
+  auto w = face::ParseArkitExpression(*Model(), text);
+  EXPECT_TRUE(w.ok()) << w.status().message();
+  return w.ok() ? *w : std::vector<float>(Model()->num_expressions(), 0.f);
+}
+
+Vec3f ToWorld(const Vec3f& head) { return HeadFromWorld().ApplyInverse(head.cast<double>()).cast<float>(); }
+Vec3f ToHead(const Vec3f& world) { return HeadFromWorld().Apply(world.cast<double>()).cast<float>(); }
+std::vector<Vec3f> ToWorld(const std::vector<Vec3f>& head) {
+  std::vector<Vec3f> world;
+  for (const Vec3f& x : head) world.push_back(ToWorld(x));
+  return world;
+}
+
+// Head-frame points: every 7th face vertex of the neutral, jittered by up to 2 cm.
+std::vector<Vec3f> PointsNearTheFace(uint32_t seed) {
+  const IctModel& m = *Model();
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(-2.f, 2.f);
+  std::vector<Vec3f> points;
+  for (int v = 0; v < m.num_vertices(); v += 7)
+    if (m.part_labels()[v] == m.PartIndex("face"))
+      points.push_back(m.neutral()[v] + Vec3f(u(rng), u(rng), u(rng)));
+  return points;
+}
+
+// betas [n, B]: sample i has expressions[which[i]].
+std::vector<float> Rows(const std::vector<std::vector<float>>& expressions, const std::vector<int>& which) {
+  std::vector<float> betas;
+  for (int k : which) betas.insert(betas.end(), expressions[k].begin(), expressions[k].end());
+  return betas;
+}
+std::vector<float> Rows(const std::vector<float>& expression, size_t n) {
+  return Rows({expression}, std::vector<int>(n, 0));
+}
+
+struct Outputs {
+  std::vector<Vec3f> offsets, observed, canonical;
+  std::vector<uint8_t> inside;
+};
+
+// All the prior's outputs at world-frame points.
+Outputs Evaluate(const IctPrior& prior, const std::vector<Vec3f>& world, const std::vector<float>& betas,
+                 int threads = 2) {
+  const Executor executor(threads);
+  const auto n = static_cast<int64_t>(world.size());
+  Outputs out{std::vector<Vec3f>(world.size()), std::vector<Vec3f>(world.size()),
+              std::vector<Vec3f>(world.size()), std::vector<uint8_t>(world.size())};
+  prior.Offsets(executor, n, world.data()->data(), betas.data(), out.offsets.data()->data());
+  prior.Cavity(executor, n, world.data()->data(), betas.data(), out.inside.data());
+  EXPECT_TRUE(prior.Normals(executor, n, world.data()->data(), betas.data(), out.observed.data()->data(),
+                            out.canonical.data()->data()));
+  return out;
+}
+
+void ExpectSame(const Outputs& a, const Outputs& b) {
+  EXPECT_EQ(a.offsets, b.offsets);
+  EXPECT_EQ(a.inside, b.inside);
+  EXPECT_EQ(a.observed, b.observed);
+  EXPECT_EQ(a.canonical, b.canonical);
+}
+
+TEST(IctPrior, CreateRejectsBadArguments) {
+  if (Model() == nullptr) GTEST_SKIP() << "no face model at " << IctModel::DefaultPath();
+  face::Similarity s = HeadFromWorld();
+  s.scale = 0;
+  EXPECT_FALSE(IctPrior::Create(Model(), {}, s).ok());
+  s = HeadFromWorld();
+  s.rotation(0, 0) += 0.1;
+  EXPECT_FALSE(IctPrior::Create(Model(), {}, s).ok());
+  face::IctWarpOptions options;
+  options.outer_radius = 0.5f;
+  EXPECT_FALSE(IctPrior::Create(Model(), {}, HeadFromWorld(), options).ok());
+  EXPECT_FALSE(
+      IctPrior::Create(Model(), std::vector<float>(Model()->num_identities() + 1), HeadFromWorld()).ok());
+  EXPECT_FALSE(IctPrior::Create(nullptr, {}, HeadFromWorld()).ok());
+}
+
+TEST(IctPrior, IsTheIdentityAtRest) {
+  ICT_PRIOR_OR_SKIP(p);
+  EXPECT_EQ(p.expression_dims(), 53);
+  const std::vector<Vec3f> world = ToWorld(PointsNearTheFace(1));
+  // Negative weights act as 0.
+  std::vector<float> negative(53, 0.f);
+  negative[Model()->ExpressionIndex("jawOpen")] = -0.5f;
+  for (const std::vector<float>& rest : {std::vector<float>(53, 0.f), negative}) {
+    const Outputs out = Evaluate(p, world, Rows(rest, world.size()));
+    for (size_t i = 0; i < world.size(); ++i) {
+      ASSERT_EQ(out.offsets[i], Vec3f::Zero()) << i;
+      ASSERT_EQ(out.inside[i], 0) << i;
+      ASSERT_EQ(out.observed[i], out.canonical[i]) << i;
+    }
+  }
+  EXPECT_NE(p.ToString().find("head_from_world="), std::string::npos) << p.ToString();
+}
+
+TEST(IctPrior, PosedVerticesMapToTheNeutral) {
+  ICT_PRIOR_OR_SKIP(p);
+  const IctModel& m = *Model();
+  const std::vector<Vec3f> posed = m.Mesh({}, Weights("jawOpen=1"));
+  std::vector<int> vertices;
+  for (int v = 0; v < m.num_vertices() && vertices.size() < 200; v += 47)
+    if (m.part_labels()[v] == m.PartIndex("face")) vertices.push_back(v);
+  std::vector<Vec3f> world;
+  for (int v : vertices) world.push_back(ToWorld(posed[v]));
+  const Outputs out = Evaluate(p, world, Rows(Weights("jawOpen=1"), world.size()));
+  float worst = 0, moved = 0;
+  for (size_t i = 0; i < world.size(); ++i) {
+    worst = std::max(worst, (ToHead(world[i] + out.offsets[i]) - m.neutral()[vertices[i]]).norm());
+    moved = std::max(moved, (posed[vertices[i]] - m.neutral()[vertices[i]]).norm());
+  }
+  EXPECT_LT(worst, 1e-3f);  // head cm
+  EXPECT_GT(moved, 0.5f);
+}
+
+// Three expressions interleaved in runs of random lengths, shuffled: the same outputs as batches of
+// one expression each, for a prior that has seen them in another order, and for 1 or 2 threads.
+TEST(IctPrior, MixedBatchesMatchSingleExpressionBatches) {
+  ICT_PRIOR_OR_SKIP(p);
+  const std::vector<std::vector<float>> expressions = {
+      Weights("jawOpen=1"), Weights("mouthSmile_L=0.8,eyeBlink_R=1"), Weights("jawOpen=0.4,mouthFunnel=0.5")};
+  const std::vector<Vec3f> world = ToWorld(PointsNearTheFace(2));
+  std::mt19937 rng(3);
+  std::vector<int> which;
+  while (which.size() < world.size()) {
+    const int k = std::uniform_int_distribution<int>(0, 2)(rng);
+    const int run = std::uniform_int_distribution<int>(1, 40)(rng);
+    for (int j = 0; j < run && which.size() < world.size(); ++j) which.push_back(k);
+  }
+  const Outputs mixed = Evaluate(p, world, Rows(expressions, which), 2);
+  std::unique_ptr<IctPrior> fresh = IctPrior::Create(Model(), {}, HeadFromWorld()).value();
+  std::vector<Outputs> single(3);
+  for (int k : {2, 0, 1}) single[k] = Evaluate(*fresh, world, Rows(expressions[k], world.size()), 1);
+  Outputs expected = single[0];
+  int moved = 0, inside = 0;
+  for (size_t i = 0; i < world.size(); ++i) {
+    const Outputs& s = single[which[i]];
+    expected.offsets[i] = s.offsets[i];
+    expected.inside[i] = s.inside[i];
+    expected.observed[i] = s.observed[i];
+    expected.canonical[i] = s.canonical[i];
+    moved += s.offsets[i] != Vec3f::Zero();
+    inside += s.inside[i];
+  }
+  ExpectSame(mixed, expected);
+  ExpectSame(Evaluate(*fresh, world, Rows(expressions, which), 1), mixed);
+  EXPECT_GT(moved, static_cast<int>(world.size()) / 4);  // the test means something
+  EXPECT_GT(inside, 0);
+}
+
+// More distinct expressions in one batch than the cache holds: each as the posed warp gives it.
+TEST(IctPrior, MatchesThePosedWarpBeyondTheCacheCapacity) {
+  ICT_PRIOR_OR_SKIP(p);
+  std::vector<std::vector<float>> expressions;
+  std::vector<int> which;
+  for (int k = 0; k < IctPrior::kCacheCapacity + 2; ++k) {
+    expressions.push_back(Weights("jawOpen=" + std::to_string(0.05 * (k + 1)) + ",mouthSmile_R=0.3"));
+    for (int j = 0; j < 20; ++j) which.push_back(k);
+  }
+  const std::vector<Vec3f> head = PointsNearTheFace(4);
+  std::vector<Vec3f> world;
+  ASSERT_GE(head.size(), which.size());
+  for (size_t i = 0; i < which.size(); ++i) world.push_back(ToWorld(head[i]));
+  const Outputs first = Evaluate(p, world, Rows(expressions, which));
+  for (int k : {0, 9, IctPrior::kCacheCapacity + 1}) {
+    const face::PosedIctWarp posed = p.warp().Pose(expressions[k]);
+    for (int i = 20 * k; i < 20 * (k + 1); ++i) {
+      const Vec3f expected = ToWorld(head[i] + posed.Offset(head[i])) - world[i];
+      EXPECT_LT((first.offsets[i] - expected).norm(), 1e-6f) << i;
+    }
+  }
+  ExpectSame(Evaluate(p, world, Rows(expressions, which)), first);
+}
+
+// Points in the open mouth behind the parted lips are in the cavity; the cheek, the chin, points in
+// front of the mouth and between the lips, and the teeth are not; at rest nothing is.
+TEST(IctPrior, CavityIsTheOpenMouth) {
+  ICT_PRIOR_OR_SKIP(p);
+  const IctModel& m = *Model();
+  const std::vector<float> jaw = Weights("jawOpen=1");
+  const std::vector<Vec3f> lm = m.Landmarks(m.Mesh({}, jaw));
+  const Vec3f lips = 0.5f * (lm[62] + lm[66]);  // between the inner lips' midpoints
+  const std::vector<Vec3f> in = {lips + Vec3f(0, 0, -2), lips + Vec3f(0, 0, -3), lips + Vec3f(1, 0, -3)};
+  const Vec3f cheek = 0.5f * (lm[3] + lm[31]) + Vec3f(0, 0, 0.5f);
+  // The front of the upper incisors: the foremost upper-teeth vertex, 1 mm in front of it.
+  const std::vector<Vec3f> posed = m.Mesh({}, jaw);
+  int incisor = -1;
+  for (int v = 0; v < m.num_vertices(); ++v)
+    if (m.part_labels()[v] == m.PartIndex("teeth") && m.neutral()[v].y() > -4.f &&
+        (incisor < 0 || posed[v].z() > posed[incisor].z()))
+      incisor = v;
+  ASSERT_GE(incisor, 0);
+  const std::vector<Vec3f> out = {cheek, lm[8] + Vec3f(0, 0, 0.3f), lips + Vec3f(0, 0, 2), lips,
+                                  posed[incisor] + Vec3f(0, 0, 0.1f)};
+  std::vector<Vec3f> points = in;
+  points.insert(points.end(), out.begin(), out.end());
+  const Outputs open = Evaluate(p, ToWorld(points), Rows(jaw, points.size()));
+  for (size_t i = 0; i < points.size(); ++i)
+    EXPECT_EQ(open.inside[i], i < in.size() ? 1 : 0) << i << ": " << points[i].transpose();
+  const Outputs rest = Evaluate(p, ToWorld(points), Rows(std::vector<float>(53, 0.f), points.size()));
+  for (size_t i = 0; i < points.size(); ++i) EXPECT_EQ(rest.inside[i], 0) << i;
+  // Over a grid around the mouth, the cavity is a mouth-sized part of it and holds no face vertex.
+  std::vector<Vec3f> grid;
+  for (float x = -4; x <= 4; x += 0.5f)
+    for (float y = -10; y <= 0; y += 0.5f)
+      for (float z = 4; z <= 13; z += 0.5f) grid.push_back({x, y, z});
+  const Outputs g = Evaluate(p, ToWorld(grid), Rows(jaw, grid.size()));
+  const int count = static_cast<int>(std::count(g.inside.begin(), g.inside.end(), 1));
+  EXPECT_GT(count, 10);
+  EXPECT_LT(count, static_cast<int>(grid.size()) / 8);
+}
+
+// Area-weighted vertex normals of the warp's surface on mesh (0 off it).
+std::vector<Vec3f> VertexNormals(const face::IctWarp& warp, const std::vector<Vec3f>& mesh) {
+  std::vector<Vec3f> normals(mesh.size(), Vec3f::Zero());
+  for (const auto& t : warp.triangles()) {
+    const Vec3f n = (mesh[t[1]] - mesh[t[0]]).cross(mesh[t[2]] - mesh[t[0]]);
+    for (uint32_t v : t) normals[v] += n;
+  }
+  for (Vec3f& n : normals)
+    if (n.squaredNorm() > 0) n.normalize();
+  return normals;
+}
+
+TEST(IctPrior, NormalsAreThoseOfTheSurfaces) {
+  ICT_PRIOR_OR_SKIP(p);
+  const IctModel& m = *Model();
+  const std::vector<float> jaw = Weights("jawOpen=1");
+  const std::vector<Vec3f> posed = m.Mesh({}, jaw);
+  const std::vector<Vec3f> posed_normals = VertexNormals(p.warp(), posed);
+  const std::vector<Vec3f> neutral_normals = VertexNormals(p.warp(), m.neutral());
+  const int chin = m.landmark_vertices()[8], nose = m.landmark_vertices()[30];
+  const std::vector<Vec3f> points = {posed[chin] + 0.3f * posed_normals[chin],
+                                     posed[nose] + 0.3f * posed_normals[nose], Vec3f(0, 0, 40)};
+  const Outputs out = Evaluate(p, ToWorld(points), Rows(jaw, points.size()));
+  const Mat3f world_from_head = HeadFromWorld().rotation.transpose().cast<float>();
+  for (size_t i = 0; i < 2; ++i) {
+    EXPECT_NEAR(out.observed[i].norm(), 1.f, 1e-5f);
+    EXPECT_NEAR(out.canonical[i].norm(), 1.f, 1e-5f);
+  }
+  // The chin turns with the jaw: observed is the posed surface's normal, canonical the neutral's.
+  EXPECT_GT(out.observed[0].dot(world_from_head * posed_normals[chin]), 0.99f);
+  EXPECT_GT(out.canonical[0].dot(world_from_head * neutral_normals[chin]), 0.99f);
+  // The nose tip hardly moves: both are its normal, pointing forward.
+  EXPECT_GT(out.observed[1].dot(out.canonical[1]), 0.999f);
+  EXPECT_GT(out.observed[1].dot(world_from_head * Vec3f::UnitZ()), 0.8f);
+  // Far from the head: no surface, no normals.
+  EXPECT_EQ(out.observed[2], Vec3f::Zero());
+  EXPECT_EQ(out.canonical[2], Vec3f::Zero());
+}
+
+TEST(IctPrior, FitIctHeadFromWorldRoundTrips) {
+  if (Model() == nullptr) GTEST_SKIP() << "no face model at " << IctModel::DefaultPath();
+  const IctModel& m = *Model();
+  const face::Similarity truth = HeadFromWorld();
+  const std::vector<Vec3f> neutral = m.Landmarks(m.neutral());
+  std::vector<std::vector<Vec3f>> frames;
+  for (const char* expression : {"", "eyeBlink_L=1,mouthSmile_R=0.5", "jawOpen=0.5"}) {
+    const std::vector<Vec3f> head = m.Landmarks(m.Mesh({}, Weights(expression)));
+    frames.push_back(ToWorld(head));
+    Result<face::Similarity> fit = FitIctHeadFromWorld(m, {}, frames);
+    ASSERT_TRUE(fit.ok()) << fit.status().message();
+    // The first frame is the neutral: exact; expressions move the nose and eye corners by about a
+    // millimetre, so the fit moves by a fraction of that.
+    const double tolerance = frames.size() == 1 ? 1e-5 : 1e-2;
+    EXPECT_NEAR(fit->scale / truth.scale, 1.0, tolerance) << expression;
+    EXPECT_LT((fit->rotation - truth.rotation).norm(), tolerance) << expression;
+    const Vec3d nose = fit->Apply(frames[0][30].cast<double>());
+    EXPECT_LT((nose - neutral[30].cast<double>()).norm(), 10 * tolerance) << expression;  // cm
+  }
+  EXPECT_FALSE(FitIctHeadFromWorld(m, {}, {}).ok());
+  EXPECT_FALSE(FitIctHeadFromWorld(m, {}, {std::vector<Vec3f>(67, Vec3f::Zero())}).ok());
+  EXPECT_FALSE(FitIctHeadFromWorld(m, {}, {std::vector<Vec3f>(68, Vec3f::Zero())}).ok());
+}
+
+// Not an assertion: prints how long 100k points take with 3 distinct expressions (rays of 64 samples).
+TEST(IctPrior, Timing) {
+  if (Model() == nullptr) GTEST_SKIP() << "no face model at " << IctModel::DefaultPath();
+  std::unique_ptr<IctPrior> prior = IctPrior::Create(Model(), {}, HeadFromWorld()).value();
+  const std::vector<std::vector<float>> expressions = {Weights("jawOpen=0.6,mouthSmile_L=0.5"),
+                                                       Weights("eyeBlink_R=0.8,browInnerUp=0.3"),
+                                                       Weights("jawOpen=0.2")};
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(0.f, 1.f);
+  const Vec3f lo(-14.4f, -21.3f, -11.2f), hi(14.4f, 16.5f, 15.1f);
+  std::vector<Vec3f> world(100000);
+  std::vector<int> which(world.size());
+  for (size_t i = 0; i < world.size(); ++i) {
+    world[i] = ToWorld(lo + Vec3f(u(rng), u(rng), u(rng)).cwiseProduct(hi - lo));
+    which[i] = static_cast<int>((i / 64) % 3);
+  }
+  const std::vector<float> betas = Rows(expressions, which);
+  std::vector<float> offsets(3 * world.size());
+  std::vector<uint8_t> inside(world.size());
+  for (int threads : {1, 2}) {
+    for (const char* call : {"first (posing 3)", "cached"}) {
+      if (call[0] == 'f') prior = IctPrior::Create(Model(), {}, HeadFromWorld()).value();
+      const auto start = std::chrono::steady_clock::now();
+      prior->Offsets(Executor(threads), 100000, world.data()->data(), betas.data(), offsets.data());
+      const auto mid = std::chrono::steady_clock::now();
+      prior->Cavity(Executor(threads), 100000, world.data()->data(), betas.data(), inside.data());
+      const auto end = std::chrono::steady_clock::now();
+      std::printf(
+          "[ timing ] 100k points, 3 expressions, %d thread(s), %s: Offsets %.1f ms, Cavity %.1f ms\n",
+          threads, call, std::chrono::duration<double, std::milli>(mid - start).count(),
+          std::chrono::duration<double, std::milli>(end - mid).count());
+    }
+  }
+}
+
+}  // namespace
+}  // namespace icef
