@@ -4,7 +4,7 @@ BUILD_DIR ?= build
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
-.PHONY: all build tool deps demo test test-long bench clean sanitize fuzz fuzz-deps
+.PHONY: all build tool deps demo test test-long bench clean sanitize fuzz fuzz-deps format
 
 all: build
 
@@ -35,9 +35,14 @@ test-long: deps
 	@$(MAKE) --no-print-directory build
 	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) -L long
 
-# The benchmarks, then the same reference step in PyTorch on the same cores and the ratios
+# The benchmarks, then the same kernels (hash grid, MLPs) in PyTorch on the same cores and the ratios
 # (build/bench/results.json, build/bench/torch_reference.json).
 # Without PyTorch (it could not be installed) the comparison is skipped with a message.
+# clang-format (.clang-format: Google style, 110 columns) over every tracked C++ file; `make test`
+# checks it (ctest lint.format, scripts/check_format.sh).
+format:
+	git ls-files '*.h' '*.cc' | xargs clang-format -i
+
 bench: deps
 	@$(MAKE) --no-print-directory build
 	@mkdir -p $(BUILD_DIR)/bench

@@ -27,7 +27,8 @@ std::vector<Vec3f> FacePoints(int n) {
 
 face::ExpressionState State(const face::FaceModel& model, int which) {
   std::vector<float> beta(face::kNumExpressions, 0.f);
-  if (which == 1) beta[face::kJawOpen] = 0.5f, beta[face::kSmileLeft] = 0.4f, beta[face::kBrowRaiseRight] = 0.3f;
+  if (which == 1)
+    beta[face::kJawOpen] = 0.5f, beta[face::kSmileLeft] = 0.4f, beta[face::kBrowRaiseRight] = 0.3f;
   return model.Prepare(beta);
 }
 
@@ -44,8 +45,8 @@ void BM_FaceModelPoint(benchmark::State& state) {
       if constexpr (kind == 2) benchmark::DoNotOptimize(model.Normal(p, s));
     }
   }
-  state.counters["points/s"] =
-      benchmark::Counter(static_cast<double>(state.iterations()) * points.size(), benchmark::Counter::kIsRate);
+  state.counters["points/s"] = benchmark::Counter(static_cast<double>(state.iterations()) * points.size(),
+                                                  benchmark::Counter::kIsRate);
 }
 // The neutral surface's normals at many canonical points at once (the vectorised batch the prior's
 // shading uses), against BM_FaceModelNormal's one point at a time.
@@ -64,7 +65,12 @@ void BM_FaceModelCanonicalNormals(benchmark::State& state) {
 BENCHMARK(BM_FaceModelCanonicalNormals)->UseRealTime();
 
 BENCHMARK(BM_FaceModelPoint<0>)->Name("BM_FaceModelDistance")->ArgName("expr")->Arg(0)->Arg(1)->UseRealTime();
-BENCHMARK(BM_FaceModelPoint<1>)->Name("BM_FaceModelPriorWarp")->ArgName("expr")->Arg(0)->Arg(1)->UseRealTime();
+BENCHMARK(BM_FaceModelPoint<1>)
+    ->Name("BM_FaceModelPriorWarp")
+    ->ArgName("expr")
+    ->Arg(0)
+    ->Arg(1)
+    ->UseRealTime();
 BENCHMARK(BM_FaceModelPoint<2>)->Name("BM_FaceModelNormal")->ArgName("expr")->Arg(0)->Arg(1)->UseRealTime();
 
 }  // namespace

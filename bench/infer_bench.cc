@@ -37,7 +37,8 @@ void BM_FaceMeshGraph(benchmark::State& state) {
     benchmark::DoNotOptimize(out);
   }
   const double rate = static_cast<double>(state.iterations()) * flops;
-  state.counters["crops/s"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["crops/s"] =
+      benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
   state.counters["GFLOP/crop"] = flops / 1e9;
   state.counters["fraction_of_gemm"] = benchmark::Counter(rate / gemm, benchmark::Counter::kIsRate);
 }

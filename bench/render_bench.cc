@@ -11,10 +11,10 @@
 // up past the occupancy grid's warm-up (300 steps). Compare with BM_GemmFp32 of the same run (the machine's
 // matrix-multiply rate).
 #include <benchmark/benchmark.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <memory>
-#include <unistd.h>
 
 #include "icef/eval/evaluate.h"
 #include "icef/model/render_image.h"
@@ -62,8 +62,8 @@ icef::Status Train(Subject* s) {
       icef::TrainedModel deep,
       icef::LoadTrainedModel(dir / "model", icef::Executor(2), {"model.render.transmittance_eps=1e-4"}));
   s->deep = std::move(deep.model);
-  ICEF_ASSIGN_OR_RETURN(icef::TrainedModel sparse,
-                        icef::LoadTrainedModel(dir / "model", icef::Executor(2), {"model.render.sample_factor=1"}));
+  ICEF_ASSIGN_OR_RETURN(icef::TrainedModel sparse, icef::LoadTrainedModel(dir / "model", icef::Executor(2),
+                                                                          {"model.render.sample_factor=1"}));
   s->sparse = std::move(sparse.model);
   return icef::Status::Ok();
 }
@@ -93,19 +93,29 @@ void BM_RenderImage128(benchmark::State& state) {
   if (!s.error.empty()) return state.SkipWithError(s.error.c_str());
   const icef::Frame& frame = FarFrame(s);
   const icef::Executor executor(2);
-  const auto mode = state.range(0) == 1 ? icef::RenderOccupancyMode::kTraining : icef::RenderOccupancyMode::kExpression;
-  const icef::AvatarModel& model =
-      state.range(0) == 2 ? *s.deep : state.range(0) == 3 ? *s.sparse : s.trainer->model();
+  const auto mode =
+      state.range(0) == 1 ? icef::RenderOccupancyMode::kTraining : icef::RenderOccupancyMode::kExpression;
+  const icef::AvatarModel& model = state.range(0) == 2   ? *s.deep
+                                   : state.range(0) == 3 ? *s.sparse
+                                                         : s.trainer->model();
   int64_t samples = 0;
   for (auto _ : state) {
     const icef::RenderedImage img =
         icef::RenderImage(model, frame.camera, frame.expression, s.dataset.background, executor, mode);
     samples += img.samples_evaluated;
   }
-  state.counters["frames/s"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["frames/s"] =
+      benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
   state.counters["samples/frame"] = static_cast<double>(samples) / static_cast<double>(state.iterations());
 }
-BENCHMARK(BM_RenderImage128)->ArgName("variant")->Arg(0)->Arg(1)->Arg(2)->Arg(3)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_RenderImage128)
+    ->ArgName("variant")
+    ->Arg(0)
+    ->Arg(1)
+    ->Arg(2)
+    ->Arg(3)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 // A 256x256 frame of the same view (intrinsics scaled by 2).
 void BM_RenderImage256(benchmark::State& state) {
@@ -117,9 +127,11 @@ void BM_RenderImage256(benchmark::State& state) {
   const icef::Camera camera(k, frame.camera.world_from_cam());
   const icef::Executor executor(2);
   for (auto _ : state)
-    benchmark::DoNotOptimize(icef::RenderImage(s.trainer->model(), camera, frame.expression, s.dataset.background,
-                                               executor, icef::RenderOccupancyMode::kExpression));
-  state.counters["frames/s"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+    benchmark::DoNotOptimize(icef::RenderImage(s.trainer->model(), camera, frame.expression,
+                                               s.dataset.background, executor,
+                                               icef::RenderOccupancyMode::kExpression));
+  state.counters["frames/s"] =
+      benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_RenderImage256)->Unit(benchmark::kMillisecond)->UseRealTime();
 
@@ -215,7 +227,8 @@ void BM_EvalFrame(benchmark::State& state) {
   icef::Dataset one = s.dataset;
   one.test = {FarFrame(s)};
   const icef::Executor executor(2);
-  icef::Result<icef::eval::FaceIdentity> identity = icef::eval::FaceIdentity::Load(icef::eval::FaceIdentityOptions{});
+  icef::Result<icef::eval::FaceIdentity> identity =
+      icef::eval::FaceIdentity::Load(icef::eval::FaceIdentityOptions{});
   icef::eval::EvalNetworks networks;
   if (identity.ok()) networks.identity = &*identity;
   icef::eval::EvalOptions options;  // no out_dir: nothing written
@@ -224,8 +237,10 @@ void BM_EvalFrame(benchmark::State& state) {
         icef::eval::EvaluateModel(s.trainer->model(), one, options, networks, executor, nullptr);
     if (!result.ok()) return state.SkipWithError(result.status().message().c_str());
   }
-  state.counters["frames/s"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
-  state.SetLabel(identity.ok() ? "with face descriptors" : "without face descriptors (network not installed)");
+  state.counters["frames/s"] =
+      benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.SetLabel(identity.ok() ? "with face descriptors"
+                               : "without face descriptors (network not installed)");
 }
 BENCHMARK(BM_EvalFrame)->Unit(benchmark::kMillisecond)->UseRealTime();
 
@@ -235,7 +250,8 @@ void BM_RenderOccupancy(benchmark::State& state) {
   if (!s.error.empty()) return state.SkipWithError(s.error.c_str());
   const icef::Frame& frame = FarFrame(s);
   const icef::Executor executor(2);
-  for (auto _ : state) benchmark::DoNotOptimize(s.trainer->model().RenderOccupancy(frame.expression, executor));
+  for (auto _ : state)
+    benchmark::DoNotOptimize(s.trainer->model().RenderOccupancy(frame.expression, executor));
 }
 BENCHMARK(BM_RenderOccupancy)->Unit(benchmark::kMillisecond)->UseRealTime();
 

@@ -1,9 +1,9 @@
 // Ground-truth renderer throughput: one 128x128 frame (2x2 supersampling) of the procedural head,
 // neutral and with a moderate and a far expression, on 1 and 2 threads; plus a whole tiny dataset.
 #include <benchmark/benchmark.h>
+#include <unistd.h>
 
 #include <filesystem>
-#include <unistd.h>
 
 #include "icef/face/expression.h"
 #include "icef/synth/ground_truth_renderer.h"
@@ -15,9 +15,12 @@ using icef::face::kNumExpressions;
 
 std::vector<float> Expression(int which) {
   std::vector<float> beta(kNumExpressions, 0.f);
-  if (which == 1) beta[icef::face::kJawOpen] = 0.5f, beta[icef::face::kSmileLeft] = 0.4f, beta[icef::face::kBrowRaiseRight] = 0.3f;
+  if (which == 1)
+    beta[icef::face::kJawOpen] = 0.5f, beta[icef::face::kSmileLeft] = 0.4f,
+    beta[icef::face::kBrowRaiseRight] = 0.3f;
   if (which == 2)
-    for (int e : {icef::face::kJawOpen, icef::face::kSmileLeft, icef::face::kEyeCloseLeft, icef::face::kCheekPuff})
+    for (int e :
+         {icef::face::kJawOpen, icef::face::kSmileLeft, icef::face::kEyeCloseLeft, icef::face::kCheekPuff})
       beta[e] = 1.5f;
   return beta;
 }
@@ -33,9 +36,10 @@ void BM_SynthRenderFrame128(benchmark::State& state) {
   const icef::Executor executor(static_cast<int>(state.range(0)));
   const std::vector<float> beta = Expression(static_cast<int>(state.range(1)));
   for (auto _ : state) benchmark::DoNotOptimize(icef::synth::RenderGroundTruth(head, camera, beta, executor));
-  state.counters["frames/s"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
-  state.counters["rays/s"] =
-      benchmark::Counter(static_cast<double>(state.iterations()) * 128 * 128 * 4, benchmark::Counter::kIsRate);
+  state.counters["frames/s"] =
+      benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["rays/s"] = benchmark::Counter(static_cast<double>(state.iterations()) * 128 * 128 * 4,
+                                                benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_SynthRenderFrame128)
     ->ArgNames({"threads", "expr"})
@@ -49,7 +53,8 @@ BENCHMARK(BM_SynthRenderFrame128)
 // A K=5, V=3, 128x128 dataset (41 images + landmarks + JSON) on 2 threads.
 void BM_SynthDataset(benchmark::State& state) {
   icef::synth::SynthOptions options;
-  options.out_dir = std::filesystem::temp_directory_path() / ("icef_synth_bench_" + std::to_string(::getpid()));
+  options.out_dir =
+      std::filesystem::temp_directory_path() / ("icef_synth_bench_" + std::to_string(::getpid()));
   const icef::Executor executor(2);
   for (auto _ : state) {
     const icef::Status status = icef::synth::SynthesizeDataset(options, executor);

@@ -6,9 +6,9 @@
 // (train/model_io.cc), in the same order: trainer section -> ParseTrainerSection (step range,
 // config hash), config JSON -> RunConfig (strict) -> Validate, setup JSON -> ModelSetup, params ->
 // ParameterStore::Read, occupancy -> OccupancyGrid::SetDensities, occupancy_allowed ->
-// OccupancyGrid::SetAllowed, log lines. Parameters and occupancy are read into one tiny AvatarModel built once (a model built
-// from a fuzzed config could legitimately need gigabytes). Keep this in step with LoadModel.
-// Errors are fine; crashes, leaks and undefined behaviour are not.
+// OccupancyGrid::SetAllowed, log lines. Parameters and occupancy are read into one tiny AvatarModel built
+// once (a model built from a fuzzed config could legitimately need gigabytes). Keep this in step with
+// LoadModel. Errors are fine; crashes, leaks and undefined behaviour are not.
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
@@ -49,19 +49,23 @@ icef::Status ParseSections(const icef::Checkpoint& ckpt) {
   // the stored config_hash, and the config parser below should still see it.
   if (ckpt.Has("trainer")) {
     ICEF_ASSIGN_OR_RETURN(const std::string trainer_text, ckpt.Section("trainer"));
-    const icef::Result<icef::TrainerState> state = icef::ParseTrainerSection(trainer_text, config_text, origin);
-    if (state.ok() && (state->step < 0 || state->step > icef::kMaxCheckpointStep || state->skipped_steps < 0 ||
-                       state->skipped_steps > state->step || !(state->elapsed_seconds >= 0)))
+    const icef::Result<icef::TrainerState> state =
+        icef::ParseTrainerSection(trainer_text, config_text, origin);
+    if (state.ok() &&
+        (state->step < 0 || state->step > icef::kMaxCheckpointStep || state->skipped_steps < 0 ||
+         state->skipped_steps > state->step || !(state->elapsed_seconds >= 0)))
       std::abort();  // ParseTrainerSection let an out-of-range value through
     if (!state.ok() && state.status().message().find(origin) == std::string::npos) std::abort();
   }
   ICEF_ASSIGN_OR_RETURN(const icef::Json config_json, icef::ParseJson(config_text, origin + " [config]"));
-  ICEF_ASSIGN_OR_RETURN(const icef::RunConfig config, icef::RunConfig::FromJson(config_json, origin + " [config]"));
+  ICEF_ASSIGN_OR_RETURN(const icef::RunConfig config,
+                        icef::RunConfig::FromJson(config_json, origin + " [config]"));
   (void)config.Validate();
   (void)config.Hash();
   ICEF_ASSIGN_OR_RETURN(const std::string setup_text, ckpt.Section("setup"));
   ICEF_ASSIGN_OR_RETURN(const icef::Json setup_json, icef::ParseJson(setup_text, origin + " [setup]"));
-  ICEF_ASSIGN_OR_RETURN(const icef::ModelSetup setup, icef::ModelSetup::FromJson(setup_json, origin + " [setup]"));
+  ICEF_ASSIGN_OR_RETURN(const icef::ModelSetup setup,
+                        icef::ModelSetup::FromJson(setup_json, origin + " [setup]"));
   (void)setup.ExpressionIndex("jaw_open");
   icef::AvatarModel& model = TinyModel();
   ICEF_ASSIGN_OR_RETURN(const std::string params, ckpt.Section("params"));

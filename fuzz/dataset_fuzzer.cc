@@ -37,7 +37,8 @@ const std::filesystem::path& DatasetDir() {
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::filesystem::path& dir = DatasetDir();
-  icef::fuzz::WriteBytes(dir / "transforms_train.json", std::string_view(reinterpret_cast<const char*>(data), size));
+  icef::fuzz::WriteBytes(dir / "transforms_train.json",
+                         std::string_view(reinterpret_cast<const char*>(data), size));
   const icef::Result<icef::Dataset> dataset = icef::LoadDataset(dir);
   if (!dataset.ok()) {
     if (dataset.status().message().find(dir.string()) == std::string::npos) std::abort();  // must name a file

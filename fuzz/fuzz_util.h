@@ -2,14 +2,14 @@
 // /dev/shm when present, so per-input file writes stay in memory), removed at exit.
 #pragma once
 
+#include <unistd.h>
+
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
 #include <string_view>
-
-#include <unistd.h>
 
 namespace icef::fuzz {
 

@@ -14,7 +14,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const icef::Result<icef::ImageInfo> info = icef::ReadImageInfo(path);
   const icef::Result<icef::Image> image = icef::ReadImage(path);
   if (!image.ok()) {
-    if (image.status().message().find(path.string()) == std::string::npos) std::abort();  // error must name the file
+    if (image.status().message().find(path.string()) == std::string::npos)
+      std::abort();  // error must name the file
     return 0;
   }
   const icef::Image& im = *image;

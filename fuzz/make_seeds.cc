@@ -2,12 +2,12 @@
 //   OUT/checkpoint/tiny_model.icef   a valid checkpoint of a tiny AvatarModel (SaveCheckpoint)
 //   OUT/image/{grey,rgb,rgba}_4x4.png, rgb_1x1.png, rgb_8x8.jpg
 // Usage: icef_fuzz_make_seeds OUT_DIR
+#include <stb_image_write.h>
+
 #include <cstdint>
 #include <filesystem>
 #include <iostream>
 #include <vector>
-
-#include <stb_image_write.h>
 
 #include "icef/io/atomic_file.h"
 #include "icef/io/image.h"
@@ -37,8 +37,9 @@ int main(int argc, char** argv) {
   state.elapsed_seconds = 0.5;
   state.log = {"{\"step\":1}", "{\"step\":2}"};
   icef::Status s = icef::SaveCheckpoint(out / "checkpoint/tiny_model.icef", config, **model, nullptr, state);
-  for (const auto& [name, w, h, c] : {std::tuple{"grey_4x4.png", 4, 4, 1}, std::tuple{"rgb_4x4.png", 4, 4, 3},
-                                      std::tuple{"rgba_4x4.png", 4, 4, 4}, std::tuple{"rgb_1x1.png", 1, 1, 3}}) {
+  for (const auto& [name, w, h, c] :
+       {std::tuple{"grey_4x4.png", 4, 4, 1}, std::tuple{"rgb_4x4.png", 4, 4, 3},
+        std::tuple{"rgba_4x4.png", 4, 4, 4}, std::tuple{"rgb_1x1.png", 1, 1, 3}}) {
     icef::Image im(w, h, c);
     for (size_t i = 0; i < im.pixels.size(); ++i) im.pixels[i] = float(i % 5) / 4.f;
     if (s.ok()) s = icef::WritePng(out / "image" / name, im);

@@ -15,6 +15,7 @@ PACKAGES=(
   python3-numpy python3-pil  # scripts/track_eval.py (tracking against synthetic truth; integration.track_test)
   libdlib-dev libdlib-data opencv-doc python3-skimage python-matplotlib-data  # eval: face alignment, test photos
   gnuplot-nox  # bench: report plots (PNG, SVG and PDF)
+  clang-format  # .ci/run: scripts/check_format.sh
 )
 # --bench: also what `make bench` compares against (PyTorch, for scripts/torch_reference_bench.py).
 if [ "${1:-}" = "--bench" ]; then PACKAGES+=(python3-torch libopenblas0-pthread); fi

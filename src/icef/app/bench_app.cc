@@ -51,7 +51,41 @@ Result<eval::BenchOptions> ResolveBenchOptions(const BenchAppOptions& a) {
   return o;
 }
 
+Result<RealBenchOptions> ResolveRealBenchOptions(const BenchAppOptions& a) {
+  RealBenchOptions r;
+  r.sources = a.real;
+  r.out_dir = a.out;
+  if (a.quick) r.ApplyQuick();
+  if (!a.ks.empty()) {
+    ICEF_ASSIGN_OR_RETURN(r.ks, eval::ParseIntList(a.ks, "--k"));
+  }
+  if (!a.methods.empty()) r.methods = a.methods;
+  if (a.real_test_frames) r.test_frames = *a.real_test_frames;
+  if (a.video_frames) r.video_frames = *a.video_frames;
+  if (a.resolution) r.resolution = *a.resolution;
+  if (a.steps) r.steps = *a.steps;
+  if (a.time_budget) r.time_budget_seconds = *a.time_budget;
+  r.config_path = a.base.config_path;
+  r.overrides.insert(r.overrides.end(), a.base.overrides.begin(), a.base.overrides.end());
+  r.threads = a.base.threads;
+  r.faceid_model_dir = a.base.faceid_model_dir;
+  r.lpips_weights = a.base.lpips_weights;
+  r.keep_models = a.base.keep_models;
+  r.interactive = a.interactive;
+  return r;
+}
+
 Status RunBench(const BenchAppOptions& a, std::ostream& out) {
+  if (!a.merge.empty()) {
+    if (a.out.empty()) return Status::Error("bench merge: --out is required");
+    return eval::MergeBench(a.merge, a.out, out);
+  }
+  if (!a.real.empty()) {
+    ICEF_ASSIGN_OR_RETURN(const RealBenchOptions real, ResolveRealBenchOptions(a));
+    return RunRealBench(real, out);
+  }
+  if (a.real_test_frames || a.video_frames)
+    return Status::Error("--test and --video-frames go with --real (synthetic benches: --test-views)");
   ICEF_ASSIGN_OR_RETURN(const eval::BenchOptions options, ResolveBenchOptions(a));
   return eval::RunBench(options, out, a.interactive);
 }

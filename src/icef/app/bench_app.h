@@ -1,4 +1,4 @@
-// `icef bench --out DIR ...`: the whole evaluation protocol (eval/bench_protocol.h): synthesise,
+// `icef bench --out DIR ...`: the whole evaluation protocol (study/bench_protocol.h): synthesise,
 // train and evaluate every identity x K x method, then report.md, report.json, report.tex and plots. This
 // resolves the command's options into eval::BenchOptions: the defaults, then --validation, then
 // --quick, with the options given explicitly winning over both.
@@ -11,8 +11,9 @@
 #include <string>
 #include <vector>
 
+#include "icef/app/real_bench_app.h"
 #include "icef/core/status.h"
-#include "icef/eval/bench_protocol.h"
+#include "icef/study/bench_protocol.h"
 
 namespace icef {
 
@@ -32,6 +33,13 @@ struct BenchAppOptions {
   bool quick = false;                  // tiny settings for CI (eval::BenchOptions::ApplyQuick)
   bool validation = false;             // validation identities (eval::BenchOptions::ApplyValidation)
   bool interactive = false;            // redraw progress bars in place (stdout is a terminal)
+  // Real media instead of synthetic identities (app/real_bench_app.h): videos, photo folders or
+  // datasets from icef track; the options above that apply carry over (ResolveRealBenchOptions).
+  std::vector<std::filesystem::path> real;
+  std::optional<int> real_test_frames;  // with real: held-out frames per source
+  std::optional<int> video_frames;      // with real: frames tracked per video, spread over it
+  // Bench directories to merge into `out` (one report) instead of running (eval::MergeBench).
+  std::vector<std::filesystem::path> merge;
 
   // The resolved options' check (eval::BenchOptions::Validate); errors name the option.
   Status Validate() const;
@@ -40,7 +48,12 @@ struct BenchAppOptions {
 // The bench the options describe (validated by eval::RunBench).
 Result<eval::BenchOptions> ResolveBenchOptions(const BenchAppOptions& options);
 
-// Resolves and runs the bench, logging on `out`.
+// The real-media bench the options describe: RealBenchOptions' defaults (then --quick), with the
+// options given explicitly winning.
+Result<RealBenchOptions> ResolveRealBenchOptions(const BenchAppOptions& options);
+
+// `icef bench`: merges the `merge` directories into `out`, runs the real-media bench (`real`) or
+// resolves and runs the synthetic bench, logging on `out`.
 Status RunBench(const BenchAppOptions& options, std::ostream& out);
 
 }  // namespace icef

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <sstream>
+
 #include "icef/train/train_config.h"
 
 namespace icef {
@@ -57,7 +59,7 @@ TEST(BenchApp, ValidationSettingsLoseToExplicitOptions) {
   EXPECT_TRUE(o->diverse);
   EXPECT_TRUE(o->draw_resolution);
   EXPECT_EQ(o->methods, (std::vector<std::string>{"icef", "icef-prior"}));
-  EXPECT_EQ(o->time_budget_seconds, 0.0);  // steps only: reproducible
+  EXPECT_EQ(o->time_budget_seconds, 0.0);    // steps only: reproducible
   EXPECT_EQ(o->steps, TrainConfig().steps);  // as `icef train` trains
   // --res pins the resolution; the scenes stay diverse.
   a.resolution = 160;
@@ -110,6 +112,43 @@ TEST(BenchApp, BadListsAndShardsNameTheOption) {
   a.shard.clear();
   a.out.clear();
   EXPECT_NE(a.Validate().message().find("--out"), std::string::npos) << a.Validate().message();
+}
+
+TEST(BenchApp, RealBenchTakesTheGivenOptions) {
+  BenchAppOptions a;
+  a.out = "b";
+  a.real = {"clip.mp4"};
+  a.quick = true;
+  a.ks = "3,5";
+  a.resolution = 96;
+  a.real_test_frames = 3;
+  a.base.overrides = {"train.lambda_id=0.5"};
+  a.base.threads = 2;
+  const Result<RealBenchOptions> r = ResolveRealBenchOptions(a);
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  RealBenchOptions quick;
+  quick.ApplyQuick();
+  EXPECT_EQ(r->sources, a.real);
+  EXPECT_EQ(r->out_dir, "b");
+  EXPECT_EQ(r->ks, (std::vector<int>{3, 5}));
+  EXPECT_EQ(r->resolution, 96);                    // given
+  EXPECT_EQ(r->steps, quick.steps);                // --quick's
+  EXPECT_EQ(r->video_frames, quick.video_frames);  // not given
+  EXPECT_EQ(r->test_frames, 3);
+  EXPECT_EQ(r->threads, 2);
+  ASSERT_FALSE(r->overrides.empty());
+  EXPECT_EQ(r->overrides.back(), "train.lambda_id=0.5");
+}
+
+TEST(BenchApp, RealOnlyOptionsAndMergeWithoutOutAreRefused) {
+  BenchAppOptions a;
+  a.out = "b";
+  a.video_frames = 10;  // without --real
+  std::ostringstream log;
+  EXPECT_NE(RunBench(a, log).message().find("--video-frames go with --real"), std::string::npos);
+  BenchAppOptions merge;
+  merge.merge = {"shard0", "shard1"};
+  EXPECT_NE(RunBench(merge, log).message().find("--out is required"), std::string::npos);
 }
 
 }  // namespace

@@ -6,9 +6,9 @@
 #include "icef/app/train_app.h"
 #include "icef/core/progress.h"
 #include "icef/data/dataset.h"
-#include "icef/model/model_config.h"
 #include "icef/io/gif_writer.h"
 #include "icef/io/image.h"
+#include "icef/model/model_config.h"
 #include "icef/synth/ground_truth_renderer.h"
 #include "icef/synth/synthesize.h"
 
@@ -26,7 +26,8 @@ Status WriteSweepComparison(const synth::HeadModel& head, const Camera& camera, 
   std::vector<Image> pairs;
   for (size_t i = 0; i < frames.size(); ++i) {
     ICEF_ASSIGN_OR_RETURN(const Image render, ReadImage(frames[i].color_path));
-    const Image truth = CompositeOver(synth::RenderGroundTruth(head, camera, frames[i].beta, executor), background);
+    const Image truth =
+        CompositeOver(synth::RenderGroundTruth(head, camera, frames[i].beta, executor), background);
     Image pair(render.width + truth.width, std::max(render.height, truth.height), 3, 1.f);
     for (int y = 0; y < render.height; ++y)
       for (int x = 0; x < render.width; ++x)
@@ -103,8 +104,8 @@ Status RunDemo(const DemoOptions& given, std::ostream& out) {
     sweep.dataset = data_dir;
     sweep.frame = "test:0";  // a held-out view, where the ground truth can be rendered beside it
     ICEF_ASSIGN_OR_RETURN(const auto frames, RunRender(sweep, quiet));
-    ICEF_RETURN_IF_ERROR(WriteSweepComparison(head, dataset.test[0].camera, dataset.background, frames, sweep.out,
-                                              sweep.gif_delay_cs, executor));
+    ICEF_RETURN_IF_ERROR(WriteSweepComparison(head, dataset.test[0].camera, dataset.background, frames,
+                                              sweep.out, sweep.gif_delay_cs, executor));
     out << "  " << name << ": kappa " << frames.front().nearest.kappa << " -> " << frames.back().nearest.kappa
         << " (delta " << frames.back().nearest.delta << " at the end)\n";
     sweeps.push_back(sweep.out);
@@ -112,12 +113,14 @@ Status RunDemo(const DemoOptions& given, std::ostream& out) {
 
   out << "\nICEF demo finished.\n";
   out << "  " << summary.BriefReport() << "\n";
-  out << "  dataset:    " << data_dir.string() << "   (inspect with: build/icef info " << data_dir.string() << ")\n";
+  out << "  dataset:    " << data_dir.string() << "   (inspect with: build/icef info " << data_dir.string()
+      << ")\n";
   out << "  model:      " << model_dir.string() << "   (summary.json, train_log.jsonl, checkpoint.icef)\n";
-  out << "  turntable:  " << (o.out / "turntable" / "color.gif").string() << "  (+ depth, mask, deformation)\n";
+  out << "  turntable:  " << (o.out / "turntable" / "color.gif").string()
+      << "  (+ depth, mask, deformation)\n";
   for (const fs::path& s : sweeps)
-    out << "  sweep:      " << (s / "color.gif").string() << "  (beside the ground truth: " << (s / "compare.gif").string()
-        << ")\n";
+    out << "  sweep:      " << (s / "color.gif").string()
+        << "  (beside the ground truth: " << (s / "compare.gif").string() << ")\n";
   return Status::Ok();
 }
 

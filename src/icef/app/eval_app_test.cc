@@ -29,8 +29,7 @@ TEST(EvalApp, MissingModelIsAClearError) {
   std::ostringstream out, err;
   const Status s = RunEval(o, Executor(1), out, err).status();
   ASSERT_FALSE(s.ok());
-  EXPECT_NE(s.message().find(o.model.string() + ": no checkpoint here"), std::string::npos)
-      << s.message();
+  EXPECT_NE(s.message().find(o.model.string() + ": no checkpoint here"), std::string::npos) << s.message();
   EXPECT_FALSE(fs::exists(o.out / "metrics.json"));
 }
 

@@ -35,8 +35,8 @@ struct Run {
   bool closed;
 };
 // The iBUG-68 groups.
-constexpr Run kRuns[] = {{0, 16, false},  {17, 21, false}, {22, 26, false}, {27, 30, false}, {31, 35, false},
-                         {36, 41, true},  {42, 47, true},  {48, 59, true},  {60, 67, true}};
+constexpr Run kRuns[] = {{0, 16, false}, {17, 21, false}, {22, 26, false}, {27, 30, false}, {31, 35, false},
+                         {36, 41, true}, {42, 47, true},  {48, 59, true},  {60, 67, true}};
 
 }  // namespace
 
@@ -49,7 +49,8 @@ std::array<Vec3f, 68> FittedLandmarks(const face::FaceFit& fit, std::span<const 
   return lm;
 }
 
-void DrawFaceOutline(Image* image, const Camera& camera, std::span<const Vec3f> landmarks_world, const Vec3f& colour) {
+void DrawFaceOutline(Image* image, const Camera& camera, std::span<const Vec3f> landmarks_world,
+                     const Vec3f& colour) {
   // Camera::Project works in the camera's pixel units; the image may be another size.
   const double sx = double(image->width) / camera.width(), sy = double(image->height) / camera.height();
   std::vector<std::optional<Vec2d>> uv;

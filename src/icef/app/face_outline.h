@@ -18,7 +18,8 @@ namespace icef {
 std::array<Vec3f, 68> FittedLandmarks(const face::FaceFit& fit, std::span<const float> beta);
 
 // Draws the outline (1-pixel lines, 2 pixels from 256 px up) in `colour` onto an RGB or RGBA image.
-void DrawFaceOutline(Image* image, const Camera& camera, std::span<const Vec3f> landmarks_world, const Vec3f& colour);
+void DrawFaceOutline(Image* image, const Camera& camera, std::span<const Vec3f> landmarks_world,
+                     const Vec3f& colour);
 
 // The same outline through 68 points already in the image's coordinates (nullopt: not drawn).
 void DrawFaceOutline2d(Image* image, std::span<const std::optional<Vec2d>> uv, const Vec3f& colour);

@@ -35,6 +35,8 @@ Status FaceIdAppOptions::Validate() const {
   return Status::Ok();
 }
 
+std::string DefaultFaceIdModelDir() { return eval::kDefaultFaceIdModelDir; }
+
 Status RunFaceId(const FaceIdAppOptions& o, std::ostream& out) {
   ICEF_RETURN_IF_ERROR(o.Validate());
   std::map<std::string, std::vector<Vec2f>> known;

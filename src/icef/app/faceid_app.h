@@ -25,6 +25,9 @@ struct FaceIdAppOptions {
   Status Validate() const;
 };
 
+// The face-identity model directory used when none is given and $ICEF_FACEID_MODEL is unset.
+std::string DefaultFaceIdModelDir();
+
 // Describes every image and prints the descriptors and pairwise distances on `out`.
 Status RunFaceId(const FaceIdAppOptions& options, std::ostream& out);
 

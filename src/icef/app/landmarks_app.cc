@@ -23,6 +23,8 @@ Status LandmarksAppOptions::Validate() const {
   return DetectionOptions(*this).Validate().WithContext("--splits");
 }
 
+std::string DefaultShapePredictorPath() { return kDefaultShapePredictorPath; }
+
 Status RunLandmarks(const LandmarksAppOptions& o, const Executor& executor, std::ostream& out) {
   ICEF_RETURN_IF_ERROR(o.Validate());
   const LandmarkDetectionOptions options = DetectionOptions(o);

@@ -31,6 +31,9 @@ struct LandmarksAppOptions {
   Status Validate() const;
 };
 
+// dlib's 68-point shape predictor used when none is given (also by `icef track`).
+std::string DefaultShapePredictorPath();
+
 // Detects, writes the landmarks back and prints the report on `out` (the executor's threads run
 // one detector each).
 Status RunLandmarks(const LandmarksAppOptions& options, const Executor& executor, std::ostream& out);

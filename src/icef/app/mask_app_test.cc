@@ -54,7 +54,8 @@ TEST(MaskApp, FrameOutOfRangeIsRefused) {
     std::ostringstream out;
     const Status s = RunMask(o, Executor(1), out);
     ASSERT_FALSE(s.ok());
-    EXPECT_EQ(s.message(), "--frame " + std::to_string(frame) + " is out of range: the dataset has 3 training frames");
+    EXPECT_EQ(s.message(),
+              "--frame " + std::to_string(frame) + " is out of range: the dataset has 3 training frames");
     EXPECT_FALSE(fs::exists(o.out));
   }
 }

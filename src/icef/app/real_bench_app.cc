@@ -12,13 +12,13 @@
 #include "icef/core/progress.h"
 #include "icef/data/dataset.h"
 #include "icef/data/frame_coverage.h"
-#include "icef/eval/bench_protocol.h"
 #include "icef/eval/face_identity.h"
 #include "icef/eval/lpips.h"
 #include "icef/eval/real_protocol.h"
-#include "icef/eval/real_report.h"
 #include "icef/io/atomic_file.h"
 #include "icef/model/method.h"
+#include "icef/study/bench_protocol.h"
+#include "icef/study/real_report.h"
 #include "icef/synth/synthesize.h"
 #include "icef/train/trainer.h"
 #include "icef/video/video_reader.h"
@@ -104,7 +104,8 @@ Result<Dataset> TrackSource(const RealBenchOptions& o, const fs::path& source, c
   fs::remove_all(dir, ec);
   const fs::path runs = dir.parent_path().parent_path() / "runs";
   for (const auto& entry : fs::directory_iterator(runs, ec))
-    if (entry.path().filename().string().rfind(dir.filename().string() + "_k", 0) == 0) fs::remove_all(entry.path(), ec);
+    if (entry.path().filename().string().rfind(dir.filename().string() + "_k", 0) == 0)
+      fs::remove_all(entry.path(), ec);
   fs::create_directories(dir, ec);
   if (ec) return Status::Error(dir.string() + ": cannot create directory: " + ec.message());
   ICEF_RETURN_IF_ERROR(RunTrack(t, log).WithContext(source.string()));
@@ -161,8 +162,9 @@ Result<RunConfig> MakeConfig(const RealBenchOptions& o, const std::string& metho
   return config;
 }
 
-Result<eval::RealRunRecord> RunOne(const RealBenchOptions& o, eval::RealRunRecord record, const Dataset& dataset,
-                                   const eval::EvalNetworks& networks, const Executor& executor, std::ostream& log) {
+Result<eval::RealRunRecord> RunOne(const RealBenchOptions& o, eval::RealRunRecord record,
+                                   const Dataset& dataset, const eval::EvalNetworks& networks,
+                                   const Executor& executor, std::ostream& log) {
   const fs::path model_dir = record.run_dir / "model";
   std::error_code ec;
   fs::remove_all(model_dir, ec);
@@ -175,10 +177,12 @@ Result<eval::RealRunRecord> RunOne(const RealBenchOptions& o, eval::RealRunRecor
   bar.Finish(std::to_string(summary.steps) + " steps (" + summary.stop_reason + ")");
   record.train_steps = summary.steps;
   record.train_seconds = Seconds(start);
-  ProgressBar eval_bar("eval  " + record.Name(), static_cast<int64_t>(dataset.test.size()), log, o.interactive);
+  ProgressBar eval_bar("eval  " + record.Name(), static_cast<int64_t>(dataset.test.size()), log,
+                       o.interactive);
   eval::RealEvalOptions eo;
   eo.out_dir = record.run_dir;
-  ICEF_ASSIGN_OR_RETURN(record.metrics, eval::EvaluateReal(trainer->model(), dataset, eo, networks, executor, &eval_bar));
+  ICEF_ASSIGN_OR_RETURN(record.metrics,
+                        eval::EvaluateReal(trainer->model(), dataset, eo, networks, executor, &eval_bar));
   eval_bar.Finish();
   trainer.reset();
   if (!o.keep_models) fs::remove_all(model_dir, ec);
@@ -200,7 +204,8 @@ void RealBenchOptions::ApplyQuick() {
 }
 
 Status RealBenchOptions::Validate() const {
-  if (sources.empty()) return Status::Error("--real: give at least one source (a video, a photo folder or a dataset)");
+  if (sources.empty())
+    return Status::Error("--real: give at least one source (a video, a photo folder or a dataset)");
   if (out_dir.empty()) return Status::Error("--out: required");
   if (ks.empty()) return Status::Error("--k: give at least one K");
   for (const int k : ks)
@@ -248,7 +253,8 @@ Status RunRealBench(const RealBenchOptions& o, std::ostream& log) {
     networks.identity_note = loaded.status().message();
     log << "bench --real: identity distance unavailable: " << networks.identity_note << "\n";
   }
-  ICEF_ASSIGN_OR_RETURN(const std::optional<eval::LpipsNet> lpips, eval::LoadLpipsIfConfigured(o.lpips_weights));
+  ICEF_ASSIGN_OR_RETURN(const std::optional<eval::LpipsNet> lpips,
+                        eval::LoadLpipsIfConfigured(o.lpips_weights));
   networks.lpips = lpips ? &*lpips : nullptr;
 
   eval::RealReportContext context;
@@ -283,14 +289,17 @@ Status RunRealBench(const RealBenchOptions& o, std::ostream& log) {
         if (fs::exists(metrics, ec)) {
           ICEF_ASSIGN_OR_RETURN(const std::string text, ReadFile(metrics));
           ICEF_ASSIGN_OR_RETURN(const Json json, ParseJson(text, metrics.string()));
-          ICEF_ASSIGN_OR_RETURN(eval::RealRunRecord done, eval::RealRunRecord::FromJson(json, metrics.string()));
+          ICEF_ASSIGN_OR_RETURN(eval::RealRunRecord done,
+                                eval::RealRunRecord::FromJson(json, metrics.string()));
           done.run_dir = record.run_dir;
           records.push_back(std::move(done));
           continue;
         }
-        ICEF_ASSIGN_OR_RETURN(eval::RealRunRecord finished, RunOne(o, record, dataset, networks, executor, log));
+        ICEF_ASSIGN_OR_RETURN(eval::RealRunRecord finished,
+                              RunOne(o, record, dataset, networks, executor, log));
         char line[200];
-        std::snprintf(line, sizeof line, "  %s: face PSNR %.2f dB (still %.2f), real_expr_gain %.3f, %.0f s training",
+        std::snprintf(line, sizeof line,
+                      "  %s: face PSNR %.2f dB (still %.2f), real_expr_gain %.3f, %.0f s training",
                       finished.Name().c_str(), finished.metrics.means.face_psnr.value_or(NAN),
                       finished.metrics.means.face_psnr_nearest.value_or(NAN),
                       finished.metrics.means.real_expr_gain.value_or(NAN), finished.train_seconds);
@@ -301,7 +310,8 @@ Status RunRealBench(const RealBenchOptions& o, std::ostream& log) {
     context.sources.push_back(std::move(info));
   }
   ICEF_RETURN_IF_ERROR(eval::WriteRealReport(o.out_dir, records, context));
-  log << "bench --real: wrote " << (o.out_dir / "report.md").string() << ", report.json, report.tex, plots/\n";
+  log << "bench --real: wrote " << (o.out_dir / "report.md").string()
+      << ", report.json, report.tex, plots/\n";
   return Status::Ok();
 }
 

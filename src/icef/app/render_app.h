@@ -24,23 +24,23 @@
 namespace icef {
 
 struct RenderAppOptions {
-  std::filesystem::path model;                       // model directory or checkpoint file
-  std::filesystem::path out;                         // output directory (created)
-  std::optional<std::filesystem::path> dataset;      // for --frame / --expression-frame
-  std::optional<std::string> frame;                  // camera from a dataset frame: "split:index"
-  int orbit = 0;                                     // > 0: turntable of this many views
-  double orbit_yaw = 45;                             // turntable yaw half-range, degrees
-  double orbit_pitch = 0;                            // turntable pitch, degrees
-  std::optional<int> resolution;                     // orbit/default camera: image height in pixels (width by aspect)
-  std::optional<std::string> expression_frame;       // expression from a dataset frame: "split:index"
-  std::optional<std::vector<float>> beta;            // explicit expression vector
-  std::vector<std::string> named;                    // "name=value" on top of neutral (or of beta / frame)
-  std::optional<std::string> sweep;                  // "name=value": neutral -> value * sweep_beyond
-  int sweep_frames = 16;                             // frames of a sweep
-  double sweep_beyond = 1.5;                         // the sweep ends at this multiple of the target
-  int gif_delay_cs = 8;                              // GIF frame delay (1/100 s)
-  int threads = 0;                                   // worker threads (0 = all cores)
-  std::vector<std::string> overrides;                // "model.KEY=VALUE" of inference-only keys (model/trained_model.h)
+  std::filesystem::path model;                   // model directory or checkpoint file
+  std::filesystem::path out;                     // output directory (created)
+  std::optional<std::filesystem::path> dataset;  // for --frame / --expression-frame
+  std::optional<std::string> frame;              // camera from a dataset frame: "split:index"
+  int orbit = 0;                                 // > 0: turntable of this many views
+  double orbit_yaw = 45;                         // turntable yaw half-range, degrees
+  double orbit_pitch = 0;                        // turntable pitch, degrees
+  std::optional<int> resolution;  // orbit/default camera: image height in pixels (width by aspect)
+  std::optional<std::string> expression_frame;  // expression from a dataset frame: "split:index"
+  std::optional<std::vector<float>> beta;       // explicit expression vector
+  std::vector<std::string> named;               // "name=value" on top of neutral (or of beta / frame)
+  std::optional<std::string> sweep;             // "name=value": neutral -> value * sweep_beyond
+  int sweep_frames = 16;                        // frames of a sweep
+  double sweep_beyond = 1.5;                    // the sweep ends at this multiple of the target
+  int gif_delay_cs = 8;                         // GIF frame delay (1/100 s)
+  int threads = 0;                              // worker threads (0 = all cores)
+  std::vector<std::string> overrides;  // "model.KEY=VALUE" of inference-only keys (model/trained_model.h)
 };
 
 struct RenderedFrameInfo {

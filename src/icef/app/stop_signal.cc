@@ -1,8 +1,9 @@
 #include "icef/app/stop_signal.h"
 
+#include <unistd.h>
+
 #include <csignal>
 #include <cstdlib>
-#include <unistd.h>
 
 namespace icef {
 

@@ -40,7 +40,19 @@ Status SynthAppOptions::Validate() const {
   return Status::Ok();
 }
 
-Status RunSynth(const SynthAppOptions& o, const Executor& executor, std::ostream& out) {
+Result<synth::SynthOptions> ResolveSynthOptions(const SynthAppOptions& o) {
+  synth::SynthOptions options = o.options;
+  synth::SceneAxes& axes = options.vary;
+  if (o.diverse) axes = synth::SceneAxes::All();
+  for (const std::string& a : o.vary) ICEF_RETURN_IF_ERROR(axes.Set(a, true).WithContext("--vary"));
+  for (const std::string& a : o.pin) ICEF_RETURN_IF_ERROR(axes.Set(a, false).WithContext("--pin"));
+  if (o.resolution_given) axes.resolution = false;
+  return options;
+}
+
+Status RunSynth(const SynthAppOptions& given, const Executor& executor, std::ostream& out) {
+  SynthAppOptions o = given;
+  ICEF_ASSIGN_OR_RETURN(o.options, ResolveSynthOptions(given));
   ICEF_RETURN_IF_ERROR(o.Validate());
   if (o.photos) return RunPhotoSet(o, executor, out);
   synth::SynthOptions options = o.options;
@@ -56,14 +68,15 @@ Status RunSynth(const SynthAppOptions& o, const Executor& executor, std::ostream
   if (options.vary.Any()) {
     const synth::IdentityParams id = synth::SynthIdentity(options);
     char line[320];
-    std::snprintf(line, sizeof line,
-                  "scene (drawn: %s): skin [%.2f %.2f %.2f], key %.2f + ambient %.2f%s, specular %.2f, head scale "
-                  "%.2f at [%.2f %.2f %.2f], distance %.2f, focal %.2f x res, yaw <= %.0f, pitch <= %.0f (%s)\n",
-                  options.vary.ToString().c_str(), id.skin_tone[0], id.skin_tone[1], id.skin_tone[2],
-                  resolved.render.diffuse, resolved.render.ambient, resolved.render.fill > 0 ? " + second light" : "",
-                  resolved.render.specular, resolved.head_scale, resolved.head_offset[0], resolved.head_offset[1],
-                  resolved.head_offset[2], resolved.camera_distance, resolved.focal_scale, resolved.max_yaw_deg,
-                  resolved.max_pitch_deg, synth::kSceneInfoFile);
+    std::snprintf(
+        line, sizeof line,
+        "scene (drawn: %s): skin [%.2f %.2f %.2f], key %.2f + ambient %.2f%s, specular %.2f, head scale "
+        "%.2f at [%.2f %.2f %.2f], distance %.2f, focal %.2f x res, yaw <= %.0f, pitch <= %.0f (%s)\n",
+        options.vary.ToString().c_str(), id.skin_tone[0], id.skin_tone[1], id.skin_tone[2],
+        resolved.render.diffuse, resolved.render.ambient, resolved.render.fill > 0 ? " + second light" : "",
+        resolved.render.specular, resolved.head_scale, resolved.head_offset[0], resolved.head_offset[1],
+        resolved.head_offset[2], resolved.camera_distance, resolved.focal_scale, resolved.max_yaw_deg,
+        resolved.max_pitch_deg, synth::kSceneInfoFile);
     out << line;
   }
   char mean[32];

@@ -11,6 +11,7 @@
 #include <optional>
 #include <ostream>
 #include <string>
+#include <vector>
 
 #include "icef/core/parallel.h"
 #include "icef/core/status.h"
@@ -26,12 +27,20 @@ struct SynthAppOptions {
   std::optional<int> photos;  // photo-set mode: write this many photos instead of a dataset
   std::string photo_size = "480x640";  // photo-set mode: photo size WxH
   uint64_t background_seed =
-      0;                     // photo-set mode: seed of the backgrounds (0: derived from the identity seed)
-  bool interactive = false;  // redraw the progress bar in place (stdout is a terminal)
+      0;                 // photo-set mode: seed of the backgrounds (0: derived from the identity seed)
+  bool diverse = false;  // draw every scene axis per identity seed (options.vary = All())
+  std::vector<std::string> vary;  // scene axes to draw per identity seed, on top of options.vary
+  std::vector<std::string> pin;   // scene axes kept at the classic values (after diverse and vary)
+  bool resolution_given = false;  // --res was given: it pins the resolution axis
+  bool interactive = false;       // redraw the progress bar in place (stdout is a terminal)
 
   // Errors name the option (--out, --contact-sheet).
   Status Validate() const;
 };
+
+// options.options with the scene axes diverse, vary, pin and resolution_given select; errors name
+// the option and the unknown axis.
+Result<synth::SynthOptions> ResolveSynthOptions(const SynthAppOptions& options);
 
 // Writes the dataset (or photo set) and prints what was written on `out`.
 Status RunSynth(const SynthAppOptions& options, const Executor& executor, std::ostream& out);

@@ -1,14 +1,16 @@
 // `icef track PHOTOS... --out DATASET`: track/photo_track.h's pipeline with what a user sees: the
 // log, an overlay per photo (track/overlay_NNN.png: the photo with the detected landmarks as green
 // dots and the fitted face model's landmarks, where the fit put dlib's, as a red outline; beside
-// it the dataset image over a checkerboard, which shows the mask), and the summary. With --keep-cameras, an existing dataset re-expressed in the face
-// model's expression space instead.
+// it the dataset image over a checkerboard, which shows the mask), and the summary. With --keep-cameras, an
+// existing dataset re-expressed in the face model's expression space instead.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <optional>
-#include <span>
 #include <ostream>
+#include <span>
+#include <string>
 #include <vector>
 
 #include "icef/core/status.h"
@@ -57,5 +59,34 @@ std::vector<int> RetrackOverlayFrames(int n);
 
 // Photos -> dataset (or, with keep_cameras, dataset -> re-expressed dataset).
 Status RunTrack(const TrackAppOptions& options, std::ostream& out);
+
+// `icef track` as given on the command line: TrackAppOptions, plus the choices named as there and
+// those whose default depends on the mode (photos, or a dataset with app.keep_cameras), which
+// ResolveTrackOptions turns into TrackAppOptions.
+struct TrackCommandOptions {
+  TrackAppOptions app;                       // photos, out, resolution, frames, ...: taken as they are
+  std::optional<double> focal;               // photos' focal length, pixels (nullopt: EXIF, else 35 mm)
+  std::string segmentation = "selfie";       // the dataset's alpha mask: selfie, none or selfie-only
+  std::string landmarks = "detect";          // with keep_cameras: detect, dlib or model (RetrackLandmarks)
+  bool generic_style = false;                // with keep_cameras and landmarks model: no subject style
+  std::string detector = "mesh";             // whose 68 landmarks the fit reads: mesh or dlib
+  std::string silhouette_region = "face";    // the part of the mask's edge the refit uses: face or head
+  std::optional<int> silhouette_points;      // mask-edge points per photo (nullopt: the mode's default)
+  std::optional<double> photometric_weight;  // the photometric refit's weight (nullopt: the mode's default)
+  std::optional<double> landmark_sigma;      // landmark noise, inter-ocular distances (nullopt: the mode's)
+  bool calibrate_detector = false;           // developer: print the detector's calibration table instead
+};
+
+// The validation identities `--calibrate-detector` renders (app/detector_calibration.h).
+const std::vector<uint64_t>& DetectorCalibrationSeeds();
+
+// The TrackAppOptions the command line describes: the named choices parsed, and the options not
+// given at the mode's defaults (track::TrackOptions' for photos, track::RetrackOptions' with
+// keep_cameras). Errors name the option.
+Result<TrackAppOptions> ResolveTrackOptions(const TrackCommandOptions& options);
+
+// `icef track`: resolves the options, then prints the detector's calibration table on `out` (its
+// log on `log`) with calibrate_detector, else tracks (RunTrack).
+Status RunTrackCommand(const TrackCommandOptions& options, std::ostream& out, std::ostream& log);
 
 }  // namespace icef

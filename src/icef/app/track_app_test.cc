@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <iostream>
 #include <vector>
 
 namespace icef {
@@ -39,7 +40,8 @@ TEST(RetrackOverlay, DrawsLandmarksAndFitOverTheFrameOnItsBackground) {
   EXPECT_FLOAT_EQ(out.At(5, 5, 2), 1.f);
   EXPECT_FLOAT_EQ(out.At(5, 5, 0), 0.f);
   // Every landmark is a green dot at its scaled position; the fit draws red only on the right half.
-  for (const Vec2f& l : landmarks) EXPECT_TRUE(IsGreen(out, int(std::floor(l.x() * s)), int(std::floor(l.y() * s))));
+  for (const Vec2f& l : landmarks)
+    EXPECT_TRUE(IsGreen(out, int(std::floor(l.x() * s)), int(std::floor(l.y() * s))));
   int red_left = 0, red_right = 0;
   for (int y = 0; y < out.height; ++y)
     for (int x = 0; x < out.width; ++x)
@@ -68,6 +70,54 @@ TEST(RetrackOverlay, LongSequencesGetOverlaysSpreadFromFirstToLast) {
     EXPECT_NEAR(many[i] - many[i - 1], 4999.0 / 99, 1.0);
   }
   EXPECT_TRUE(RetrackOverlayFrames(0).empty());
+}
+
+// icef track's options: the named choices parsed, the ones not given at the mode's defaults.
+TEST(TrackCommand, PhotosKeepTheTrackDefaults) {
+  TrackCommandOptions c;
+  c.segmentation = "none";
+  c.silhouette_region = "head";
+  c.detector = "dlib";
+  const Result<TrackAppOptions> o = ResolveTrackOptions(c);
+  ASSERT_TRUE(o.ok()) << o.status().message();
+  const track::TrackOptions d;
+  EXPECT_EQ(o->track.segmentation, track::TrackOptions::Segmentation::kNone);
+  EXPECT_FALSE(o->track.fit.silhouette_face_only);
+  EXPECT_EQ(o->track.fit.detector, track::LandmarkDetector::kDlib);
+  EXPECT_EQ(o->track.silhouette_points, d.silhouette_points);
+  EXPECT_EQ(o->track.fit.photometric_weight, d.fit.photometric_weight);
+  EXPECT_EQ(o->track.fit.landmark_sigma_iod, d.fit.landmark_sigma_iod);
+  EXPECT_FALSE(o->track.focal.has_value());
+  EXPECT_TRUE(o->fit_style);
+}
+
+TEST(TrackCommand, KeepCamerasTakesTheRetrackDefaultsUnlessGiven) {
+  TrackCommandOptions c;
+  c.app.keep_cameras = true;
+  c.landmarks = "model";
+  c.generic_style = true;
+  c.silhouette_points = 7;
+  c.focal = 900;
+  const Result<TrackAppOptions> o = ResolveTrackOptions(c);
+  ASSERT_TRUE(o.ok()) << o.status().message();
+  const track::RetrackOptions r;
+  EXPECT_EQ(o->landmarks, track::RetrackLandmarks::kDatasetModel);
+  EXPECT_FALSE(o->fit_style);
+  EXPECT_EQ(o->track.silhouette_points, 7);  // given
+  EXPECT_EQ(o->track.fit.photometric_weight, r.fit.photometric_weight);
+  EXPECT_EQ(o->track.fit.landmark_sigma_iod, r.fit.landmark_sigma_iod);
+  EXPECT_EQ(o->track.focal, 900.0);
+}
+
+TEST(TrackCommand, BadChoicesNameTheOption) {
+  TrackCommandOptions c;
+  c.landmarks = "eyes";
+  EXPECT_NE(ResolveTrackOptions(c).status().message().find("--landmarks"), std::string::npos);
+  c.landmarks = "model";
+  c.generic_style = true;  // without --keep-cameras
+  EXPECT_NE(ResolveTrackOptions(c).status().message().find("--generic-style"), std::string::npos);
+  TrackCommandOptions none;  // nothing to track
+  EXPECT_NE(RunTrackCommand(none, std::cout, std::cerr).message().find("give the photos"), std::string::npos);
 }
 
 }  // namespace

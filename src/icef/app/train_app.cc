@@ -43,7 +43,8 @@ const std::vector<std::string>& ResumableConfigKeys() {
   return keys;
 }
 
-Result<RunConfig> ResolveResumeConfig(const TrainAppOptions& o, const RunConfig& saved, const std::string& checkpoint) {
+Result<RunConfig> ResolveResumeConfig(const TrainAppOptions& o, const RunConfig& saved,
+                                      const std::string& checkpoint) {
   ICEF_ASSIGN_OR_RETURN(const RunConfig config, ResolveFrom(saved, o));
   const Json before = saved.ToJson(), after = config.ToJson();
   std::string differ;
@@ -53,15 +54,17 @@ Result<RunConfig> ResolveResumeConfig(const TrainAppOptions& o, const RunConfig&
     std::string pointer = "/" + key;
     std::replace(pointer.begin(), pointer.end(), '.', '/');
     const Json::json_pointer at(pointer);
-    differ += (differ.empty() ? "" : ", ") + key + " (checkpoint " + (before.contains(at) ? before.at(at).dump() : "-") +
-              ", given " + (after.contains(at) ? after.at(at).dump() : "-") + ")";
+    differ += (differ.empty() ? "" : ", ") + key + " (checkpoint " +
+              (before.contains(at) ? before.at(at).dump() : "-") + ", given " +
+              (after.contains(at) ? after.at(at).dump() : "-") + ")";
   }
   if (differ.empty()) return config;
   std::string source = o.config_file ? o.config_file->string() : "--set/--method/--seed";
   std::string allowed;
   for (const std::string& key : ResumableConfigKeys()) allowed += (allowed.empty() ? "" : ", ") + key;
-  return Status::Error(checkpoint + ": cannot resume with a different run config (" + source + "): " + differ +
-                       "; only " + allowed + " may change when resuming (start afresh with --overwrite)");
+  return Status::Error(checkpoint + ": cannot resume with a different run config (" + source +
+                       "): " + differ + "; only " + allowed +
+                       " may change when resuming (start afresh with --overwrite)");
 }
 
 Result<TrainSummary> RunTrain(const TrainAppOptions& o, std::ostream& out) {
@@ -70,14 +73,16 @@ Result<TrainSummary> RunTrain(const TrainAppOptions& o, std::ostream& out) {
   const bool has_model = fs::exists(o.out / kCheckpointFile, ec);
   std::unique_ptr<Trainer> trainer;
   if (o.resume) {
-    if (!has_model) return Status::Error(o.out.string() + ": --resume given but there is no checkpoint to resume");
+    if (!has_model)
+      return Status::Error(o.out.string() + ": --resume given but there is no checkpoint to resume");
     const std::string checkpoint = (o.out / kCheckpointFile).string();
     auto configure = [&](const RunConfig& saved) { return ResolveResumeConfig(o, saved, checkpoint); };
     ICEF_ASSIGN_OR_RETURN(trainer, Trainer::Resume(dataset, o.out, configure, o.threads.value_or(0)));
   } else {
     if (has_model && !o.overwrite)
-      return Status::Error(o.out.string() + ": already holds a trained model; use --resume to continue it, "
-                                            "--overwrite to start afresh, or another --out");
+      return Status::Error(o.out.string() +
+                           ": already holds a trained model; use --resume to continue it, "
+                           "--overwrite to start afresh, or another --out");
     ICEF_ASSIGN_OR_RETURN(const RunConfig config, ResolveRunConfig(o));
     ICEF_ASSIGN_OR_RETURN(trainer, Trainer::Create(dataset, o.out, config));
   }
@@ -90,8 +95,8 @@ Result<TrainSummary> RunTrain(const TrainAppOptions& o, std::ostream& out) {
   if (const std::optional<face::FaceFit>& fit = trainer->model().setup().face_fit) {
     out << fit->BriefReport() << "\n";
     if (const std::optional<Vec3f>& light = trainer->model().prior_light())
-      out << "prior shading: light [" << light->x() << ", " << light->y() << ", " << light->z() << "] (strength "
-          << light->norm() << ", fitted to the training images' skin)\n";
+      out << "prior shading: light [" << light->x() << ", " << light->y() << ", " << light->z()
+          << "] (strength " << light->norm() << ", fitted to the training images' skin)\n";
     if (!trainer->density_start_note().empty()) out << trainer->density_start_note() << "\n";
     if (trainer->num_view_rays() > 0)
       out << "depth prior: " << trainer->num_view_rays() << " rays from " << config.train.depth_prior_views
@@ -99,8 +104,10 @@ Result<TrainSummary> RunTrain(const TrainAppOptions& o, std::ostream& out) {
     if (!trainer->prior_shading_note().empty())
       out << "prior shading: off, no light fitted (" << trainer->prior_shading_note() << ")\n";
     if (fit->Poor())
-      out << "warning: the face model fits the landmarks poorly (RMS above 0.1 inter-ocular distances): the prior "
-             "will pull expressions to the wrong places; check the dataset's landmarks and expression vectors\n";
+      out << "warning: the face model fits the landmarks poorly (RMS above 0.1 inter-ocular distances): the "
+             "prior "
+             "will pull expressions to the wrong places; check the dataset's landmarks and expression "
+             "vectors\n";
   }
   if (config.train.lambda_symmetry > 0) {
     const std::optional<SymmetryPlane>& plane = trainer->model().symmetry_plane();
@@ -110,7 +117,8 @@ Result<TrainSummary> RunTrain(const TrainAppOptions& o, std::ostream& out) {
       std::ostringstream line;
       line << "symmetry prior: landmark pairs mirror onto each other within " << std::setprecision(2)
            << plane->residual() << " inter-ocular distances";
-      if (plane->residual() > kAsymmetricFace) line << " (a clearly asymmetric face: consider train.lambda_symmetry=0)";
+      if (plane->residual() > kAsymmetricFace)
+        line << " (a clearly asymmetric face: consider train.lambda_symmetry=0)";
       out << line.str() << "\n";
     }
   }
@@ -119,8 +127,8 @@ Result<TrainSummary> RunTrain(const TrainAppOptions& o, std::ostream& out) {
   bar.Update(trainer->step());
   auto progress = [&](const TrainProgress& p) {
     std::ostringstream status;
-    status << std::fixed << std::setprecision(4) << "loss " << p.terms.total << std::setprecision(2) << " psnr "
-           << p.terms.psnr();
+    status << std::fixed << std::setprecision(4) << "loss " << p.terms.total << std::setprecision(2)
+           << " psnr " << p.terms.psnr();
     bar.Update(p.step, status.str());
   };
   const std::atomic<bool>* stop = InstallStopHandlers();
@@ -129,8 +137,9 @@ Result<TrainSummary> RunTrain(const TrainAppOptions& o, std::ostream& out) {
   out << summary.BriefReport() << "\n";
   out << "model: " << (o.out / kCheckpointFile).string() << "\nsummary: " << (o.out / "summary.json").string()
       << "\n";
-  if (summary.interrupted) out << "interrupted: resume with `icef train " << o.dataset.string() << " --out "
-                               << o.out.string() << " --resume`\n";
+  if (summary.interrupted)
+    out << "interrupted: resume with `icef train " << o.dataset.string() << " --out " << o.out.string()
+        << " --resume`\n";
   return summary;
 }
 

@@ -9,23 +9,24 @@
 #include <vector>
 
 #include "icef/core/status.h"
+#include "icef/train/train_config.h"
 #include "icef/train/trainer.h"
 
 namespace icef {
 
 struct TrainAppOptions {
-  std::filesystem::path dataset;             // dataset directory
-  std::filesystem::path out;                 // model directory
-  std::optional<std::string> method;         // overrides model.method
-  std::optional<int64_t> steps;              // overrides train.steps
-  std::optional<double> time_budget;         // overrides train.time_budget_seconds
+  std::filesystem::path dataset;                     // dataset directory
+  std::filesystem::path out;                         // model directory
+  std::optional<std::string> method;                 // overrides model.method
+  std::optional<int64_t> steps;                      // overrides train.steps
+  std::optional<double> time_budget;                 // overrides train.time_budget_seconds
   std::optional<std::filesystem::path> config_file;  // run config JSON
-  std::optional<int64_t> seed;               // overrides train.seed
-  std::optional<int> threads;                // overrides train.threads
-  std::vector<std::string> overrides;        // "section.key=value"
-  bool resume = false;                       // continue from out/checkpoint.icef
-  bool overwrite = false;                    // allow training into a directory that already holds a model
-  bool quiet = false;                        // no progress bar
+  std::optional<int64_t> seed;                       // overrides train.seed
+  std::optional<int> threads;                        // overrides train.threads
+  std::vector<std::string> overrides;                // "section.key=value"
+  bool resume = false;                               // continue from out/checkpoint.icef
+  bool overwrite = false;  // allow training into a directory that already holds a model
+  bool quiet = false;      // no progress bar
 };
 
 // Resolves the run config the options describe (without training).

@@ -4,10 +4,9 @@
 #include "icef/app/train_app.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <fstream>
-
-#include <unistd.h>
 
 namespace icef {
 namespace {
@@ -57,17 +56,21 @@ TEST(ResumeConfig, OtherChangesAreRefusedNamingEachKey) {
   o.method = "warp";
   const Status s = ResolveResumeConfig(o, Saved(), "m/checkpoint.icef").status();
   ASSERT_FALSE(s.ok());
-  EXPECT_NE(s.message().find("m/checkpoint.icef: cannot resume with a different run config"), std::string::npos)
+  EXPECT_NE(s.message().find("m/checkpoint.icef: cannot resume with a different run config"),
+            std::string::npos)
       << s.message();
-  EXPECT_NE(s.message().find("model.method (checkpoint \"icef-prior\", given \"warp\")"), std::string::npos) << s.message();
-  EXPECT_NE(s.message().find("train.lambda_id (checkpoint 0.2, given 0.5)"), std::string::npos) << s.message();
+  EXPECT_NE(s.message().find("model.method (checkpoint \"icef-prior\", given \"warp\")"), std::string::npos)
+      << s.message();
+  EXPECT_NE(s.message().find("train.lambda_id (checkpoint 0.2, given 0.5)"), std::string::npos)
+      << s.message();
   EXPECT_EQ(s.message().find("train.steps ("), std::string::npos) << "steps may change: " << s.message();
 }
 
 TEST(ResumeConfig, ConfigFileIsAWholeRunConfig) {
   // The same file as the original run: accepted (its step count applies).
   TrainAppOptions same;
-  same.config_file = WriteConfigFile("same.json", R"({"train": {"steps": 60, "lambda_id": 0.2, "threads": 2}})");
+  same.config_file =
+      WriteConfigFile("same.json", R"({"train": {"steps": 60, "lambda_id": 0.2, "threads": 2}})");
   const Result<RunConfig> c = ResolveResumeConfig(same, Saved(), "m/checkpoint.icef");
   ASSERT_TRUE(c.ok()) << c.status().message();
   EXPECT_EQ(c->train.steps, 60);
@@ -77,7 +80,8 @@ TEST(ResumeConfig, ConfigFileIsAWholeRunConfig) {
   const Status s = ResolveResumeConfig(other, Saved(), "m/checkpoint.icef").status();
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.message().find("other.json"), std::string::npos) << s.message();
-  EXPECT_NE(s.message().find("train.lambda_id (checkpoint 0.2, given 1.0)"), std::string::npos) << s.message();
+  EXPECT_NE(s.message().find("train.lambda_id (checkpoint 0.2, given 1.0)"), std::string::npos)
+      << s.message();
   fs::remove_all(other.config_file->parent_path());
 }
 

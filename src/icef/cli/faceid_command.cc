@@ -5,7 +5,6 @@
 
 #include "icef/app/faceid_app.h"
 #include "icef/cli/commands.h"
-#include "icef/eval/face_identity.h"
 
 namespace icef::cli {
 
@@ -17,7 +16,8 @@ CommandFn RegisterFaceId(CLI::App& app) {
                  "(others use dlib's face detector)");
   app.add_option("--faceid-model", args->model_dir,
                  "Directory with face_recognition_model{.bin,-weights_manifest.json} (default: "
-                 "$ICEF_FACEID_MODEL, else " + std::string(eval::kDefaultFaceIdModelDir) + ")");
+                 "$ICEF_FACEID_MODEL, else " +
+                     DefaultFaceIdModelDir() + ")");
   app.add_flag("--json", args->json, "Print one JSON document (descriptors, pairs)");
   return [args]() { return RunFaceId(*args, std::cout); };
 }

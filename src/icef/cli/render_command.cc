@@ -11,7 +11,8 @@ CommandFn RegisterRender(CLI::App& app) {
   app.description(
       "Render a trained model: colour, depth, region mask M and deformation magnitude as PNGs per frame, "
       "animated GIFs for sequences, and frames.json with delta, kappa and the nearest observed expression of "
-      "every frame (also printed). Models on the face-model prior (icef-prior, warp-prior) also get fit_NNN.png: "
+      "every frame (also printed). Models on the face-model prior (icef-prior, warp-prior) also get "
+      "fit_NNN.png: "
       "the fitted face model's outline at the frame's expression over the colour render.");
   auto o = std::make_shared<RenderAppOptions>();
   auto frame = std::make_shared<std::string>();
@@ -31,10 +32,14 @@ CommandFn RegisterRender(CLI::App& app) {
   app.add_option("--res", *res, "Image height of orbit/default cameras, pixels")->check(CLI::Range(8, 4096));
   app.add_option("--expression-frame", *expression_frame, "Expression of a dataset frame, SPLIT:INDEX");
   app.add_option("--beta", *beta, "Expression vector, comma-separated (expression_dim values)");
-  app.add_option("--set-expression", o->named, "NAME=VALUE on top of the expression, e.g. jaw_open=0.8 (repeatable)");
+  app.add_option("--set-expression", o->named,
+                 "NAME=VALUE on top of the expression, e.g. jaw_open=0.8 (repeatable)");
   app.add_option("--sweep", *sweep, "NAME=VALUE: frames from the expression to VALUE x --sweep-beyond");
-  app.add_option("--sweep-frames", o->sweep_frames, "Frames of a sweep")->capture_default_str()->check(CLI::Range(2, 1000));
-  app.add_option("--sweep-beyond", o->sweep_beyond, "The sweep ends at this multiple of the target")->capture_default_str();
+  app.add_option("--sweep-frames", o->sweep_frames, "Frames of a sweep")
+      ->capture_default_str()
+      ->check(CLI::Range(2, 1000));
+  app.add_option("--sweep-beyond", o->sweep_beyond, "The sweep ends at this multiple of the target")
+      ->capture_default_str();
   app.add_option("--threads", o->threads, "Worker threads (0 = all cores)")->check(kNonNegative);
   app.add_option(
       "--set", o->overrides,

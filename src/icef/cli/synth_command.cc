@@ -11,7 +11,6 @@
 #include "icef/app/synth_app.h"
 #include "icef/cli/commands.h"
 #include "icef/core/progress.h"
-#include "icef/synth/photo_set.h"
 
 namespace icef::cli {
 
@@ -19,48 +18,52 @@ CommandFn RegisterSynth(CLI::App& app) {
   auto args = std::make_shared<SynthAppOptions>();
   auto threads = std::make_shared<int>(0);
   auto num_photos = std::make_shared<int>(0);
-  auto diverse = std::make_shared<bool>(false);
-  auto vary = std::make_shared<std::vector<std::string>>();
-  auto pin = std::make_shared<std::vector<std::string>>();
   synth::SynthOptions& o = args->options;
   app.description(
-      "Render a synthetic ground-truth dataset from the procedural parametric head: K training "
-      "frames (distinct views, each with its own expression) and test frames at held-out views: "
-      "the training expressions (tier observed) and novel expressions in the near/moderate/far "
-      "tiers (delta = min_k ||beta - beta_k||), with neutral renders and 68 landmarks. The subject "
-      "performs the expressions in its own style (style.json: the style and its landmark gap to the "
-      "generic face model). With --photos N: instead N photos of the subject (random head pose, size, "
-      "position and expression over a procedural background) with their truth (alpha mask, camera, "
-      "expression, 68 landmarks) for testing a face tracker.");
+      "Render a synthetic ground-truth dataset from the procedural parametric head: K training frames "
+      "(distinct views, each with its own expression) and test frames at held-out views: the training "
+      "expressions (tier observed) and novel expressions in the near/moderate/far tiers (delta = min_k "
+      "||beta - beta_k||), with neutral renders and 68 landmarks. The subject performs the expressions in "
+      "its own style (style.json: the style and its landmark gap to the generic face model). With --photos "
+      "N: instead N photos of the subject (random head pose, size, position and expression over a procedural "
+      "background) with their truth (alpha mask, camera, expression, 68 landmarks) for testing a face "
+      "tracker.");
   app.add_option("--out,-o", args->out, "Output dataset (or photo-set) directory (created)")->required();
   app.add_option("--identity-seed,--seed", o.identity_seed,
                  "Identity seed (face shape, albedo, views, expressions)")
       ->capture_default_str();
   app.add_flag("--generic-style", o.generic_style,
                "Render the face model's generic expressions instead of the identity's own style");
-  app.add_flag("--canonical-shading", o.render.canonical_shading,
-               "Shade every point as its neutral canonical point is shaded, so the lighting moves with the skin "
-               "and no expression changes it: what a warp of a static field can reproduce (a reference for "
-               "scripts/expr_gain_probe.py, not a realistic render)");
+  app.add_flag(
+      "--canonical-shading", o.render.canonical_shading,
+      "Shade every point as its neutral canonical point is shaded, so the lighting moves with the skin and "
+      "no expression changes it: what a warp of a static field can reproduce (a reference for "
+      "scripts/expr_gain_probe.py, not a realistic render)");
   app.add_option("--k", o.num_train, "Number of training frames K")->capture_default_str();
   app.add_option("--res", o.resolution, "Image width = height in pixels")->capture_default_str();
   app.add_option("--test-views", o.test_views, "Held-out test views V")->capture_default_str();
-  app.add_option("--novel-per-tier", o.novel_per_tier, "Novel test expressions per tier (near, moderate, far)")
+  app.add_option("--novel-per-tier", o.novel_per_tier,
+                 "Novel test expressions per tier (near, moderate, far)")
       ->capture_default_str();
   app.add_option("--near", o.near_threshold, "Tier threshold t0: near = (0, t0]")->capture_default_str();
-  app.add_option("--far", o.far_threshold, "Tier threshold t1: moderate = (t0, t1], far > t1")->capture_default_str();
-  app.add_flag("--diverse", *diverse,
-               "Draw every scene axis per identity seed (skin, lighting, placement, camera, views, resolution, "
-               "detail; see scene.json) instead of the classic studio scene; --res pins the resolution");
-  app.add_option("--max-res", o.max_drawn_resolution,
-                 "Largest resolution the drawn resolution axis picks (from 128, 160, 192, 256, 320, 384, 448, 512; "
-                 "icef bench --validation draws up to 256: --max-res 256 makes its datasets)")
+  app.add_option("--far", o.far_threshold, "Tier threshold t1: moderate = (t0, t1], far > t1")
+      ->capture_default_str();
+  app.add_flag(
+      "--diverse", args->diverse,
+      "Draw every scene axis per identity seed (skin, lighting, placement, camera, views, resolution, "
+      "detail; see scene.json) instead of the classic studio scene; --res pins the resolution");
+  app.add_option(
+         "--max-res", o.max_drawn_resolution,
+         "Largest resolution the drawn resolution axis picks (from 128, 160, 192, 256, 320, 384, 448, 512; "
+         "icef bench --validation draws up to 256: --max-res 256 makes its datasets)")
       ->capture_default_str()
       ->check(CLI::Range(128, 4096));
-  app.add_option("--vary", *vary, "Draw these scene axes per identity seed (comma-separated axis names)")
+  app.add_option("--vary", args->vary, "Draw these scene axes per identity seed (comma-separated axis names)")
       ->delimiter(',');
-  app.add_option("--pin", *pin, "Keep these scene axes at the classic values (with --diverse)")->delimiter(',');
-  app.add_option("--supersample", o.render.supersample, "Samples per pixel along each axis")->capture_default_str();
+  app.add_option("--pin", args->pin, "Keep these scene axes at the classic values (with --diverse)")
+      ->delimiter(',');
+  app.add_option("--supersample", o.render.supersample, "Samples per pixel along each axis")
+      ->capture_default_str();
   app.add_option("--threads", *threads, "Worker threads (0 = all cores)")->capture_default_str();
   CLI::Option* contact =
       app.add_option("--contact-sheet", args->contact_sheet, "Also write a labelled contact sheet PNG here");
@@ -75,18 +78,15 @@ CommandFn RegisterSynth(CLI::App& app) {
                  "Photo-set mode: seed of the procedural backgrounds (0: derived from the identity seed)")
       ->capture_default_str()
       ->needs(photos);
-  for (const char* dataset_only : {"--k", "--res", "--max-res", "--test-views", "--novel-per-tier", "--near", "--far"})
+  for (const char* dataset_only :
+       {"--k", "--res", "--max-res", "--test-views", "--novel-per-tier", "--near", "--far"})
     photos->excludes(app.get_option(dataset_only));
   photos->excludes(contact);
   for (const char* scene : {"--diverse", "--vary", "--pin"}) photos->excludes(app.get_option(scene));
   CLI::Option* res = app.get_option("--res");
-  return [args, photos, threads, num_photos, diverse, vary, pin, res]() -> Status {
+  return [args, photos, threads, num_photos, res]() -> Status {
     SynthAppOptions options = *args;
-    synth::SceneAxes& axes = options.options.vary;
-    if (*diverse) axes = synth::SceneAxes::All();
-    for (const std::string& a : *vary) ICEF_RETURN_IF_ERROR(axes.Set(a, true).WithContext("--vary"));
-    for (const std::string& a : *pin) ICEF_RETURN_IF_ERROR(axes.Set(a, false).WithContext("--pin"));
-    if (res->count() > 0) axes.resolution = false;
+    options.resolution_given = res->count() > 0;
     if (photos->count() > 0) options.photos = *num_photos;
     options.interactive = StdoutIsTerminal();
     return RunSynth(options, Executor(*threads), std::cout);

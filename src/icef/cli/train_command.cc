@@ -4,7 +4,6 @@
 #include "icef/app/train_app.h"
 #include "icef/cli/commands.h"
 #include "icef/cli/validators.h"
-#include "icef/train/train_config.h"
 
 namespace icef::cli {
 
@@ -13,8 +12,10 @@ CommandFn RegisterTrain(CLI::App& app) {
       "Train a model on a dataset. The run config is the defaults (docs/config.md), then --config FILE, then "
       "--set overrides, then the dedicated flags. Writes MODEL/checkpoint.icef (periodically, atomically), "
       "config.json, train_log.jsonl and summary.json. Ctrl-C stops after the current step with a checkpoint; "
-      "--resume continues it with the checkpoint's run config: --config, --set and the flags may then change only "
-      "train.steps, train.time_budget_seconds, train.threads and train.on_nonfinite (anything else is refused, "
+      "--resume continues it with the checkpoint's run config: --config, --set and the flags may then change "
+      "only "
+      "train.steps, train.time_budget_seconds, train.threads and train.on_nonfinite (anything else is "
+      "refused, "
       "naming the keys).");
   auto o = std::make_shared<TrainAppOptions>();
   auto method = std::make_shared<std::string>();
@@ -25,7 +26,11 @@ CommandFn RegisterTrain(CLI::App& app) {
   auto threads = std::make_shared<int>(-1);
   app.add_option("dataset", o->dataset, "Dataset directory (transforms_train.json ...)")->required();
   app.add_option("--out", o->out, "Model directory to write")->required();
-  app.add_option("--method", *method, "icef-prior | warp-prior | icef | icef-no-id | icef-no-conf | icef-uniform | warp | nerface (default icef-prior: ICEF on the face model fitted to the training landmarks, docs/face_model.md; it needs the face model's expression names: re-express other datasets with icef track DATASET --keep-cameras, or train them with --method icef)");
+  app.add_option("--method", *method,
+                 "icef-prior | warp-prior | icef | icef-no-id | icef-no-conf | icef-uniform | warp | nerface "
+                 "(default icef-prior: ICEF on the face model fitted to the training landmarks, "
+                 "docs/face_model.md; it needs the face model's expression names: re-express other datasets "
+                 "with icef track DATASET --keep-cameras, or train them with --method icef)");
   const TrainConfig defaults;
   app.add_option("--steps", *steps,
                  "Optimiser steps (train.steps, default " + std::to_string(defaults.steps) +
@@ -41,10 +46,12 @@ CommandFn RegisterTrain(CLI::App& app) {
                  "Root random seed (train.seed, default " + std::to_string(defaults.seed) + ")")
       ->check(kNonNegative);
   app.add_option("--threads", *threads, "Worker threads (0 = all cores)")->check(kNonNegative);
-  app.add_option("--set", o->overrides, "Config override SECTION.KEY=VALUE, e.g. train.lambda_id=0.2 (repeatable)");
-  app.add_flag("--resume", o->resume,
-               "Continue from MODEL/checkpoint.icef (its run config; only the step count, time budget, threads and "
-               "train.on_nonfinite may change)");
+  app.add_option("--set", o->overrides,
+                 "Config override SECTION.KEY=VALUE, e.g. train.lambda_id=0.2 (repeatable)");
+  app.add_flag(
+      "--resume", o->resume,
+      "Continue from MODEL/checkpoint.icef (its run config; only the step count, time budget, threads and "
+      "train.on_nonfinite may change)");
   app.add_flag("--overwrite", o->overwrite, "Start afresh even if MODEL already holds a model");
   app.add_flag("--quiet", o->quiet, "No progress bar");
   return [=]() -> Status {

@@ -48,7 +48,8 @@ TEST(StatusTest, CheckThrowsWithLocation) {
 TEST(RngTest, StreamsAreDeterministicAndIndependent) {
   Rng a(42, StreamId("rays"), 3, 7), b(42, StreamId("rays"), 3, 7), c(42, StreamId("rays"), 3, 8);
   std::vector<uint64_t> va, vb, vc;
-  for (int i = 0; i < 16; ++i) va.push_back(a.NextU64()), vb.push_back(b.NextU64()), vc.push_back(c.NextU64());
+  for (int i = 0; i < 16; ++i)
+    va.push_back(a.NextU64()), vb.push_back(b.NextU64()), vc.push_back(c.NextU64());
   EXPECT_EQ(va, vb);
   EXPECT_NE(va, vc);
   Rng d(42, StreamId("rays"), 3, 7);
@@ -116,9 +117,10 @@ TEST(ParallelTest, BalancedChunksSplitSmallAndLargeBatches) {
 
 TEST(ParallelTest, ExceptionsReachTheCaller) {
   Executor ex(2);
-  EXPECT_THROW(ParallelFor(ex, 10, [](int64_t, int64_t, int t) {
-                 if (t == 1) throw std::runtime_error("boom");
-               }),
+  EXPECT_THROW(ParallelFor(ex, 10,
+                           [](int64_t, int64_t, int t) {
+                             if (t == 1) throw std::runtime_error("boom");
+                           }),
                std::runtime_error);
 }
 

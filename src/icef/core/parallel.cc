@@ -32,8 +32,7 @@ class ExceptionSlot {
 };
 }  // namespace
 
-void ParallelFor(const Executor& executor, int64_t n,
-                 const std::function<void(int64_t, int64_t, int)>& fn) {
+void ParallelFor(const Executor& executor, int64_t n, const std::function<void(int64_t, int64_t, int)>& fn) {
   if (n <= 0) return;
   const int threads = static_cast<int>(std::min<int64_t>(executor.num_threads(), n));
   if (threads == 1) {

@@ -14,8 +14,8 @@ double Rng::Normal() {
 
 std::string Rng::ToString() const {
   char buf[64];
-  std::snprintf(buf, sizeof buf, "Rng(key=%016llx, counter=%llu)",
-                static_cast<unsigned long long>(key_), static_cast<unsigned long long>(counter_));
+  std::snprintf(buf, sizeof buf, "Rng(key=%016llx, counter=%llu)", static_cast<unsigned long long>(key_),
+                static_cast<unsigned long long>(counter_));
   return buf;
 }
 

@@ -12,8 +12,7 @@ Status Status::WithContext(const std::string& prefix) const {
   return Status::Error(prefix + ": " + *message_);
 }
 
-void ThrowCheckFailure(const char* file, int line, const char* condition,
-                       const std::string& message) {
+void ThrowCheckFailure(const char* file, int line, const char* condition, const std::string& message) {
   std::string what = std::string(file) + ":" + std::to_string(line) + ": check failed: " + condition;
   if (!message.empty()) what += ": " + message;
   throw InternalError(what);

@@ -37,7 +37,7 @@ class Status {
 template <typename T>
 class Result {
  public:
-  Result(T value) : v_(std::move(value)) {}  // NOLINT: implicit by design
+  Result(T value) : v_(std::move(value)) {}        // NOLINT: implicit by design
   Result(Status status) : v_(std::move(status)) {  // NOLINT: implicit by design
     if (std::get<Status>(v_).ok()) v_ = Status::Error("internal: Result built from an OK Status");
   }
@@ -85,15 +85,15 @@ T&& Result<T>::value() && {
 }  // namespace icef
 
 // ICEF_CHECK(cond, "message"): throws icef::InternalError("file:line: check failed: cond: message").
-#define ICEF_CHECK(cond, ...)                                                          \
-  do {                                                                                 \
+#define ICEF_CHECK(cond, ...)                                                                    \
+  do {                                                                                           \
     if (!(cond)) ::icef::ThrowCheckFailure(__FILE__, __LINE__, #cond, std::string{__VA_ARGS__}); \
   } while (0)
 
 // Propagates an error Status out of the current function.
-#define ICEF_RETURN_IF_ERROR(expr)            \
-  do {                                        \
-    ::icef::Status icef_status_ = (expr);     \
+#define ICEF_RETURN_IF_ERROR(expr)               \
+  do {                                           \
+    ::icef::Status icef_status_ = (expr);        \
     if (!icef_status_.ok()) return icef_status_; \
   } while (0)
 

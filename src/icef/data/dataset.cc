@@ -2,23 +2,22 @@
 
 #include <sstream>
 
+#include "icef/core/enum_table.h"
+
 namespace icef {
 
-const char* TierName(Tier tier) {
-  switch (tier) {
-    case Tier::kObserved: return "observed";
-    case Tier::kNear: return "near";
-    case Tier::kModerate: return "moderate";
-    case Tier::kFar: return "far";
-  }
-  return "?";
-}
+namespace {
 
-std::optional<Tier> ParseTier(const std::string& name) {
-  for (Tier t : {Tier::kObserved, Tier::kNear, Tier::kModerate, Tier::kFar})
-    if (name == TierName(t)) return t;
-  return std::nullopt;
-}
+constexpr std::array<EnumEntry<Tier>, 4> kTierNames = {{{Tier::kObserved, "observed"},
+                                                        {Tier::kNear, "near"},
+                                                        {Tier::kModerate, "moderate"},
+                                                        {Tier::kFar, "far"}}};
+
+}  // namespace
+
+const char* TierName(Tier tier) { return EnumName(kTierNames, tier); }
+
+std::optional<Tier> ParseTier(const std::string& name) { return ParseEnum(kTierNames, name); }
 
 std::string Frame::ToString() const {
   std::ostringstream os;
@@ -35,10 +34,13 @@ std::string Frame::ToString() const {
 std::string Dataset::ToString() const {
   std::ostringstream os;
   os << "Dataset(" << root.string() << ", train=" << train.size() << ", test=" << test.size()
-     << ", val=" << val.size() << ", expression_dim=" << expression_dim << ", aabb=" << aabb.ToString() << ")";
+     << ", val=" << val.size() << ", expression_dim=" << expression_dim << ", aabb=" << aabb.ToString()
+     << ")";
   return os.str();
 }
 
-Result<Image> LoadFrameImage(const Dataset& dataset, const Frame& frame) { return ReadImage(dataset.ImagePath(frame)); }
+Result<Image> LoadFrameImage(const Dataset& dataset, const Frame& frame) {
+  return ReadImage(dataset.ImagePath(frame));
+}
 
 }  // namespace icef

@@ -25,14 +25,14 @@ const char* TierName(Tier tier);
 std::optional<Tier> ParseTier(const std::string& name);
 
 struct Frame {
-  std::string file_path;            // as written in the JSON, relative to the dataset directory
-  Camera camera;                    // intrinsics (global or per-frame) + camera-to-world pose
-  std::vector<float> expression;    // [expression_dim]
-  std::optional<std::vector<Vec2f>> landmarks_2d;  // [68] pixels (image coordinates, +0.5 centres)
+  std::string file_path;          // as written in the JSON, relative to the dataset directory
+  Camera camera;                  // intrinsics (global or per-frame) + camera-to-world pose
+  std::vector<float> expression;  // [expression_dim]
+  std::optional<std::vector<Vec2f>> landmarks_2d;         // [68] pixels (image coordinates, +0.5 centres)
   std::optional<std::vector<bool>> landmarks_2d_visible;  // [68] false where occluded (optional)
-  std::optional<std::vector<Vec3f>> landmarks_3d;  // [68] world frame
-  std::optional<double> delta;      // test frames: min_k ||beta - beta_k|| over training frames
-  std::optional<Tier> tier;         // test frames
+  std::optional<std::vector<Vec3f>> landmarks_3d;         // [68] world frame
+  std::optional<double> delta;                   // test frames: min_k ||beta - beta_k|| over training frames
+  std::optional<Tier> tier;                      // test frames
   std::optional<std::string> neutral_file_path;  // test frames: same view at expression zero
   // Test frames: the 68 landmarks of that neutral image (2D pixels, 3D world frame; optional).
   std::optional<std::vector<Vec2f>> neutral_landmarks_2d;
@@ -43,11 +43,11 @@ struct Frame {
 };
 
 struct Dataset {
-  std::filesystem::path root;       // directory holding the transforms_*.json files
-  Aabb aabb;                        // world frame
+  std::filesystem::path root;  // directory holding the transforms_*.json files
+  Aabb aabb;                   // world frame
   int expression_dim = 0;
-  std::vector<std::string> expression_names;  // [expression_dim], may be empty
-  Vec3f background = Vec3f::Ones();  // RGB in [0,1]
+  std::vector<std::string> expression_names;        // [expression_dim], may be empty
+  Vec3f background = Vec3f::Ones();                 // RGB in [0,1]
   std::optional<std::string> background_file_path;  // NerFace: a background image instead
   // Test-tier thresholds on delta: near = (0, t[0]], moderate = (t[0], t[1]], far > t[1].
   // JSON: "tier_thresholds": [t0, t1] (optional, written by `icef synth`).

@@ -5,26 +5,27 @@
 #include <cstdio>
 #include <sstream>
 
+#include "icef/core/enum_table.h"
 #include "icef/io/json_util.h"
 
 namespace icef {
 
 namespace fs = std::filesystem;
 
-const char* DatasetFormatName(DatasetFormat format) {
-  switch (format) {
-    case DatasetFormat::kAuto: return "auto";
-    case DatasetFormat::kIcef: return "icef";
-    case DatasetFormat::kNerface: return "nerface";
-    case DatasetFormat::kInstantNgp: return "instant-ngp";
-  }
-  return "?";
-}
+namespace {
+
+constexpr std::array<EnumEntry<DatasetFormat>, 4> kFormatNames = {
+    {{DatasetFormat::kAuto, "auto"},
+     {DatasetFormat::kIcef, "icef"},
+     {DatasetFormat::kNerface, "nerface"},
+     {DatasetFormat::kInstantNgp, "instant-ngp"}}};
+
+}  // namespace
+
+const char* DatasetFormatName(DatasetFormat format) { return EnumName(kFormatNames, format); }
 
 std::optional<DatasetFormat> ParseDatasetFormat(const std::string& name) {
-  for (DatasetFormat f : {DatasetFormat::kAuto, DatasetFormat::kIcef, DatasetFormat::kNerface, DatasetFormat::kInstantNgp})
-    if (name == DatasetFormatName(f)) return f;
-  return std::nullopt;
+  return ParseEnum(kFormatNames, name);
 }
 
 Result<DatasetFormat> DetectDatasetFormat(const fs::path& dir) {
@@ -51,8 +52,9 @@ std::string ImportOptions::ToString() const {
 std::string ImportReport::ToString() const {
   std::ostringstream os;
   os << "imported a " << DatasetFormatName(format) << " dataset into " << dataset.root.string() << ": train "
-     << dataset.train.size() << ", test " << dataset.test.size() << ", val " << dataset.val.size() << " frames, "
-     << images << " images " << "(expression_dim " << dataset.expression_dim << ")";
+     << dataset.train.size() << ", test " << dataset.test.size() << ", val " << dataset.val.size()
+     << " frames, " << images << " images "
+     << "(expression_dim " << dataset.expression_dim << ")";
   return os.str();
 }
 
@@ -117,7 +119,8 @@ Result<ImportReport> ImportDataset(const fs::path& src, const fs::path& dst, con
   ICEF_RETURN_IF_ERROR(options.Validate());
   std::error_code ec;
   if (fs::exists(dst, ec) && !(fs::is_directory(dst, ec) && fs::is_empty(dst, ec)))
-    return Status::Error(dst.string() + ": already exists and is not an empty directory (choose a new --out)");
+    return Status::Error(dst.string() +
+                         ": already exists and is not an empty directory (choose a new --out)");
   if (fs::exists(dst, ec) && fs::equivalent(src, dst, ec))
     return Status::Error(dst.string() + ": the destination must differ from the source");
 
@@ -130,11 +133,15 @@ Result<ImportReport> ImportDataset(const fs::path& src, const fs::path& dst, con
   ICEF_ASSIGN_OR_RETURN(const Dataset source, LoadDataset(src));
   const std::string train_file = (src / "transforms_train.json").string();
   if (report.format == DatasetFormat::kNerface && source.expression_dim == 0)
-    return Status::Error(train_file + ": frames[0].expression: missing (NerFace datasets have per-frame expressions)");
+    return Status::Error(train_file +
+                         ": frames[0].expression: missing (NerFace datasets have per-frame expressions)");
 
   const fs::path parent = dst.has_parent_path() ? dst.parent_path() : fs::path(".");
   if (!fs::is_directory(parent, ec)) return Status::Error(dst.string() + ": parent directory does not exist");
-  const fs::path temp = parent / std::string(1, '.').append(dst.filename().string()).append(".import-").append(std::to_string(::getpid()));
+  const fs::path temp = parent / std::string(1, '.')
+                                     .append(dst.filename().string())
+                                     .append(".import-")
+                                     .append(std::to_string(::getpid()));
   fs::remove_all(temp, ec);
   fs::create_directories(temp, ec);
   if (ec) return Status::Error(temp.string() + ": cannot create directory: " + ec.message());

@@ -21,7 +21,8 @@ std::map<std::string, std::string> Snapshot(const fs::path& dir) {
 }
 
 TEST(DatasetImport, FormatNamesRoundTrip) {
-  for (DatasetFormat f : {DatasetFormat::kAuto, DatasetFormat::kIcef, DatasetFormat::kNerface, DatasetFormat::kInstantNgp})
+  for (DatasetFormat f :
+       {DatasetFormat::kAuto, DatasetFormat::kIcef, DatasetFormat::kNerface, DatasetFormat::kInstantNgp})
     EXPECT_EQ(ParseDatasetFormat(DatasetFormatName(f)), f);
   EXPECT_FALSE(ParseDatasetFormat("colmap").has_value());
 }
@@ -76,7 +77,8 @@ TEST(DatasetImport, ConvertsANerfaceDataset) {
     EXPECT_EQ(ReadFile(d.ImagePath(d.train[i])).value(), ReadFile(source.ImagePath(source.train[i])).value());
   }
   EXPECT_LT((d.background - info.background_mean).cwiseAbs().maxCoeff(), 1e-6f);
-  EXPECT_EQ(ReadFile(root / "dst" / "background.png").value(), ReadFile(root / "src" / "bg" / "00050.png").value());
+  EXPECT_EQ(ReadFile(root / "dst" / "background.png").value(),
+            ReadFile(root / "src" / "bg" / "00050.png").value());
   EXPECT_EQ(report->dataset.root, root / "dst");
 }
 

@@ -178,7 +178,8 @@ Result<ParsedFrame> ParseFrame(const JsonObjectView& f, int expression_dim) {
     ICEF_ASSIGN_OR_RETURN(const std::vector<double> e, f.NumberArray("expression", expression_dim));
     frame.expression.assign(e.begin(), e.end());
   } else if (expression_dim > 0) {
-    return f.Error("expression", "missing required field (expression_dim is " + std::to_string(expression_dim) + ")");
+    return f.Error("expression",
+                   "missing required field (expression_dim is " + std::to_string(expression_dim) + ")");
   }
 
   if (f.Has("landmarks_2d")) {
@@ -205,7 +206,8 @@ Result<ParsedFrame> ParseFrame(const JsonObjectView& f, int expression_dim) {
   if (f.Has("tier")) {
     ICEF_ASSIGN_OR_RETURN(const std::string name, f.String("tier"));
     frame.tier = ParseTier(name);
-    if (!frame.tier) return f.Error("tier", "unknown tier \"" + name + "\" (expected observed, near, moderate or far)");
+    if (!frame.tier)
+      return f.Error("tier", "unknown tier \"" + name + "\" (expected observed, near, moderate or far)");
   }
   if (f.Has("neutral_file_path")) {
     ICEF_ASSIGN_OR_RETURN(frame.neutral_file_path, f.String("neutral_file_path"));
@@ -248,7 +250,8 @@ Result<SplitHeader> ParseHeader(const JsonObjectView& root) {
     h.expression_dim = dim;
   }
   if (root.Has("expression_names")) {
-    ICEF_ASSIGN_OR_RETURN(h.expression_names, root.StringArray("expression_names", h.expression_dim.value_or(-1)));
+    ICEF_ASSIGN_OR_RETURN(h.expression_names,
+                          root.StringArray("expression_names", h.expression_dim.value_or(-1)));
   }
   if (root.Has("background")) {
     ICEF_ASSIGN_OR_RETURN(const std::vector<double> c, root.NumberArray("background", 3));
@@ -274,9 +277,10 @@ Status Agree(const std::optional<T>& value, const SplitHeader& header, const cha
              std::optional<T>& merged, std::string& merged_from, Eq eq) {
   if (!value) return Status::Ok();
   if (merged && !eq(*merged, *value))
-    return Status::Error(header.file + ": " + key + ": differs from the value in " + merged_from +
-                         " (aabb, expression_dim, expression_names, background and tier_thresholds must agree "
-                         "across splits)");
+    return Status::Error(
+        header.file + ": " + key + ": differs from the value in " + merged_from +
+        " (aabb, expression_dim, expression_names, background and tier_thresholds must agree "
+        "across splits)");
   if (!merged) {
     merged = value;
     merged_from = header.file;
@@ -360,16 +364,17 @@ Result<std::vector<Frame>> LoadFrames(const fs::path& root, const SplitHeader& h
     const int w = p.camera.w.value_or(header.camera.w.value_or(c.info.width));
     const int h = p.camera.h.value_or(header.camera.h.value_or(c.info.height));
     if (c.info.width != w || c.info.height != h)
-      return f.Error("file_path", "image " + (root / c.file_path).string() + " is " + std::to_string(c.info.width) +
-                                      "x" + std::to_string(c.info.height) + ", but w x h is " + std::to_string(w) +
-                                      "x" + std::to_string(h));
+      return f.Error("file_path", "image " + (root / c.file_path).string() + " is " +
+                                      std::to_string(c.info.width) + "x" + std::to_string(c.info.height) +
+                                      ", but w x h is " + std::to_string(w) + "x" + std::to_string(h));
     const PartialIntrinsics local = Resolve(p.camera, w, h);
     const PartialIntrinsics global = Resolve(header.camera, w, h);
     Intrinsics k;
     k.width = w;
     k.height = h;
     if (!local.fl_x && !global.fl_x)
-      return f.Error("fl_x", "no focal length: give fl_x, camera_angle_x or intrinsics (in the file or the frame)");
+      return f.Error("fl_x",
+                     "no focal length: give fl_x, camera_angle_x or intrinsics (in the file or the frame)");
     k.fl_x = local.fl_x ? *local.fl_x : *global.fl_x;
     k.fl_y = local.fl_y ? *local.fl_y : global.fl_y.value_or(k.fl_x);
     k.cx = local.cx ? *local.cx : global.cx.value_or(0.5 * w);
@@ -387,10 +392,12 @@ Result<std::vector<Frame>> LoadFrames(const fs::path& root, const SplitHeader& h
 
 Result<Dataset> LoadDataset(const fs::path& dir) {
   std::error_code ec;
-  if (!fs::is_directory(dir, ec)) return Status::Error(dir.string() + ": not a dataset directory (does not exist or is not a directory)");
+  if (!fs::is_directory(dir, ec))
+    return Status::Error(dir.string() + ": not a dataset directory (does not exist or is not a directory)");
   const fs::path train_file = dir / "transforms_train.json";
   if (!fs::exists(train_file, ec))
-    return Status::Error(train_file.string() + ": not found (a dataset directory holds transforms_train.json)");
+    return Status::Error(train_file.string() +
+                         ": not found (a dataset directory holds transforms_train.json)");
 
   // Parse every split file first: documents must outlive the views into them.
   const char* kSplits[] = {"train", "test", "val"};
@@ -427,7 +434,8 @@ Result<Dataset> LoadDataset(const fs::path& dir) {
     ICEF_RETURN_IF_ERROR(Agree(h.expression_dim, h, "expression_dim", dim, from[1], same));
     ICEF_RETURN_IF_ERROR(Agree(h.expression_names, h, "expression_names", names, from[2], same));
     ICEF_RETURN_IF_ERROR(Agree(h.background, h, "background", background, from[3], same));
-    ICEF_RETURN_IF_ERROR(Agree(h.background_file_path, h, "background_file_path", background_file, from[4], same));
+    ICEF_RETURN_IF_ERROR(
+        Agree(h.background_file_path, h, "background_file_path", background_file, from[4], same));
     ICEF_RETURN_IF_ERROR(Agree(h.tier_thresholds, h, "tier_thresholds", thresholds, from[5], same));
   }
 
@@ -455,13 +463,13 @@ Result<Dataset> LoadDataset(const fs::path& dir) {
   if (background_file) {
     const fs::path path = dir / *background_file;
     if (!fs::is_regular_file(path, ec))
-      return Status::Error((from[4].empty() ? dir.string() : from[4]) + ": background_file_path: image not found: " +
-                           path.string());
+      return Status::Error((from[4].empty() ? dir.string() : from[4]) +
+                           ": background_file_path: image not found: " + path.string());
     ICEF_ASSIGN_OR_RETURN(const ImageInfo info, ReadImageInfo(path));
     if (train.camera.w && train.camera.h && (info.width != *train.camera.w || info.height != *train.camera.h))
-      return Status::Error(train.file + ": background_file_path: image is " + std::to_string(info.width) + "x" +
-                           std::to_string(info.height) + ", but w x h is " + std::to_string(*train.camera.w) + "x" +
-                           std::to_string(*train.camera.h));
+      return Status::Error(train.file + ": background_file_path: image is " + std::to_string(info.width) +
+                           "x" + std::to_string(info.height) + ", but w x h is " +
+                           std::to_string(*train.camera.w) + "x" + std::to_string(*train.camera.h));
     if (!background) {
       ICEF_ASSIGN_OR_RETURN(background, MeanColour(path));
     }
@@ -471,7 +479,8 @@ Result<Dataset> LoadDataset(const fs::path& dir) {
 
   const Executor executor;
   for (size_t s = 0; s < headers.size(); ++s) {
-    ICEF_ASSIGN_OR_RETURN(std::vector<Frame> frames, LoadFrames(dir, headers[s], dataset.expression_dim, executor));
+    ICEF_ASSIGN_OR_RETURN(std::vector<Frame> frames,
+                          LoadFrames(dir, headers[s], dataset.expression_dim, executor));
     if (present[s] == "train") dataset.train = std::move(frames);
     if (present[s] == "test") dataset.test = std::move(frames);
     if (present[s] == "val") dataset.val = std::move(frames);

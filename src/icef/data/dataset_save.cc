@@ -55,7 +55,8 @@ Status CheckFrame(const Dataset& d, const Frame& f, const std::string& where) {
     return Status::Error(where + ".neutral_landmarks_3d: expected 68 points");
   if (Status s = ValidateRigid(f.camera.world_from_cam()); !s.ok())
     return Status::Error(where + ".transform_matrix: " + s.message());
-  if (Status s = f.camera.intrinsics().Validate(); !s.ok()) return Status::Error(where + ": intrinsics: " + s.message());
+  if (Status s = f.camera.intrinsics().Validate(); !s.ok())
+    return Status::Error(where + ": intrinsics: " + s.message());
   return Status::Ok();
 }
 
@@ -91,11 +92,13 @@ Json FrameToJson(const Frame& f, const std::optional<Intrinsics>& global) {
 
 Status SaveDataset(const Dataset& d) {
   std::error_code ec;
-  if (!fs::is_directory(d.root, ec)) return Status::Error(d.root.string() + ": dataset directory does not exist");
+  if (!fs::is_directory(d.root, ec))
+    return Status::Error(d.root.string() + ": dataset directory does not exist");
   if (d.expression_dim < 0) return Status::Error(d.root.string() + ": expression_dim must be >= 0");
   if (!d.expression_names.empty() && d.expression_names.size() != size_t(d.expression_dim))
-    return Status::Error(d.root.string() + ": expression_names: has " + std::to_string(d.expression_names.size()) +
-                         " names, expression_dim is " + std::to_string(d.expression_dim));
+    return Status::Error(d.root.string() + ": expression_names: has " +
+                         std::to_string(d.expression_names.size()) + " names, expression_dim is " +
+                         std::to_string(d.expression_dim));
   if (!d.aabb.IsValid()) return Status::Error(d.root.string() + ": aabb: min must be below max");
 
   const std::pair<const char*, const std::vector<Frame>*> splits[] = {
@@ -104,7 +107,8 @@ Status SaveDataset(const Dataset& d) {
   std::optional<Intrinsics> global;
   for (const auto& [name, frames] : splits) {
     for (size_t i = 0; i < frames->size(); ++i)
-      ICEF_RETURN_IF_ERROR(CheckFrame(d, (*frames)[i], d.root.string() + ": " + name + "[" + std::to_string(i) + "]"));
+      ICEF_RETURN_IF_ERROR(
+          CheckFrame(d, (*frames)[i], d.root.string() + ": " + name + "[" + std::to_string(i) + "]"));
     if (!global && !frames->empty()) global = frames->front().camera.intrinsics();
   }
 
@@ -117,11 +121,13 @@ Status SaveDataset(const Dataset& d) {
     if (!d.expression_names.empty()) doc["expression_names"] = d.expression_names;
     doc["background"] = FloatArray(d.background.data(), 3);
     if (d.background_file_path) doc["background_file_path"] = *d.background_file_path;
-    if (d.tier_thresholds) doc["tier_thresholds"] = Json::array({(*d.tier_thresholds)[0], (*d.tier_thresholds)[1]});
+    if (d.tier_thresholds)
+      doc["tier_thresholds"] = Json::array({(*d.tier_thresholds)[0], (*d.tier_thresholds)[1]});
     Json list = Json::array();
     for (const Frame& f : *frames) list.push_back(FrameToJson(f, global));
     doc["frames"] = std::move(list);
-    ICEF_RETURN_IF_ERROR(WriteFileAtomic(d.root / ("transforms_" + std::string(name) + ".json"), FormatJson(doc)));
+    ICEF_RETURN_IF_ERROR(
+        WriteFileAtomic(d.root / ("transforms_" + std::string(name) + ".json"), FormatJson(doc)));
   }
   return Status::Ok();
 }

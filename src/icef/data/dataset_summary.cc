@@ -41,8 +41,8 @@ SplitSummary SummarizeSplit(const std::string& name, const std::vector<Frame>& f
 std::optional<Range> PairwiseDistances(const std::vector<Frame>& frames, const Executor& executor) {
   const int64_t n = static_cast<int64_t>(frames.size());
   if (n < 2) return std::nullopt;
-  std::vector<Range> per_thread(executor.num_threads(),
-                                Range{std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()});
+  std::vector<Range> per_thread(executor.num_threads(), Range{std::numeric_limits<double>::infinity(),
+                                                              -std::numeric_limits<double>::infinity()});
   ParallelFor(executor, n, [&](int64_t begin, int64_t end, int thread) {
     Range& r = per_thread[thread];
     for (int64_t i = begin; i < end; ++i)
@@ -105,7 +105,8 @@ DatasetSummary SummarizeDataset(const Dataset& d, const Executor& executor) {
     for (const Frame& f : *frames) {
       const Intrinsics& k = f.camera.intrinsics();
       const std::string res = std::to_string(k.width) + "x" + std::to_string(k.height);
-      if (std::find(s.resolutions.begin(), s.resolutions.end(), res) == s.resolutions.end()) s.resolutions.push_back(res);
+      if (std::find(s.resolutions.begin(), s.resolutions.end(), res) == s.resolutions.end())
+        s.resolutions.push_back(res);
       Extend(s.fl_x, k.fl_x);
       Extend(s.fl_y, k.fl_y);
       Extend(s.cx, k.cx);
@@ -125,19 +126,20 @@ std::string DatasetSummary::ToString() const {
   std::ostringstream os;
   const SplitSummary &train = Split("train"), &test = Split("test"), &val = Split("val");
   os << "dataset " << root << "\n";
-  os << "  frames:        train " << train.num_frames << ", test " << test.num_frames << ", val " << val.num_frames
-     << "\n";
+  os << "  frames:        train " << train.num_frames << ", test " << test.num_frames << ", val "
+     << val.num_frames << "\n";
   std::string res;
   for (const std::string& r : resolutions) res += (res.empty() ? "" : ", ") + r;
   os << "  resolution:    " << (res.empty() ? "-" : res) << "\n";
-  os << "  intrinsics:    fl_x " << RangeText(fl_x) << ", fl_y " << RangeText(fl_y) << ", cx " << RangeText(cx)
-     << ", cy " << RangeText(cy) << " (pixels)\n";
+  os << "  intrinsics:    fl_x " << RangeText(fl_x) << ", fl_y " << RangeText(fl_y) << ", cx "
+     << RangeText(cx) << ", cy " << RangeText(cy) << " (pixels)\n";
   os << "  aabb:          " << Vec3Text(aabb.min) << " .. " << Vec3Text(aabb.max) << "\n";
   os << "  expression:    dim " << expression_dim;
   if (!expression_names.empty()) {
     os << ": ";
     constexpr size_t kShown = 16;
-    for (size_t i = 0; i < expression_names.size() && i < kShown; ++i) os << (i ? ", " : "") << expression_names[i];
+    for (size_t i = 0; i < expression_names.size() && i < kShown; ++i)
+      os << (i ? ", " : "") << expression_names[i];
     if (expression_names.size() > kShown) os << ", ... (" << expression_names.size() - kShown << " more)";
   } else if (expression_dim > 0) {
     os << " (unnamed)";
@@ -166,11 +168,13 @@ std::string DatasetSummary::ToString() const {
     separator = "; ";
   }
   if (separator.empty()) os << "none";
-  if (tier_thresholds) os << " (thresholds " << Num((*tier_thresholds)[0]) << ", " << Num((*tier_thresholds)[1]) << ")";
+  if (tier_thresholds)
+    os << " (thresholds " << Num((*tier_thresholds)[0]) << ", " << Num((*tier_thresholds)[1]) << ")";
   os << "\n";
   os << "  train expression distance (pairwise): ";
   if (train_expression_distance) {
-    os << "min " << Num(train_expression_distance->min) << ", max " << Num(train_expression_distance->max) << "\n";
+    os << "min " << Num(train_expression_distance->min) << ", max " << Num(train_expression_distance->max)
+       << "\n";
   } else {
     os << "- (needs 2+ training frames)\n";
   }
@@ -202,14 +206,18 @@ Json DatasetSummary::ToJson() const {
   }
   j["splits"] = splits_json;
   j["resolutions"] = resolutions;
-  j["intrinsics"] = Json{{"fl_x", RangeJson(fl_x)}, {"fl_y", RangeJson(fl_y)}, {"cx", RangeJson(cx)}, {"cy", RangeJson(cy)}};
-  j["aabb"] = Json::array({Json::array({JsonFloat(aabb.min.x()), JsonFloat(aabb.min.y()), JsonFloat(aabb.min.z())}),
-                           Json::array({JsonFloat(aabb.max.x()), JsonFloat(aabb.max.y()), JsonFloat(aabb.max.z())})});
+  j["intrinsics"] = Json{
+      {"fl_x", RangeJson(fl_x)}, {"fl_y", RangeJson(fl_y)}, {"cx", RangeJson(cx)}, {"cy", RangeJson(cy)}};
+  j["aabb"] =
+      Json::array({Json::array({JsonFloat(aabb.min.x()), JsonFloat(aabb.min.y()), JsonFloat(aabb.min.z())}),
+                   Json::array({JsonFloat(aabb.max.x()), JsonFloat(aabb.max.y()), JsonFloat(aabb.max.z())})});
   j["expression_dim"] = expression_dim;
   j["expression_names"] = expression_names;
-  j["background"] = Json::array({JsonFloat(background.x()), JsonFloat(background.y()), JsonFloat(background.z())});
+  j["background"] =
+      Json::array({JsonFloat(background.x()), JsonFloat(background.y()), JsonFloat(background.z())});
   j["background_file_path"] = background_file_path ? Json(*background_file_path) : Json(nullptr);
-  j["tier_thresholds"] = tier_thresholds ? Json::array({(*tier_thresholds)[0], (*tier_thresholds)[1]}) : Json(nullptr);
+  j["tier_thresholds"] =
+      tier_thresholds ? Json::array({(*tier_thresholds)[0], (*tier_thresholds)[1]}) : Json(nullptr);
   j["train_expression_distance"] = RangeJson(train_expression_distance);
   j["test_missing"] = Split("test").num_frames == 0;
   return j;

@@ -19,20 +19,20 @@ struct Range {
 };
 
 struct SplitSummary {
-  std::string name;                      // "train", "test" or "val"
+  std::string name;  // "train", "test" or "val"
   int num_frames = 0;
-  int with_landmarks_2d = 0;             // frames that carry 68 2D landmarks
-  int with_landmarks_3d = 0;             // frames that carry 68 3D landmarks
-  int with_neutral = 0;                  // frames with a neutral_file_path
-  std::array<int, 4> tier_counts{};      // indexed by Tier
+  int with_landmarks_2d = 0;         // frames that carry 68 2D landmarks
+  int with_landmarks_3d = 0;         // frames that carry 68 3D landmarks
+  int with_neutral = 0;              // frames with a neutral_file_path
+  std::array<int, 4> tier_counts{};  // indexed by Tier
   int without_tier = 0;
-  std::optional<Range> delta;            // over frames that carry delta
+  std::optional<Range> delta;  // over frames that carry delta
 };
 
 struct DatasetSummary {
   std::string root;
-  std::vector<SplitSummary> splits;       // train, test, val (always all three)
-  std::vector<std::string> resolutions;   // distinct "WxH", in order of first appearance
+  std::vector<SplitSummary> splits;         // train, test, val (always all three)
+  std::vector<std::string> resolutions;     // distinct "WxH", in order of first appearance
   std::optional<Range> fl_x, fl_y, cx, cy;  // over all frames (absent without frames)
   Aabb aabb;
   int expression_dim = 0;

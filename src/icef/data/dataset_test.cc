@@ -119,7 +119,8 @@ TEST(Dataset, SaveLoadRoundTripIsExactAndStable) {
   WriteTinyDataset(dir, options);
   Dataset first = LoadDataset(dir).value();
   // Fields the fixture does not set: per-frame intrinsics, visibility, neutral image, bbox, image background.
-  first.train[2].camera = Camera(Intrinsics{8, 6, 11.25, 10.5, 4.25, 2.75}, first.train[2].camera.world_from_cam());
+  first.train[2].camera =
+      Camera(Intrinsics{8, 6, 11.25, 10.5, 4.25, 2.75}, first.train[2].camera.world_from_cam());
   first.train[0].landmarks_2d_visible = std::vector<bool>(kNumLandmarks, true);
   (*first.train[0].landmarks_2d_visible)[5] = false;
   first.test[1].neutral_file_path = first.train[1].file_path;
@@ -166,7 +167,8 @@ TEST(Dataset, NonRigidTransform) {
   const fs::path dir = MakeTempDir(TestName());
   WriteTinyDataset(dir);
   EditJson(dir / "transforms_train.json", [](Json& d) {
-    for (int r = 0; r < 3; ++r) d["frames"][2]["transform_matrix"][r][0] = 2.0 * d["frames"][2]["transform_matrix"][r][0].get<double>();
+    for (int r = 0; r < 3; ++r)
+      d["frames"][2]["transform_matrix"][r][0] = 2.0 * d["frames"][2]["transform_matrix"][r][0].get<double>();
   });
   ExpectLoadError(dir, "transforms_train.json: frames[2].transform_matrix: rotation is not orthonormal");
 }
@@ -175,7 +177,8 @@ TEST(Dataset, ReflectionAndBadLastRowAreNotRigid) {
   const fs::path dir = MakeTempDir(TestName());
   WriteTinyDataset(dir);
   EditJson(dir / "transforms_train.json", [](Json& d) {
-    for (int r = 0; r < 3; ++r) d["frames"][0]["transform_matrix"][r][0] = -d["frames"][0]["transform_matrix"][r][0].get<double>();
+    for (int r = 0; r < 3; ++r)
+      d["frames"][0]["transform_matrix"][r][0] = -d["frames"][0]["transform_matrix"][r][0].get<double>();
   });
   ExpectLoadError(dir, "transforms_train.json: frames[0].transform_matrix: rotation has determinant -1");
   WriteTinyDataset(dir);
@@ -187,7 +190,8 @@ TEST(Dataset, NonFiniteTransform) {
   const fs::path dir = MakeTempDir(TestName());
   WriteTinyDataset(dir);
   // Python's json.dump writes NaN literally.
-  EditJson(dir / "transforms_train.json", [](Json& d) { d["frames"][1]["transform_matrix"][0][3] = "@NAN@"; });
+  EditJson(dir / "transforms_train.json",
+           [](Json& d) { d["frames"][1]["transform_matrix"][0][3] = "@NAN@"; });
   std::string text = ReadFile(dir / "transforms_train.json").value();
   text.replace(text.find("\"@NAN@\""), 7, "NaN");
   ASSERT_TRUE(WriteFileAtomic(dir / "transforms_train.json", text).ok());
@@ -198,7 +202,8 @@ TEST(Dataset, WrongExpressionLength) {
   const fs::path dir = MakeTempDir(TestName());
   WriteTinyDataset(dir);
   EditJson(dir / "transforms_train.json", [](Json& d) { d["frames"][2]["expression"].erase(0); });
-  ExpectLoadError(dir, "transforms_train.json: frames[2].expression: expected an array of 4 numbers, got 3 values");
+  ExpectLoadError(
+      dir, "transforms_train.json: frames[2].expression: expected an array of 4 numbers, got 3 values");
 }
 
 TEST(Dataset, MissingExpression) {
@@ -214,13 +219,20 @@ TEST(Dataset, WrongLandmarkCount) {
   options.landmarks_3d = true;
   WriteTinyDataset(dir, options);
   EditJson(dir / "transforms_train.json", [](Json& d) { d["frames"][0]["landmarks_2d"].erase(67); });
-  ExpectLoadError(dir, "transforms_train.json: frames[0].landmarks_2d: expected an array of 68 arrays of 2 numbers, got 67 entries");
+  ExpectLoadError(dir,
+                  "transforms_train.json: frames[0].landmarks_2d: expected an array of 68 arrays of 2 "
+                  "numbers, got 67 entries");
   WriteTinyDataset(dir, options);
-  EditJson(dir / "transforms_train.json", [](Json& d) { d["frames"][1]["landmarks_3d"][4] = Json::array({1, 2}); });
-  ExpectLoadError(dir, "transforms_train.json: frames[1].landmarks_3d: expected an array of 68 arrays of 3 numbers");
+  EditJson(dir / "transforms_train.json", [](Json& d) {
+    d["frames"][1]["landmarks_3d"][4] = Json::array({1, 2});
+  });
+  ExpectLoadError(
+      dir, "transforms_train.json: frames[1].landmarks_3d: expected an array of 68 arrays of 3 numbers");
   WriteTinyDataset(dir, options);
-  EditJson(dir / "transforms_train.json", [](Json& d) { d["frames"][1]["landmarks_2d_visible"] = Json::array({true}); });
-  ExpectLoadError(dir, "transforms_train.json: frames[1].landmarks_2d_visible: expected an array of 68 booleans");
+  EditJson(dir / "transforms_train.json",
+           [](Json& d) { d["frames"][1]["landmarks_2d_visible"] = Json::array({true}); });
+  ExpectLoadError(dir,
+                  "transforms_train.json: frames[1].landmarks_2d_visible: expected an array of 68 booleans");
 }
 
 TEST(Dataset, UnknownTier) {
@@ -291,7 +303,8 @@ TEST(Dataset, ExpressionNamesMustMatchDim) {
   const fs::path dir = MakeTempDir(TestName());
   WriteTinyDataset(dir);
   EditJson(dir / "transforms_train.json", [](Json& d) { d["expression_names"].erase(0); });
-  ExpectLoadError(dir, "transforms_train.json: expression_names: expected an array of 4 strings, got 3 values");
+  ExpectLoadError(dir,
+                  "transforms_train.json: expression_names: expected an array of 4 strings, got 3 values");
 }
 
 TEST(Dataset, MissingTrainFileAndBadJson) {
@@ -331,7 +344,10 @@ TEST(Dataset, CameraAngleX) {
 TEST(Dataset, NoFocalLengthIsAnError) {
   const fs::path dir = MakeTempDir(TestName());
   WriteTinyDataset(dir);
-  EditJson(dir / "transforms_train.json", [](Json& d) { d.erase("fl_x"); d.erase("fl_y"); });
+  EditJson(dir / "transforms_train.json", [](Json& d) {
+    d.erase("fl_x");
+    d.erase("fl_y");
+  });
   ExpectLoadError(dir, "transforms_train.json: frames[0].fl_x: no focal length");
 }
 
@@ -353,7 +369,8 @@ TEST(Dataset, PerFrameIntrinsicsOverrideGlobalOnes) {
 TEST(Dataset, FilePathWithoutExtensionResolves) {
   const fs::path dir = MakeTempDir(TestName());
   WriteTinyDataset(dir);
-  EditJson(dir / "transforms_train.json", [](Json& d) { d["frames"][0]["file_path"] = "./images/train_000"; });
+  EditJson(dir / "transforms_train.json",
+           [](Json& d) { d["frames"][0]["file_path"] = "./images/train_000"; });
   const Dataset d = LoadDataset(dir).value();
   EXPECT_EQ(d.train[0].file_path, "./images/train_000.png");
   EXPECT_TRUE(fs::exists(d.ImagePath(d.train[0])));
@@ -375,7 +392,7 @@ TEST(Dataset, LoadsNerfaceLayoutDirectly) {
   EXPECT_EQ(k.width, 8);
   EXPECT_EQ(k.fl_x, info.intrinsics[0]);  // "intrinsics" wins over camera_angle_x
   EXPECT_EQ(k.fl_y, info.intrinsics[1]);
-  EXPECT_DOUBLE_EQ(k.cx, 0.5 * 8 + 0.5);   // fraction of the width; NerFace rays use integer pixels
+  EXPECT_DOUBLE_EQ(k.cx, 0.5 * 8 + 0.5);  // fraction of the width; NerFace rays use integer pixels
   EXPECT_DOUBLE_EQ(k.cy, 0.45 * 8 + 0.5);
   ASSERT_TRUE(d.background_file_path.has_value());
   EXPECT_EQ(*d.background_file_path, "bg/00050.png");
@@ -391,7 +408,8 @@ TEST(Dataset, NerfaceRaysMatchTheirConvention) {
   const Dataset d = LoadDataset(dir).value();
   const Camera& camera = d.train[1].camera;
   const int i = 5, j = 2;
-  const Vec3d dir_cam((i - 8 * info.intrinsics[2]) / info.intrinsics[0], -(j - 8 * info.intrinsics[3]) / info.intrinsics[1], -1.0);
+  const Vec3d dir_cam((i - 8 * info.intrinsics[2]) / info.intrinsics[0],
+                      -(j - 8 * info.intrinsics[3]) / info.intrinsics[1], -1.0);
   const Vec3d expected = (camera.world_from_cam().block<3, 3>(0, 0) * dir_cam).normalized();
   const Ray ray = camera.PixelRay(i, j);
   EXPECT_LT((ray.direction.cast<double>() - expected).norm(), 1e-6);

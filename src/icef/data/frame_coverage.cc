@@ -37,7 +37,8 @@ std::vector<int> ChooseCoverageFrames(const std::vector<CoverageCandidate>& cand
   std::vector<bool> preferred(n);
   int num_preferred = 0;
   for (int i = 0; i < n; ++i) {
-    preferred[i] = candidates[i].sharpness >= options.min_sharpness && (options.allow_blink || !candidates[i].blink);
+    preferred[i] =
+        candidates[i].sharpness >= options.min_sharpness && (options.allow_blink || !candidates[i].blink);
     num_preferred += preferred[i];
   }
   std::vector<int> chosen;

@@ -14,9 +14,8 @@ double Cross(const Vec2d& o, const Vec2d& a, const Vec2d& b) {
 
 // Convex hull, counter-clockwise (Andrew's monotone chain); degenerate inputs give fewer points.
 std::vector<Vec2d> ConvexHull(std::vector<Vec2d> p) {
-  std::sort(p.begin(), p.end(), [](const Vec2d& a, const Vec2d& b) {
-    return a.x() != b.x() ? a.x() < b.x() : a.y() < b.y();
-  });
+  std::sort(p.begin(), p.end(),
+            [](const Vec2d& a, const Vec2d& b) { return a.x() != b.x() ? a.x() < b.x() : a.y() < b.y(); });
   p.erase(std::unique(p.begin(), p.end()), p.end());
   if (p.size() < 3) return p;
   std::vector<Vec2d> h(2 * p.size());
@@ -45,11 +44,13 @@ bool InDilatedHull(const std::vector<Vec2d>& hull, const Vec2d& p, double dilati
   if (hull.empty()) return false;
   if (hull.size() >= 3) {
     bool inside = true;
-    for (size_t i = 0; i < hull.size() && inside; ++i) inside = Cross(hull[i], hull[(i + 1) % hull.size()], p) >= 0;
+    for (size_t i = 0; i < hull.size() && inside; ++i)
+      inside = Cross(hull[i], hull[(i + 1) % hull.size()], p) >= 0;
     if (inside) return true;
   }
   double d = (p - hull[0]).norm();
-  for (size_t i = 0; i < hull.size(); ++i) d = std::min(d, SegmentDistance(p, hull[i], hull[(i + 1) % hull.size()]));
+  for (size_t i = 0; i < hull.size(); ++i)
+    d = std::min(d, SegmentDistance(p, hull[i], hull[(i + 1) % hull.size()]));
   return d <= dilation;
 }
 
@@ -76,7 +77,9 @@ const std::vector<int>& ExpressionLandmarkIndices() {
   return kIndices;
 }
 
-int DefaultRegionDilation(int width) { return std::max(1, static_cast<int>(std::lround(3.0 * width / 128.0))); }
+int DefaultRegionDilation(int width) {
+  return std::max(1, static_cast<int>(std::lround(3.0 * width / 128.0)));
+}
 
 Image ExpressionRegion(int width, int height, const std::vector<Vec2f>& frame_landmarks,
                        const std::vector<Vec2f>& neutral_landmarks, int dilation) {

@@ -51,7 +51,8 @@ int Count(const Image& mask) {
 TEST(LandmarkRegionTest, HullRegionIsTheFilledLandmarkHull) {
   // A square [2, 10]^2 of landmarks (corners, edge midpoints, the centre), plus unusable points.
   const float nan = std::nanf("");
-  const std::vector<Vec2f> square = {{2, 2}, {10, 2}, {10, 10}, {2, 10}, {6, 2}, {6, 6}, {nan, 3}, {4, INFINITY}};
+  const std::vector<Vec2f> square = {{2, 2}, {10, 2}, {10, 10}, {2, 10},
+                                     {6, 2}, {6, 6},  {nan, 3}, {4, INFINITY}};
   const Image region = LandmarkHullRegion(16, 12, square);
   ASSERT_EQ(region.width, 16);
   ASSERT_EQ(region.height, 12);

@@ -17,7 +17,8 @@ namespace fs = std::filesystem;
 namespace icef::eval {
 
 const std::array<Tier, kNumTiers>& AllTiers() {
-  static const std::array<Tier, kNumTiers> kTiers = {Tier::kObserved, Tier::kNear, Tier::kModerate, Tier::kFar};
+  static const std::array<Tier, kNumTiers> kTiers = {Tier::kObserved, Tier::kNear, Tier::kModerate,
+                                                     Tier::kFar};
   return kTiers;
 }
 
@@ -32,7 +33,8 @@ Result<std::optional<double>> OptionalNumber(const Json& j, const std::string& w
   const auto it = j.find(key);
   if (it == j.end()) return Status::Error(where + "." + key + ": missing required field (a number or null)");
   if (it->is_null()) return std::optional<double>();
-  if (!it->is_number()) return Status::Error(where + "." + key + ": expected a number or null, got " + JsonTypeDescription(*it));
+  if (!it->is_number())
+    return Status::Error(where + "." + key + ": expected a number or null, got " + JsonTypeDescription(*it));
   const double v = it->get<double>();
   if (!std::isfinite(v)) return Status::Error(where + "." + key + ": non-finite number");
   return std::optional<double>(v);
@@ -58,26 +60,47 @@ std::string Fmt(const std::optional<double>& v, const char* format) {
 
 }  // namespace
 
+std::span<const MetricField> MetricFields() {
+  static const MetricField kFields[] = {
+      {"psnr", &FrameMetrics::psnr, &TierMetrics::psnr, true},
+      {"ssim", &FrameMetrics::ssim, &TierMetrics::ssim, true},
+      {"lpips", &FrameMetrics::lpips, &TierMetrics::lpips, true},
+      {"id_cosine", &FrameMetrics::id_cosine, &TierMetrics::id_cosine, true},
+      {"id_distance", &FrameMetrics::id_distance, &TierMetrics::id_distance, true},
+      {"id_distance_gt", &FrameMetrics::id_distance_gt, &TierMetrics::id_distance_gt, true},
+      {"id_distance_reference", &FrameMetrics::id_distance_reference, &TierMetrics::id_distance_reference,
+       false},
+      {"id_excess", &FrameMetrics::id_excess, &TierMetrics::id_excess, false},
+      {"expr_gain", &FrameMetrics::expr_gain, &TierMetrics::expr_gain, false},
+      {"expr_corr", &FrameMetrics::expr_corr, &TierMetrics::expr_corr, false},
+      {"expr_gain_coarse", &FrameMetrics::expr_gain_coarse, &TierMetrics::expr_gain_coarse, false},
+      {"region_psnr", &FrameMetrics::region_psnr, &TierMetrics::region_psnr, false},
+      {"psnr_neutral_floor", &FrameMetrics::psnr_neutral_floor, &TierMetrics::psnr_neutral_floor, false},
+      {"face_detail", &FrameMetrics::face_detail, &TierMetrics::face_detail, false},
+  };
+  return kFields;
+}
+
+namespace {
+
+// One optional metric read from `j` into `*out`: a required one must be there (a number or null),
+// an optional one may be absent.
+Status ReadMetric(const Json& j, const std::string& where, const char* key, bool required,
+                  std::optional<double>* out) {
+  if (!required && !j.contains(key)) return Status::Ok();
+  ICEF_ASSIGN_OR_RETURN(*out, OptionalNumber(j, where, key));
+  return Status::Ok();
+}
+
+}  // namespace
+
 Json FrameMetrics::ToJson() const {
   Json j;
   j["file_path"] = file_path;
   j["tier"] = TierName(tier);
   j["delta"] = delta;
-  j["psnr"] = OptionalJson(psnr);
-  j["ssim"] = OptionalJson(ssim);
-  j["lpips"] = OptionalJson(lpips);
-  j["id_cosine"] = OptionalJson(id_cosine);
-  j["id_distance"] = OptionalJson(id_distance);
-  j["id_distance_gt"] = OptionalJson(id_distance_gt);
-  j["id_distance_reference"] = OptionalJson(id_distance_reference);
-  j["id_excess"] = OptionalJson(id_excess);
-  j["expr_gain"] = OptionalJson(expr_gain);
-  j["expr_corr"] = OptionalJson(expr_corr);
-  j["expr_gain_coarse"] = OptionalJson(expr_gain_coarse);
+  for (const MetricField& f : MetricFields()) j[f.key] = OptionalJson(this->*f.frame);
   j["expr_true_rms"] = OptionalJson(expr_true_rms);
-  j["region_psnr"] = OptionalJson(region_psnr);
-  j["psnr_neutral_floor"] = OptionalJson(psnr_neutral_floor);
-  j["face_detail"] = OptionalJson(face_detail);
   j["nearest_index"] = nearest_index;
   j["model_delta"] = model_delta;
   j["kappa"] = kappa;
@@ -101,28 +124,13 @@ Result<FrameMetrics> FrameMetrics::FromJson(const Json& j, const std::string& wh
                          "' (expected observed, near, moderate or far)");
   f.tier = *parsed;
   ICEF_ASSIGN_OR_RETURN(f.delta, RequiredNumber(j, where, "delta"));
-  ICEF_ASSIGN_OR_RETURN(f.psnr, OptionalNumber(j, where, "psnr"));
-  ICEF_ASSIGN_OR_RETURN(f.ssim, OptionalNumber(j, where, "ssim"));
-  ICEF_ASSIGN_OR_RETURN(f.lpips, OptionalNumber(j, where, "lpips"));
-  ICEF_ASSIGN_OR_RETURN(f.id_cosine, OptionalNumber(j, where, "id_cosine"));
-  ICEF_ASSIGN_OR_RETURN(f.id_distance, OptionalNumber(j, where, "id_distance"));
-  ICEF_ASSIGN_OR_RETURN(f.id_distance_gt, OptionalNumber(j, where, "id_distance_gt"));
-  // Extras are optional (hand-written metrics files may omit them).
-  if (j.contains("id_distance_reference")) {
-    ICEF_ASSIGN_OR_RETURN(f.id_distance_reference, OptionalNumber(j, where, "id_distance_reference"));
-  }
-  for (auto [key, field] : {std::pair{"id_excess", &f.id_excess}, std::pair{"expr_gain", &f.expr_gain},
-                            std::pair{"expr_corr", &f.expr_corr}, std::pair{"expr_true_rms", &f.expr_true_rms},
-                            std::pair{"expr_gain_coarse", &f.expr_gain_coarse},
-                            std::pair{"region_psnr", &f.region_psnr},
-                            std::pair{"psnr_neutral_floor", &f.psnr_neutral_floor},
-                            std::pair{"face_detail", &f.face_detail}}) {
-    if (j.contains(key)) {
-      ICEF_ASSIGN_OR_RETURN(*field, OptionalNumber(j, where, key));
-    }
-  }
-  if (j.contains("nearest_index") && j["nearest_index"].is_number_integer()) f.nearest_index = j["nearest_index"].get<int>();
-  if (j.contains("model_delta") && j["model_delta"].is_number()) f.model_delta = j["model_delta"].get<double>();
+  for (const MetricField& field : MetricFields())
+    ICEF_RETURN_IF_ERROR(ReadMetric(j, where, field.key, field.required, &(f.*field.frame)));
+  ICEF_RETURN_IF_ERROR(ReadMetric(j, where, "expr_true_rms", false, &f.expr_true_rms));
+  if (j.contains("nearest_index") && j["nearest_index"].is_number_integer())
+    f.nearest_index = j["nearest_index"].get<int>();
+  if (j.contains("model_delta") && j["model_delta"].is_number())
+    f.model_delta = j["model_delta"].get<double>();
   if (j.contains("kappa") && j["kappa"].is_number()) f.kappa = j["kappa"].get<double>();
   f.landmarks = OptionalString(j, "landmarks");
   f.neutral_landmarks = OptionalString(j, "neutral_landmarks");
@@ -133,21 +141,8 @@ Result<FrameMetrics> FrameMetrics::FromJson(const Json& j, const std::string& wh
 Json TierMetrics::ToJson() const {
   Json j;
   j["count"] = count;
-  j["psnr"] = OptionalJson(psnr);
-  j["ssim"] = OptionalJson(ssim);
-  j["lpips"] = OptionalJson(lpips);
-  j["id_cosine"] = OptionalJson(id_cosine);
-  j["id_distance"] = OptionalJson(id_distance);
-  j["id_distance_gt"] = OptionalJson(id_distance_gt);
+  for (const MetricField& f : MetricFields()) j[f.key] = OptionalJson(this->*f.tier);
   j["id_share_under_0_6"] = OptionalJson(id_share_under_0_6);
-  j["id_distance_reference"] = OptionalJson(id_distance_reference);
-  j["id_excess"] = OptionalJson(id_excess);
-  j["expr_gain"] = OptionalJson(expr_gain);
-  j["expr_corr"] = OptionalJson(expr_corr);
-  j["expr_gain_coarse"] = OptionalJson(expr_gain_coarse);
-  j["region_psnr"] = OptionalJson(region_psnr);
-  j["psnr_neutral_floor"] = OptionalJson(psnr_neutral_floor);
-  j["face_detail"] = OptionalJson(face_detail);
   j["expr_count"] = expr_count;
   j["expr_negligible"] = expr_negligible;
   j["id_count"] = id_count;
@@ -161,26 +156,11 @@ Result<TierMetrics> TierMetrics::FromJson(const Json& j, const std::string& wher
   ICEF_ASSIGN_OR_RETURN(const double count, RequiredNumber(j, where, "count"));
   if (count < 0 || count != std::floor(count)) return Status::Error(where + ".count: expected a count");
   t.count = static_cast<int>(count);
-  ICEF_ASSIGN_OR_RETURN(t.psnr, OptionalNumber(j, where, "psnr"));
-  ICEF_ASSIGN_OR_RETURN(t.ssim, OptionalNumber(j, where, "ssim"));
-  ICEF_ASSIGN_OR_RETURN(t.lpips, OptionalNumber(j, where, "lpips"));
-  ICEF_ASSIGN_OR_RETURN(t.id_cosine, OptionalNumber(j, where, "id_cosine"));
-  ICEF_ASSIGN_OR_RETURN(t.id_distance, OptionalNumber(j, where, "id_distance"));
-  ICEF_ASSIGN_OR_RETURN(t.id_distance_gt, OptionalNumber(j, where, "id_distance_gt"));
-  ICEF_ASSIGN_OR_RETURN(t.id_share_under_0_6, OptionalNumber(j, where, "id_share_under_0_6"));
-  if (j.contains("id_distance_reference")) {
-    ICEF_ASSIGN_OR_RETURN(t.id_distance_reference, OptionalNumber(j, where, "id_distance_reference"));
-  }
-  for (auto [key, field] : {std::pair{"id_excess", &t.id_excess}, std::pair{"expr_gain", &t.expr_gain},
-                            std::pair{"expr_corr", &t.expr_corr}, std::pair{"region_psnr", &t.region_psnr},
-                            std::pair{"expr_gain_coarse", &t.expr_gain_coarse},
-                            std::pair{"psnr_neutral_floor", &t.psnr_neutral_floor},
-                            std::pair{"face_detail", &t.face_detail}}) {
-    if (j.contains(key)) {
-      ICEF_ASSIGN_OR_RETURN(*field, OptionalNumber(j, where, key));
-    }
-  }
-  if (j.contains("expr_count") && j["expr_count"].is_number_integer()) t.expr_count = j["expr_count"].get<int>();
+  for (const MetricField& field : MetricFields())
+    ICEF_RETURN_IF_ERROR(ReadMetric(j, where, field.key, field.required, &(t.*field.tier)));
+  ICEF_RETURN_IF_ERROR(ReadMetric(j, where, "id_share_under_0_6", true, &t.id_share_under_0_6));
+  if (j.contains("expr_count") && j["expr_count"].is_number_integer())
+    t.expr_count = j["expr_count"].get<int>();
   if (j.contains("expr_negligible") && j["expr_negligible"].is_number_integer())
     t.expr_negligible = j["expr_negligible"].get<int>();
   if (j.contains("id_count") && j["id_count"].is_number_integer()) t.id_count = j["id_count"].get<int>();
@@ -197,56 +177,34 @@ std::array<TierMetrics, kNumTiers> AggregateTiers(const std::vector<FrameMetrics
     }
     std::optional<double> Mean() const { return n > 0 ? std::optional<double>(sum / n) : std::nullopt; }
   };
+  const std::span<const MetricField> fields = MetricFields();
   struct TierAcc {
-    Acc psnr, ssim, lpips, id_cosine, id_distance, id_distance_gt, under, delta, reference, excess, gain, corr,
-        gain_coarse, region_psnr, floor, detail;
-    int negligible = 0;
+    std::vector<Acc> metrics;  // one per MetricFields() entry
+    Acc under, delta;
+    int negligible = 0, expr_count = 0, id_count = 0;
   };
   std::array<TierAcc, kNumTiers> acc;
+  for (TierAcc& a : acc) a.metrics.resize(fields.size());
   std::array<TierMetrics, kNumTiers> out;
   for (const FrameMetrics& f : frames) {
     const int t = TierIndex(f.tier);
     TierAcc& a = acc[t];
     ++out[t].count;
     a.delta.Add(f.delta);
-    a.psnr.Add(f.psnr);
-    a.ssim.Add(f.ssim);
-    a.lpips.Add(f.lpips);
-    a.id_cosine.Add(f.id_cosine);
-    a.id_distance.Add(f.id_distance);
-    a.id_distance_gt.Add(f.id_distance_gt);
-    a.reference.Add(f.id_distance_reference);
-    a.excess.Add(f.id_excess);
-    a.gain.Add(f.expr_gain);
-    a.corr.Add(f.expr_corr);
-    a.gain_coarse.Add(f.expr_gain_coarse);
-    a.region_psnr.Add(f.region_psnr);
-    a.floor.Add(f.psnr_neutral_floor);
-    a.detail.Add(f.face_detail);
+    for (size_t i = 0; i < fields.size(); ++i) a.metrics[i].Add(f.*fields[i].frame);
+    a.expr_count += f.expr_gain.has_value();
+    a.id_count += f.id_distance.has_value();
     if (f.expr_true_rms && !f.expr_gain) ++a.negligible;
     if (f.id_distance) a.under.Add(*f.id_distance < kSamePersonThreshold ? 1.0 : 0.0);
   }
   for (int t = 0; t < kNumTiers; ++t) {
     const TierAcc& a = acc[t];
     TierMetrics& m = out[t];
-    m.psnr = a.psnr.Mean();
-    m.ssim = a.ssim.Mean();
-    m.lpips = a.lpips.Mean();
-    m.id_cosine = a.id_cosine.Mean();
-    m.id_distance = a.id_distance.Mean();
-    m.id_distance_gt = a.id_distance_gt.Mean();
+    for (size_t i = 0; i < fields.size(); ++i) m.*fields[i].tier = a.metrics[i].Mean();
     m.id_share_under_0_6 = a.under.Mean();
-    m.id_distance_reference = a.reference.Mean();
-    m.id_excess = a.excess.Mean();
-    m.expr_gain = a.gain.Mean();
-    m.expr_corr = a.corr.Mean();
-    m.expr_gain_coarse = a.gain_coarse.Mean();
-    m.region_psnr = a.region_psnr.Mean();
-    m.psnr_neutral_floor = a.floor.Mean();
-    m.face_detail = a.detail.Mean();
-    m.expr_count = a.gain.n;
+    m.expr_count = a.expr_count;
     m.expr_negligible = a.negligible;
-    m.id_count = a.id_distance.n;
+    m.id_count = a.id_count;
     m.mean_delta = a.delta.Mean().value_or(0.0);
   }
   return out;
@@ -271,7 +229,8 @@ Result<TrainFrameFit> TrainFrameFit::FromJson(const Json& j, const std::string& 
   f.file_path = path->get<std::string>();
   ICEF_ASSIGN_OR_RETURN(f.face_psnr, OptionalNumber(j, where, "face_psnr"));
   ICEF_ASSIGN_OR_RETURN(f.psnr, OptionalNumber(j, where, "psnr"));
-  if (j.contains("face_pixels") && j["face_pixels"].is_number_integer()) f.face_pixels = j["face_pixels"].get<int>();
+  if (j.contains("face_pixels") && j["face_pixels"].is_number_integer())
+    f.face_pixels = j["face_pixels"].get<int>();
   if (j.contains("face_detail")) {
     ICEF_ASSIGN_OR_RETURN(f.face_detail, OptionalNumber(j, where, "face_detail"));
   }
@@ -319,7 +278,8 @@ Result<TrainingFit> TrainingFit::FromJson(const Json& j, const std::string& wher
   ICEF_ASSIGN_OR_RETURN(const double count, RequiredNumber(j, where, "count"));
   if (count < 0 || count != std::floor(count)) return Status::Error(where + ".count: expected a count");
   fit.count = static_cast<int>(count);
-  if (j.contains("face_count") && j["face_count"].is_number_integer()) fit.face_count = j["face_count"].get<int>();
+  if (j.contains("face_count") && j["face_count"].is_number_integer())
+    fit.face_count = j["face_count"].get<int>();
   ICEF_ASSIGN_OR_RETURN(fit.face_psnr, OptionalNumber(j, where, "face_psnr"));
   ICEF_ASSIGN_OR_RETURN(fit.face_psnr_min, OptionalNumber(j, where, "face_psnr_min"));
   ICEF_ASSIGN_OR_RETURN(fit.psnr, OptionalNumber(j, where, "psnr"));
@@ -329,8 +289,8 @@ Result<TrainingFit> TrainingFit::FromJson(const Json& j, const std::string& wher
   const auto frames = j.find("frames");
   if (frames == j.end() || !frames->is_array()) return Status::Error(where + ".frames: expected an array");
   for (size_t i = 0; i < frames->size(); ++i) {
-    ICEF_ASSIGN_OR_RETURN(TrainFrameFit f,
-                          TrainFrameFit::FromJson((*frames)[i], where + ".frames[" + std::to_string(i) + "]"));
+    ICEF_ASSIGN_OR_RETURN(
+        TrainFrameFit f, TrainFrameFit::FromJson((*frames)[i], where + ".frames[" + std::to_string(i) + "]"));
     fit.frames.push_back(std::move(f));
   }
   return fit;
@@ -340,8 +300,8 @@ std::string TrainingFit::Summary() const {
   if (count == 0) return "training-view fit: unavailable (no training frame rendered)";
   const std::string all = std::to_string(count) + " views";
   if (!face_psnr)
-    return "training-view fit: face-region PSNR unavailable (no landmarks_2d), full image " + Fmt(psnr, "%.2f") +
-           " dB (" + all + ")";
+    return "training-view fit: face-region PSNR unavailable (no landmarks_2d), full image " +
+           Fmt(psnr, "%.2f") + " dB (" + all + ")";
   const std::string views = face_count == count ? all : std::to_string(face_count) + " of " + all;
   return "training-view fit: face-region PSNR " + Fmt(face_psnr, "%.2f") + " dB (worst " +
          Fmt(face_psnr_min, "%.2f") + ", " + views + "), full image " + Fmt(psnr, "%.2f") +
@@ -384,8 +344,8 @@ Result<EvalResult> EvalResult::FromJson(const Json& j, const std::string& origin
   const auto frames = j.find("frames");
   if (frames == j.end() || !frames->is_array()) return Status::Error(origin + ": frames: expected an array");
   for (size_t i = 0; i < frames->size(); ++i) {
-    ICEF_ASSIGN_OR_RETURN(FrameMetrics f,
-                          FrameMetrics::FromJson((*frames)[i], origin + ": frames[" + std::to_string(i) + "]"));
+    ICEF_ASSIGN_OR_RETURN(
+        FrameMetrics f, FrameMetrics::FromJson((*frames)[i], origin + ": frames[" + std::to_string(i) + "]"));
     r.frames.push_back(std::move(f));
   }
   const auto tiers = j.find("tiers");
@@ -407,34 +367,39 @@ std::string EvalResult::Table() const {
   std::ostringstream s;
   char line[256];
   if (expression_scale != 1) s << "every frame rendered at " << expression_scale << " x its expression\n";
-  std::snprintf(line, sizeof line, "%-9s %5s %7s %7s %6s %6s %9s %9s %11s %10s %9s %11s\n", "tier", "count", "psnr",
-                "floor", "ssim", "lpips", "expr_gain", "expr_corr", "expr_coarse", "region_psnr", "expr_n",
-                "face_detail");
+  std::snprintf(line, sizeof line, "%-9s %5s %7s %7s %6s %6s %9s %9s %11s %10s %9s %11s\n", "tier", "count",
+                "psnr", "floor", "ssim", "lpips", "expr_gain", "expr_corr", "expr_coarse", "region_psnr",
+                "expr_n", "face_detail");
   s << line;
   for (Tier t : AllTiers()) {
     const TierMetrics& m = tiers[TierIndex(t)];
-    const std::string expr_n = std::to_string(m.expr_count) + (m.expr_negligible ? "+" + std::to_string(m.expr_negligible) : "");
-    std::snprintf(line, sizeof line, "%-9s %5d %7s %7s %6s %6s %9s %9s %11s %10s %9s %11s\n", TierName(t), m.count,
-                  Fmt(m.psnr, "%.2f").c_str(), Fmt(m.psnr_neutral_floor, "%.2f").c_str(), Fmt(m.ssim, "%.3f").c_str(),
-                  Fmt(m.lpips, "%.3f").c_str(), Fmt(m.expr_gain, "%.3f").c_str(), Fmt(m.expr_corr, "%.3f").c_str(),
-                  Fmt(m.expr_gain_coarse, "%.3f").c_str(), Fmt(m.region_psnr, "%.2f").c_str(), expr_n.c_str(),
-                  Fmt(m.face_detail, "%.2f").c_str());
+    const std::string expr_n =
+        std::to_string(m.expr_count) + (m.expr_negligible ? "+" + std::to_string(m.expr_negligible) : "");
+    std::snprintf(line, sizeof line, "%-9s %5d %7s %7s %6s %6s %9s %9s %11s %10s %9s %11s\n", TierName(t),
+                  m.count, Fmt(m.psnr, "%.2f").c_str(), Fmt(m.psnr_neutral_floor, "%.2f").c_str(),
+                  Fmt(m.ssim, "%.3f").c_str(), Fmt(m.lpips, "%.3f").c_str(), Fmt(m.expr_gain, "%.3f").c_str(),
+                  Fmt(m.expr_corr, "%.3f").c_str(), Fmt(m.expr_gain_coarse, "%.3f").c_str(),
+                  Fmt(m.region_psnr, "%.2f").c_str(), expr_n.c_str(), Fmt(m.face_detail, "%.2f").c_str());
     s << line;
   }
-  std::snprintf(line, sizeof line, "%-9s %9s %7s %10s %7s %9s %7s\n", "tier", "id_cosine", "id_dist", "id_dist_gt",
-                "gt_ref", "id_excess", "id<0.6");
+  std::snprintf(line, sizeof line, "%-9s %9s %7s %10s %7s %9s %7s\n", "tier", "id_cosine", "id_dist",
+                "id_dist_gt", "gt_ref", "id_excess", "id<0.6");
   s << line;
   for (Tier t : AllTiers()) {
     const TierMetrics& m = tiers[TierIndex(t)];
-    std::snprintf(line, sizeof line, "%-9s %9s %7s %10s %7s %9s %7s\n", TierName(t), Fmt(m.id_cosine, "%.4f").c_str(),
-                  Fmt(m.id_distance, "%.3f").c_str(), Fmt(m.id_distance_gt, "%.3f").c_str(),
-                  Fmt(m.id_distance_reference, "%.3f").c_str(), Fmt(m.id_excess, "%+.3f").c_str(),
+    std::snprintf(line, sizeof line, "%-9s %9s %7s %10s %7s %9s %7s\n", TierName(t),
+                  Fmt(m.id_cosine, "%.4f").c_str(), Fmt(m.id_distance, "%.3f").c_str(),
+                  Fmt(m.id_distance_gt, "%.3f").c_str(), Fmt(m.id_distance_reference, "%.3f").c_str(),
+                  Fmt(m.id_excess, "%+.3f").c_str(),
                   m.id_share_under_0_6 ? Fmt(100.0 * *m.id_share_under_0_6, "%.0f%%").c_str() : "-");
     s << line;
   }
-  s << "floor: PSNR of the ground-truth neutral against the ground truth (a model that renders no expression); "
-       "expr_gain: share of the true change (ground truth - its neutral) that the render's change (render - the "
-       "model's neutral) reproduces in the brow/eye/mouth region (1 = all, 0 = none), expr_corr their cosine, "
+  s << "floor: PSNR of the ground-truth neutral against the ground truth (a model that renders no "
+       "expression); "
+       "expr_gain: share of the true change (ground truth - its neutral) that the render's change (render - "
+       "the "
+       "model's neutral) reproduces in the brow/eye/mouth region (1 = all, 0 = none), expr_corr their "
+       "cosine, "
        "expr_coarse the same share with both changes low-passed (2 px at 128): a soft render that has the "
        "expression scores high here and lower on pixels; "
        "expr_n: frames in those means (+ frames left out: negligible true change)\n";
@@ -446,7 +411,8 @@ std::string EvalResult::Table() const {
   if (!identity_available)
     s << "identity: unavailable" << (identity_note.empty() ? "" : " (" + identity_note + ")") << "\n";
   else if (identity_missing > 0)
-    s << "identity: no face found in " << identity_missing << " of " << frames.size() << " frames (null there)\n";
+    s << "identity: no face found in " << identity_missing << " of " << frames.size()
+      << " frames (null there)\n";
   return s.str();
 }
 
@@ -461,15 +427,17 @@ Result<EvalResult> ReadMetricsFile(const fs::path& path) {
 
 Status EvalOptions::Validate() const {
   if (!std::isfinite(expression_scale))
-    return Status::Error("expression_scale: must be a finite number, got " + std::to_string(expression_scale));
+    return Status::Error("expression_scale: must be a finite number, got " +
+                         std::to_string(expression_scale));
   if (train_fit_frames < 0)
     return Status::Error("train_fit_frames: must be >= 0, got " + std::to_string(train_fit_frames));
   return Status::Ok();
 }
 
 std::string EvalOptions::ToString() const {
-  return "EvalOptions(out_dir=" + out_dir.string() + ", write_neutral_renders=" +
-         (write_neutral_renders ? "true" : "false") + ", expression_scale=" + std::to_string(expression_scale) +
+  return "EvalOptions(out_dir=" + out_dir.string() +
+         ", write_neutral_renders=" + (write_neutral_renders ? "true" : "false") +
+         ", expression_scale=" + std::to_string(expression_scale) +
          ", occupancy=" + (occupancy == RenderOccupancyMode::kExpression ? "expression" : "training") +
          ", train_fit_frames=" + std::to_string(train_fit_frames) + ")";
 }
@@ -481,7 +449,7 @@ namespace {
 struct NeutralView {
   int index = 0;
   Image render;
-  std::optional<Image> truth;                      // ground-truth neutral, composited
+  std::optional<Image> truth;                         // ground-truth neutral, composited
   std::optional<std::vector<Vec2f>> truth_landmarks;  // its 68 landmarks (dataset)
   std::optional<FaceDescriptor> descriptor;
   std::optional<FaceDescriptor> gt_descriptor;  // of the ground-truth neutral, same landmarks
@@ -524,13 +492,14 @@ std::optional<FaceDescriptor> TryDescribe(FaceIdentity& identity, const Image& i
 // The model's neutral render of the frame's view, the ground-truth neutral and their identity
 // descriptors. Landmarks of the neutral: from the dataset, else detected on the neutral ground
 // truth, else the frame's own, else detected on the neutral render.
-Result<NeutralView> MakeNeutralView(const AvatarModel& model, const Dataset& dataset, const Frame& frame, int index,
-                                    const EvalOptions& options, const EvalNetworks& networks,
+Result<NeutralView> MakeNeutralView(const AvatarModel& model, const Dataset& dataset, const Frame& frame,
+                                    int index, const EvalOptions& options, const EvalNetworks& networks,
                                     const Executor& executor) {
   NeutralView view;
   view.index = index;
   const std::vector<float> neutral_beta(dataset.expression_dim, 0.f);
-  view.render = RenderImage(model, frame.camera, neutral_beta, dataset.background, executor, options.occupancy).color;
+  view.render =
+      RenderImage(model, frame.camera, neutral_beta, dataset.background, executor, options.occupancy).color;
   if (!options.out_dir.empty() && options.write_neutral_renders) {
     char name[64];
     std::snprintf(name, sizeof name, "renders/neutral_%03d.png", view.index);
@@ -563,8 +532,8 @@ Result<NeutralView> MakeNeutralView(const AvatarModel& model, const Dataset& dat
 }
 
 // Expression fidelity, region PSNR and the neutral floor of one frame (eval/expression_fidelity.h).
-Status MeasureExpressionMetrics(const Frame& frame, const Image& render, const Image& truth, const NeutralView& view,
-                                FrameMetrics* m) {
+Status MeasureExpressionMetrics(const Frame& frame, const Image& render, const Image& truth,
+                                const NeutralView& view, FrameMetrics* m) {
   if (view.truth) {
     ICEF_ASSIGN_OR_RETURN(const double floor, Psnr(*view.truth, truth));
     m->psnr_neutral_floor = Finite(floor);
@@ -577,8 +546,9 @@ Status MeasureExpressionMetrics(const Frame& frame, const Image& render, const I
   if (!region_psnr.ok()) return Status::Ok();  // the region lies outside the image: no values
   m->region_psnr = Finite(*region_psnr);
   if (!view.truth) return Status::Ok();
-  ICEF_ASSIGN_OR_RETURN(const ExpressionFidelity f, MeasureExpression(render, view.render, truth, *view.truth, region,
-                                                                      DefaultCoarseSigma(truth.width)));
+  ICEF_ASSIGN_OR_RETURN(
+      const ExpressionFidelity f,
+      MeasureExpression(render, view.render, truth, *view.truth, region, DefaultCoarseSigma(truth.width)));
   m->expr_true_rms = f.true_rms;
   m->expr_gain = f.gain;
   m->expr_corr = f.corr;
@@ -647,19 +617,137 @@ Result<TrainFrameFit> MeasureTrainFrame(const Frame& frame, const Image& render,
 
 }  // namespace
 
+namespace {
+
+// The image metrics of one test frame against its truth: PSNR, SSIM, face detail, LPIPS.
+Status MeasureImage(const Frame& frame, const Image& render, const Image& gt, const EvalNetworks& networks,
+                    FrameMetrics* m) {
+  ICEF_ASSIGN_OR_RETURN(const double psnr, Psnr(render, gt));
+  m->psnr = Finite(psnr);
+  ICEF_ASSIGN_OR_RETURN(const double ssim, Ssim(render, gt));
+  m->ssim = Finite(ssim);
+  if (frame.landmarks_2d) {
+    const Image face = FaceRegion(gt.width, gt.height, *frame.landmarks_2d);
+    Result<double> detail = DetailRatio(render, gt, &face);
+    if (detail.ok()) m->face_detail = Finite(*detail);
+  }
+  if (networks.lpips) {
+    ICEF_ASSIGN_OR_RETURN(const double lpips, networks.lpips->Distance(render, gt));
+    m->lpips = Finite(lpips);
+  }
+  return Status::Ok();
+}
+
+// The identity metrics of one test frame: the render against the model's own neutral render, against
+// the truth, and the truth's own drift. False when no face could be aligned on the render.
+bool MeasureIdentity(FaceIdentity& identity, const Frame& frame, const Image& render, const Image& gt,
+                     const NeutralView& view, FrameMetrics* m) {
+  m->landmarks = frame.landmarks_2d ? "dataset" : "detector";
+  const std::optional<FaceDescriptor> render_desc = TryDescribe(identity, render, frame.landmarks_2d);
+  const std::optional<FaceDescriptor> gt_desc = TryDescribe(identity, gt, frame.landmarks_2d);
+  if (!render_desc) m->landmarks = "none";
+  if (render_desc && view.descriptor) {
+    m->id_distance = DescriptorDistance(*render_desc, *view.descriptor);
+    m->id_cosine = DescriptorCosine(*render_desc, *view.descriptor);
+  }
+  if (render_desc && gt_desc) m->id_distance_gt = DescriptorDistance(*render_desc, *gt_desc);
+  if (gt_desc && view.gt_descriptor)
+    m->id_distance_reference = DescriptorDistance(*gt_desc, *view.gt_descriptor);
+  if (m->id_distance && m->id_distance_reference) m->id_excess = *m->id_distance - *m->id_distance_reference;
+  return m->id_distance.has_value();
+}
+
+// Everything the protocol measures on test frame i; `views` caches the model's neutral render per view.
+Result<FrameMetrics> MeasureTestFrame(const AvatarModel& model, const Dataset& dataset, size_t i,
+                                      const EvalOptions& options, const EvalNetworks& networks,
+                                      const Executor& executor, std::map<std::string, NeutralView>* views,
+                                      int* identity_missing) {
+  const Frame& frame = dataset.test[i];
+  const std::string where =
+      dataset.root.string() + ": test frame " + std::to_string(i) + " (" + frame.file_path + ")";
+  ICEF_ASSIGN_OR_RETURN(const Image gt, LoadTruth(dataset, frame, where));
+  const RenderedImage render =
+      RenderImage(model, frame.camera, ScaledExpression(frame, options.expression_scale), dataset.background,
+                  executor, options.occupancy);
+  FrameMetrics m;
+  m.file_path = frame.file_path;
+  m.delta = frame.delta.value_or(render.nearest.delta);
+  // Frames without a tier get one from their delta and the dataset's thresholds (or synth's defaults).
+  const std::array<double, 2> thresholds = dataset.tier_thresholds.value_or(
+      std::array<double, 2>{synth::SynthOptions().near_threshold, synth::SynthOptions().far_threshold});
+  m.tier = frame.tier.value_or(synth::TierForDelta(m.delta, thresholds[0], thresholds[1]));
+  m.nearest_index = render.nearest.index;
+  m.model_delta = render.nearest.delta;
+  m.kappa = render.nearest.kappa;
+  ICEF_RETURN_IF_ERROR(MeasureImage(frame, render.color, gt, networks, &m));
+  if (!options.out_dir.empty()) {
+    m.render_path = RenderName(frame.file_path);
+    ICEF_RETURN_IF_ERROR(WritePng(options.out_dir / m.render_path, render.color));
+  }
+  // The model's neutral render of this view (once per view).
+  auto it = views->find(ViewKey(frame));
+  if (it == views->end()) {
+    Result<NeutralView> view =
+        MakeNeutralView(model, dataset, frame, static_cast<int>(views->size()), options, networks, executor);
+    if (!view.ok()) return view.status().WithContext(where);
+    it = views->emplace(ViewKey(frame), std::move(*view)).first;
+  }
+  m.neutral_landmarks = it->second.landmarks;
+  ICEF_RETURN_IF_ERROR(MeasureExpressionMetrics(frame, render.color, gt, it->second, &m).WithContext(where));
+  m.landmarks = "none";
+  if (networks.identity && !MeasureIdentity(*networks.identity, frame, render.color, gt, it->second, &m))
+    ++*identity_missing;
+  return m;
+}
+
+// The training-view fit: training frames rendered back exactly as the test frames.
+Result<TrainingFit> MeasureTrainingFit(const AvatarModel& model, const Dataset& dataset,
+                                       const EvalOptions& options, const Executor& executor,
+                                       ProgressBar* progress) {
+  const std::vector<size_t> fit_indices = EvenlySpaced(dataset.train.size(), options.train_fit_frames);
+  std::vector<TrainFrameFit> fits;
+  for (size_t n = 0; n < fit_indices.size(); ++n) {
+    const Frame& frame = dataset.train[fit_indices[n]];
+    const std::string where = dataset.root.string() + ": training frame " + std::to_string(fit_indices[n]) +
+                              " (" + frame.file_path + ")";
+    if (progress)
+      progress->Update(static_cast<int64_t>(dataset.test.size()),
+                       "training view " + std::to_string(n + 1) + "/" + std::to_string(fit_indices.size()));
+    ICEF_ASSIGN_OR_RETURN(const Image gt, LoadTruth(dataset, frame, where));
+    const RenderedImage render =
+        RenderImage(model, frame.camera, ScaledExpression(frame, options.expression_scale),
+                    dataset.background, executor, options.occupancy);
+    Result<TrainFrameFit> fit = MeasureTrainFrame(frame, render.color, gt);
+    if (!fit.ok()) return fit.status().WithContext(where);
+    if (!options.out_dir.empty()) {
+      fit->render_path = RenderName(frame.file_path, "fit_");
+      ICEF_RETURN_IF_ERROR(WritePng(options.out_dir / fit->render_path, render.color));
+      // The truth and the render side by side, to look at what the numbers say.
+      const std::string pair = fs::path(fit->render_path).replace_extension().string() + "_vs_truth.png";
+      ICEF_RETURN_IF_ERROR(WritePng(options.out_dir / pair, SideBySide(gt, render.color)));
+    }
+    fits.push_back(std::move(*fit));
+  }
+  return TrainingFit::Of(std::move(fits));
+}
+
+}  // namespace
+
 Result<EvalResult> EvaluateModel(const AvatarModel& model, const Dataset& dataset, const EvalOptions& options,
-                                 const EvalNetworks& networks, const Executor& executor, ProgressBar* progress) {
+                                 const EvalNetworks& networks, const Executor& executor,
+                                 ProgressBar* progress) {
   ICEF_RETURN_IF_ERROR(options.Validate());
   if (dataset.test.empty()) return Status::Error(dataset.root.string() + ": the dataset has no test frames");
   if (dataset.expression_dim != model.setup().expression_dim)
-    return Status::Error(dataset.root.string() + ": expression_dim " + std::to_string(dataset.expression_dim) +
-                         " does not match the model's " + std::to_string(model.setup().expression_dim));
-  const bool write = !options.out_dir.empty();
-  const fs::path& out_root = options.out_dir;
-  if (write) {
+    return Status::Error(dataset.root.string() + ": expression_dim " +
+                         std::to_string(dataset.expression_dim) + " does not match the model's " +
+                         std::to_string(model.setup().expression_dim));
+  if (!options.out_dir.empty()) {
     std::error_code ec;
-    fs::create_directories(out_root / "renders", ec);
-    if (ec) return Status::Error((out_root / "renders").string() + ": cannot create directory: " + ec.message());
+    fs::create_directories(options.out_dir / "renders", ec);
+    if (ec)
+      return Status::Error((options.out_dir / "renders").string() +
+                           ": cannot create directory: " + ec.message());
   }
   EvalResult result;
   result.method = MethodName(model.method());
@@ -667,116 +755,20 @@ Result<EvalResult> EvaluateModel(const AvatarModel& model, const Dataset& datase
   result.identity_available = networks.identity != nullptr;
   result.identity_note = networks.identity ? "" : networks.identity_note;
   result.lpips_available = networks.lpips != nullptr;
-  const Vec3f background = dataset.background;
   std::map<std::string, NeutralView> views;
-
   for (size_t i = 0; i < dataset.test.size(); ++i) {
-    const Frame& frame = dataset.test[i];
-    const std::string where = dataset.root.string() + ": test frame " + std::to_string(i) + " (" + frame.file_path + ")";
-    ICEF_ASSIGN_OR_RETURN(const Image gt, LoadTruth(dataset, frame, where));
-    const RenderedImage render = RenderImage(model, frame.camera, ScaledExpression(frame, options.expression_scale),
-                                             background, executor, options.occupancy);
-
-    FrameMetrics m;
-    m.file_path = frame.file_path;
-    m.delta = frame.delta.value_or(render.nearest.delta);
-    // Frames without a tier get one from their delta and the dataset's thresholds (or synth's defaults).
-    const std::array<double, 2> thresholds = dataset.tier_thresholds.value_or(
-        std::array<double, 2>{synth::SynthOptions().near_threshold, synth::SynthOptions().far_threshold});
-    m.tier = frame.tier.value_or(synth::TierForDelta(m.delta, thresholds[0], thresholds[1]));
-    m.nearest_index = render.nearest.index;
-    m.model_delta = render.nearest.delta;
-    m.kappa = render.nearest.kappa;
-    ICEF_ASSIGN_OR_RETURN(const double psnr, Psnr(render.color, gt));
-    m.psnr = Finite(psnr);
-    ICEF_ASSIGN_OR_RETURN(const double ssim, Ssim(render.color, gt));
-    m.ssim = Finite(ssim);
-    if (frame.landmarks_2d) {
-      const Image face = FaceRegion(gt.width, gt.height, *frame.landmarks_2d);
-      Result<double> detail = DetailRatio(render.color, gt, &face);
-      if (detail.ok()) m.face_detail = Finite(*detail);
-    }
-    if (networks.lpips) {
-      ICEF_ASSIGN_OR_RETURN(const double lpips, networks.lpips->Distance(render.color, gt));
-      m.lpips = Finite(lpips);
-    }
-    if (write) {
-      m.render_path = RenderName(frame.file_path);
-      ICEF_RETURN_IF_ERROR(WritePng(out_root / m.render_path, render.color));
-    }
-
-    // The model's neutral render of this view (once per view).
-    const std::string key = ViewKey(frame);
-    auto it = views.find(key);
-    if (it == views.end()) {
-      Result<NeutralView> view = MakeNeutralView(model, dataset, frame, static_cast<int>(views.size()), options,
-                                                 networks, executor);
-      if (!view.ok()) return view.status().WithContext(where);
-      it = views.emplace(key, std::move(*view)).first;
-    }
-    const NeutralView& view = it->second;
-    m.neutral_landmarks = view.landmarks;
-    ICEF_RETURN_IF_ERROR(MeasureExpressionMetrics(frame, render.color, gt, view, &m).WithContext(where));
-
-    if (networks.identity) {
-      FaceIdentity& identity = *networks.identity;
-      std::optional<FaceDescriptor> render_desc, gt_desc;
-      if (frame.landmarks_2d) {
-        m.landmarks = "dataset";
-        render_desc = TryDescribe(identity, render.color, frame.landmarks_2d);
-        gt_desc = TryDescribe(identity, gt, frame.landmarks_2d);
-      } else {
-        m.landmarks = "detector";
-        render_desc = TryDescribe(identity, render.color, std::nullopt);
-        gt_desc = TryDescribe(identity, gt, std::nullopt);
-      }
-      if (!render_desc) m.landmarks = "none";
-      if (render_desc && view.descriptor) {
-        m.id_distance = DescriptorDistance(*render_desc, *view.descriptor);
-        m.id_cosine = DescriptorCosine(*render_desc, *view.descriptor);
-      }
-      if (render_desc && gt_desc) m.id_distance_gt = DescriptorDistance(*render_desc, *gt_desc);
-      if (gt_desc && view.gt_descriptor) m.id_distance_reference = DescriptorDistance(*gt_desc, *view.gt_descriptor);
-      if (m.id_distance && m.id_distance_reference) m.id_excess = *m.id_distance - *m.id_distance_reference;
-      if (!m.id_distance) ++result.identity_missing;
-    } else {
-      m.landmarks = "none";
-    }
+    ICEF_ASSIGN_OR_RETURN(FrameMetrics m, MeasureTestFrame(model, dataset, i, options, networks, executor,
+                                                           &views, &result.identity_missing));
     result.frames.push_back(std::move(m));
     if (progress) {
       const FrameMetrics& last = result.frames.back();
-      progress->Update(static_cast<int64_t>(i) + 1, std::string(TierName(last.tier)) + " psnr " +
-                                                        Fmt(last.psnr, "%.2f") + " gain " + Fmt(last.expr_gain, "%.2f") +
-                                                        " id " + Fmt(last.id_distance, "%.3f"));
+      progress->Update(static_cast<int64_t>(i) + 1,
+                       std::string(TierName(last.tier)) + " psnr " + Fmt(last.psnr, "%.2f") + " gain " +
+                           Fmt(last.expr_gain, "%.2f") + " id " + Fmt(last.id_distance, "%.3f"));
     }
   }
   result.tiers = AggregateTiers(result.frames);
-
-  // The training-view fit: training frames rendered back exactly as the test frames.
-  const std::vector<size_t> fit_indices = EvenlySpaced(dataset.train.size(), options.train_fit_frames);
-  std::vector<TrainFrameFit> fits;
-  for (size_t n = 0; n < fit_indices.size(); ++n) {
-    const Frame& frame = dataset.train[fit_indices[n]];
-    const std::string where = dataset.root.string() + ": training frame " + std::to_string(fit_indices[n]) + " (" +
-                              frame.file_path + ")";
-    if (progress)
-      progress->Update(static_cast<int64_t>(dataset.test.size()),
-                       "training view " + std::to_string(n + 1) + "/" + std::to_string(fit_indices.size()));
-    ICEF_ASSIGN_OR_RETURN(const Image gt, LoadTruth(dataset, frame, where));
-    const RenderedImage render = RenderImage(model, frame.camera, ScaledExpression(frame, options.expression_scale),
-                                             background, executor, options.occupancy);
-    Result<TrainFrameFit> fit = MeasureTrainFrame(frame, render.color, gt);
-    if (!fit.ok()) return fit.status().WithContext(where);
-    if (write) {
-      fit->render_path = RenderName(frame.file_path, "fit_");
-      ICEF_RETURN_IF_ERROR(WritePng(out_root / fit->render_path, render.color));
-      // The truth and the render side by side, to look at what the numbers say.
-      const std::string pair = fs::path(fit->render_path).replace_extension().string() + "_vs_truth.png";
-      ICEF_RETURN_IF_ERROR(WritePng(out_root / pair, SideBySide(gt, render.color)));
-    }
-    fits.push_back(std::move(*fit));
-  }
-  result.train_fit = TrainingFit::Of(std::move(fits));
+  ICEF_ASSIGN_OR_RETURN(result.train_fit, MeasureTrainingFit(model, dataset, options, executor, progress));
   if (progress) progress->Finish();
   return result;
 }

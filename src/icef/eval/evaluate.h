@@ -19,6 +19,7 @@
 #include <array>
 #include <filesystem>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -40,14 +41,14 @@ inline int TierIndex(Tier tier) { return static_cast<int>(tier); }
 
 // The metrics of one test frame.
 struct FrameMetrics {
-  std::string file_path;               // the frame's ground-truth image, relative to the dataset
+  std::string file_path;  // the frame's ground-truth image, relative to the dataset
   Tier tier = Tier::kObserved;
-  double delta = 0;                    // the dataset's delta of the frame
-  std::optional<double> psnr;          // dB (null only when infinite: a pixel-perfect render)
+  double delta = 0;            // the dataset's delta of the frame
+  std::optional<double> psnr;  // dB (null only when infinite: a pixel-perfect render)
   std::optional<double> ssim;
-  std::optional<double> lpips;         // null without LPIPS weights
-  std::optional<double> id_cosine;     // render vs the model's neutral render, same view
-  std::optional<double> id_distance;   // Euclidean, same pair
+  std::optional<double> lpips;           // null without LPIPS weights
+  std::optional<double> id_cosine;       // render vs the model's neutral render, same view
+  std::optional<double> id_distance;     // Euclidean, same pair
   std::optional<double> id_distance_gt;  // render vs the ground-truth image of the frame
   // Ground truth vs the ground-truth neutral of the view, chips made exactly as for id_distance:
   // the drift a perfect model would show (null without a neutral image in the dataset).
@@ -61,8 +62,8 @@ struct FrameMetrics {
   std::optional<double> expr_gain;
   std::optional<double> expr_corr;
   std::optional<double> expr_gain_coarse;  // expr_gain at the features' scale (eval/expression_fidelity.h)
-  std::optional<double> expr_true_rms;  // RMS of ground truth - ground-truth neutral in the region
-  std::optional<double> region_psnr;    // PSNR inside the expression region, dB
+  std::optional<double> expr_true_rms;     // RMS of ground truth - ground-truth neutral in the region
+  std::optional<double> region_psnr;       // PSNR inside the expression region, dB
   // Fine detail inside the face region (the hull of the frame's landmarks) relative to the truth's
   // (eval/metrics.h DetailRatio: 1 = as sharp, below 1 = blurred, above 1 = blocks or noise); null
   // without landmarks.
@@ -70,12 +71,13 @@ struct FrameMetrics {
   // PSNR of the ground-truth neutral of the view against the ground truth: what a model that
   // renders no expression at all would score (null without a neutral image).
   std::optional<double> psnr_neutral_floor;
-  int nearest_index = -1;              // the model's nearest training expression k
-  double model_delta = 0;              // ||beta - beta_n|| as the model sees it
-  double kappa = 1;                    // confidence at that distance
-  std::string landmarks;               // "dataset", "detector" or "none" (render chip)
-  std::string neutral_landmarks;       // "dataset", "detector (ground truth)", "detector (render)", "frame", "none"
-  std::string render_path;             // relative to the output directory (empty when not written)
+  int nearest_index = -1;  // the model's nearest training expression k
+  double model_delta = 0;  // ||beta - beta_n|| as the model sees it
+  double kappa = 1;        // confidence at that distance
+  std::string landmarks;   // "dataset", "detector" or "none" (render chip)
+  std::string
+      neutral_landmarks;    // "dataset", "detector (ground truth)", "detector (render)", "frame", "none"
+  std::string render_path;  // relative to the output directory (empty when not written)
 
   Json ToJson() const;
   // `where` names the object in errors, e.g. "run/metrics.json: frames[3]".
@@ -92,23 +94,35 @@ struct TierMetrics {
   std::optional<double> id_cosine;
   std::optional<double> id_distance;
   std::optional<double> id_distance_gt;
-  std::optional<double> id_share_under_0_6;  // share of id_distance values under 0.6
+  std::optional<double> id_share_under_0_6;     // share of id_distance values under 0.6
   std::optional<double> id_distance_reference;  // mean ground-truth drift (see FrameMetrics)
-  std::optional<double> id_excess;           // mean over frames with both distances
-  std::optional<double> expr_gain;           // means over the frames with a non-negligible true change
+  std::optional<double> id_excess;              // mean over frames with both distances
+  std::optional<double> expr_gain;              // means over the frames with a non-negligible true change
   std::optional<double> expr_corr;
   std::optional<double> expr_gain_coarse;
   std::optional<double> region_psnr;
   std::optional<double> psnr_neutral_floor;
-  std::optional<double> face_detail;         // mean over the frames with landmarks
-  int expr_count = 0;                        // frames in the expr_gain mean
-  int expr_negligible = 0;                   // frames left out of it: negligible true change
-  int id_count = 0;                          // frames with identity metrics
-  double mean_delta = 0;                     // mean dataset delta (0 when count is 0)
+  std::optional<double> face_detail;  // mean over the frames with landmarks
+  int expr_count = 0;                 // frames in the expr_gain mean
+  int expr_negligible = 0;            // frames left out of it: negligible true change
+  int id_count = 0;                   // frames with identity metrics
+  double mean_delta = 0;              // mean dataset delta (0 when count is 0)
 
   Json ToJson() const;
   static Result<TierMetrics> FromJson(const Json& json, const std::string& where);
 };
+
+// The metrics a frame carries and a tier averages, written once: the JSON key (the same in a frame,
+// a tier's means and the bench's tables), the frame's value, the tier's mean, and whether a metrics
+// file must hold it (files from before the later metrics lack them). The frame's expr_true_rms and
+// the tier's id_share_under_0_6 are each one's own.
+struct MetricField {
+  const char* key;
+  std::optional<double> FrameMetrics::*frame;
+  std::optional<double> TierMetrics::*tier;
+  bool required;
+};
+std::span<const MetricField> MetricFields();
 
 // Per-tier means of frame metrics (plain arithmetic means in frame order).
 std::array<TierMetrics, kNumTiers> AggregateTiers(const std::vector<FrameMetrics>& frames);
@@ -116,17 +130,17 @@ std::array<TierMetrics, kNumTiers> AggregateTiers(const std::vector<FrameMetrics
 // How well the model reproduces one of its own training frames, rendered back at the frame's camera
 // and expression and compared with its image composited over the background.
 struct TrainFrameFit {
-  std::string file_path;            // the training image, relative to the dataset
+  std::string file_path;  // the training image, relative to the dataset
   // PSNR inside the face region (FaceRegion of the frame's landmarks_2d, eval/expression_fidelity.h),
   // dB; null without landmarks (face_pixels 0) or when infinite (a pixel-perfect face).
   std::optional<double> face_psnr;
-  int face_pixels = 0;              // pixels in the face region
+  int face_pixels = 0;  // pixels in the face region
   // Fine detail of the render in the face region relative to the truth's (eval/metrics.h
   // DetailRatio: 1 = as much pixel-scale detail, below 1 = blurred away, above = extra edges);
   // null without a face region.
   std::optional<double> face_detail;
-  std::optional<double> psnr;       // full image, dB (null only when infinite)
-  std::string render_path;          // relative to the output directory (empty when not written)
+  std::optional<double> psnr;  // full image, dB (null only when infinite)
+  std::string render_path;     // relative to the output directory (empty when not written)
 
   Json ToJson() const;
   static Result<TrainFrameFit> FromJson(const Json& json, const std::string& where);
@@ -135,9 +149,9 @@ struct TrainFrameFit {
 // The training-view fit: per-frame values and their means (over the frames with a value).
 struct TrainingFit {
   std::vector<TrainFrameFit> frames;
-  int count = 0;                        // training frames rendered (0: not measured, e.g. an old metrics.json)
-  int face_count = 0;                   // frames with a face_psnr (in its mean and minimum)
-  std::optional<double> face_psnr;      // mean face-region PSNR, dB
+  int count = 0;                    // training frames rendered (0: not measured, e.g. an old metrics.json)
+  int face_count = 0;               // frames with a face_psnr (in its mean and minimum)
+  std::optional<double> face_psnr;  // mean face-region PSNR, dB
   std::optional<double> face_psnr_min;  // the worst frame's
   std::optional<double> psnr;           // mean full-image PSNR, dB
   std::optional<double> face_detail;    // mean face-region detail ratio
@@ -153,14 +167,14 @@ struct TrainingFit {
 // One model evaluated on one dataset: the content of metrics.json.
 struct EvalResult {
   std::string method;
-  double expression_scale = 1;       // every frame was rendered at expression_scale * beta
+  double expression_scale = 1;  // every frame was rendered at expression_scale * beta
   std::vector<FrameMetrics> frames;
   std::array<TierMetrics, kNumTiers> tiers;
-  TrainingFit train_fit;             // empty when not measured (metrics files from before it)
-  bool identity_available = false;   // the face-descriptor network was loaded
-  bool lpips_available = false;      // LPIPS weights were given
-  int identity_missing = 0;          // frames whose identity could not be measured (no face)
-  std::string identity_note;         // why identity is unavailable, when it is
+  TrainingFit train_fit;            // empty when not measured (metrics files from before it)
+  bool identity_available = false;  // the face-descriptor network was loaded
+  bool lpips_available = false;     // LPIPS weights were given
+  int identity_missing = 0;         // frames whose identity could not be measured (no face)
+  std::string identity_note;        // why identity is unavailable, when it is
 
   Json ToJson() const;
   static Result<EvalResult> FromJson(const Json& json, const std::string& origin);
@@ -194,7 +208,7 @@ struct EvalOptions {
 struct EvalNetworks {
   FaceIdentity* identity = nullptr;  // not thread-safe: frames are described one at a time
   const LpipsNet* lpips = nullptr;
-  std::string identity_note;         // why `identity` is null (copied into the result)
+  std::string identity_note;  // why `identity` is null (copied into the result)
 };
 
 // Evaluates `model` on the test frames of `dataset` (expression fidelity needs the frames' 2D
@@ -206,6 +220,7 @@ struct EvalNetworks {
 // unreadable images, size mismatches, an expression dimension other than the model's.
 // progress (may be null) counts test frames; its status names the training view being rendered.
 Result<EvalResult> EvaluateModel(const AvatarModel& model, const Dataset& dataset, const EvalOptions& options,
-                                 const EvalNetworks& networks, const Executor& executor, ProgressBar* progress);
+                                 const EvalNetworks& networks, const Executor& executor,
+                                 ProgressBar* progress);
 
 }  // namespace icef::eval

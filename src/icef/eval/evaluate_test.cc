@@ -9,9 +9,9 @@
 
 #include "icef/eval/expression_fidelity.h"
 #include "icef/eval/metrics.h"
-#include "icef/eval/report.h"
 #include "icef/io/atomic_file.h"
 #include "icef/model/render_image.h"
+#include "icef/study/report.h"
 #include "icef/synth/synthesize.h"
 #include "icef/train/trainer.h"
 
@@ -21,7 +21,8 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path TempDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("icef_evaluate_test_" + name + "_" + std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("icef_evaluate_test_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
@@ -105,8 +106,8 @@ TEST(EvaluateTest, AggregatesHandMadeMetricsFilePerTier) {
   EXPECT_TRUE((*json)["frames"][4]["id_distance"].is_null());
   EXPECT_TRUE((*json)["tiers"]["near"]["psnr"].is_null());
   EXPECT_DOUBLE_EQ((*json)["tiers"]["far"]["id_distance"].get<double>(), 0.625);
-  for (const char* key : {"count", "psnr", "ssim", "lpips", "id_cosine", "id_distance", "id_distance_gt",
-                          "id_share_under_0_6"})
+  for (const char* key :
+       {"count", "psnr", "ssim", "lpips", "id_cosine", "id_distance", "id_distance_gt", "id_share_under_0_6"})
     EXPECT_TRUE((*json)["tiers"]["observed"].contains(key)) << key;
   const Result<EvalResult> again = ReadMetricsFile(dir / "out.json");
   ASSERT_TRUE(again.ok()) << again.status().message();
@@ -151,10 +152,10 @@ TEST(EvaluateTest, TrainingFitRoundTripsAndOldFilesHaveNone) {
 
   // Means over the frames with a value; the frame without landmarks has no face PSNR.
   EvalResult result = *old;
-  result.train_fit =
-      TrainingFit::Of({TrainFrameFit{"images/train_000.png", 32.0, 400, 0.8, 24.0, "renders/fit_train_000.png"},
-                       TrainFrameFit{"images/train_001.png", 28.0, 380, 0.6, 26.0, ""},
-                       TrainFrameFit{"images/train_002.png", std::nullopt, 0, std::nullopt, 25.0, ""}});
+  result.train_fit = TrainingFit::Of(
+      {TrainFrameFit{"images/train_000.png", 32.0, 400, 0.8, 24.0, "renders/fit_train_000.png"},
+       TrainFrameFit{"images/train_001.png", 28.0, 380, 0.6, 26.0, ""},
+       TrainFrameFit{"images/train_002.png", std::nullopt, 0, std::nullopt, 25.0, ""}});
   const TrainingFit& fit = result.train_fit;
   EXPECT_EQ(fit.count, 3);
   EXPECT_EQ(fit.face_count, 2);
@@ -162,9 +163,10 @@ TEST(EvaluateTest, TrainingFitRoundTripsAndOldFilesHaveNone) {
   EXPECT_DOUBLE_EQ(*fit.face_psnr_min, 28.0);
   EXPECT_DOUBLE_EQ(*fit.psnr, 25.0);
   EXPECT_DOUBLE_EQ(*fit.face_detail, 0.7);
-  EXPECT_NE(result.Table().find("training-view fit: face-region PSNR 30.00 dB (worst 28.00, 2 of 3 views), full "
-                                "image 25.00 dB, face detail 0.70 x the truth's"),
-            std::string::npos)
+  EXPECT_NE(
+      result.Table().find("training-view fit: face-region PSNR 30.00 dB (worst 28.00, 2 of 3 views), full "
+                          "image 25.00 dB, face detail 0.70 x the truth's"),
+      std::string::npos)
       << result.Table();
 
   const Json json = result.ToJson();
@@ -322,8 +324,8 @@ TEST(EvaluateTest, EvaluatesTinyTrainedModel) {
     EXPECT_DOUBLE_EQ(*f.face_detail, *DetailRatio(r.color, gt, &face));
     EXPECT_EQ(f.render_path, "renders/fit_" + fs::path(frame.file_path).stem().string() + ".png");
     EXPECT_TRUE(fs::exists(options.out_dir / f.render_path)) << f.render_path;
-    const Result<Image> pair = ReadImage(options.out_dir / ("renders/fit_" + fs::path(frame.file_path).stem().string() +
-                                                            "_vs_truth.png"));
+    const Result<Image> pair = ReadImage(
+        options.out_dir / ("renders/fit_" + fs::path(frame.file_path).stem().string() + "_vs_truth.png"));
     ASSERT_TRUE(pair.ok()) << pair.status().message();
     EXPECT_EQ(pair->width, 2 * gt.width);  // truth | render
   }
@@ -358,7 +360,8 @@ TEST(EvaluateTest, EvaluatesTinyTrainedModel) {
   still_run.metrics.method = "warp";
   const Aggregate aggregate = AggregateRuns({real_run, still_run});
   for (Tier tier : {Tier::kNear, Tier::kModerate, Tier::kFar})
-    EXPECT_EQ(ComparePair(aggregate, 3, tier, "warp", "icef").outcome, Outcome::kUnderExpresses) << TierName(tier);
+    EXPECT_EQ(ComparePair(aggregate, 3, tier, "warp", "icef").outcome, Outcome::kUnderExpresses)
+        << TierName(tier);
 
   // Frames without a stored tier get it from their delta and the dataset's thresholds.
   Dataset untiered = dataset;
@@ -366,7 +369,8 @@ TEST(EvaluateTest, EvaluatesTinyTrainedModel) {
   EvalOptions no_renders;
   const Result<EvalResult> derived = EvaluateModel(model, untiered, no_renders, networks, executor, nullptr);
   ASSERT_TRUE(derived.ok()) << derived.status().message();
-  for (size_t i = 0; i < derived->frames.size(); ++i) EXPECT_EQ(derived->frames[i].tier, dataset.test[i].tier) << i;
+  for (size_t i = 0; i < derived->frames.size(); ++i)
+    EXPECT_EQ(derived->frames[i].tier, dataset.test[i].tier) << i;
 
   // With the face-identity network (when installed): identity metrics on every frame where a
   // face chip could be made (the dataset has landmarks, so all of them).
@@ -435,7 +439,8 @@ TEST(EvaluateTest, TrainingFitFaceRegionIsTheLandmarkHull) {
     }
   }
   // Only the training views were changed: the test frames' numbers are those of the original.
-  const Result<EvalResult> reference = EvaluateModel(model, original, options, EvalNetworks{}, executor, nullptr);
+  const Result<EvalResult> reference =
+      EvaluateModel(model, original, options, EvalNetworks{}, executor, nullptr);
   ASSERT_TRUE(reference.ok()) << reference.status().message();
   EXPECT_EQ(result->frames[0].psnr, reference->frames[0].psnr);
   EXPECT_GT(*reference->train_fit.psnr, *result->train_fit.psnr);

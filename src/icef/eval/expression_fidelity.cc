@@ -15,8 +15,9 @@ Image FaceRegion(int width, int height, const std::vector<Vec2f>& landmarks) {
   return LandmarkHullRegion(width, height, landmarks);
 }
 
-Result<ExpressionFidelity> MeasureExpression(const Image& render, const Image& render_neutral, const Image& truth,
-                                             const Image& truth_neutral, const Image& region, double coarse_sigma) {
+Result<ExpressionFidelity> MeasureExpression(const Image& render, const Image& render_neutral,
+                                             const Image& truth, const Image& truth_neutral,
+                                             const Image& region, double coarse_sigma) {
   for (const Image* image : {&render, &render_neutral, &truth, &truth_neutral}) {
     if (image->width != region.width || image->height != region.height || image->channels < 3)
       return Status::Error("expression fidelity: images must be RGB(A) of the region's size " +
@@ -51,7 +52,8 @@ Result<ExpressionFidelity> MeasureExpression(const Image& render, const Image& r
           m[size_t(y) * w + x] = double(render.At(x, y, c)) - render_neutral.At(x, y, c);
           t[size_t(y) * w + x] = double(truth.At(x, y, c)) - truth_neutral.At(x, y, c);
         }
-      const std::vector<double> ms = GaussianFilter(m, w, h, coarse_sigma), ts = GaussianFilter(t, w, h, coarse_sigma);
+      const std::vector<double> ms = GaussianFilter(m, w, h, coarse_sigma),
+                                ts = GaussianFilter(t, w, h, coarse_sigma);
       for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
           if (region.At(x, y, 0) <= 0.5f) continue;

@@ -47,16 +47,17 @@ double DefaultCoarseSigma(int width);
 Image FaceRegion(int width, int height, const std::vector<Vec2f>& landmarks);
 
 struct ExpressionFidelity {
-  int pixels = 0;             // pixels in the region
-  double true_rms = 0;        // RMS of t over the region's RGB values
-  bool negligible = true;     // true_rms < kNegligibleExpressionRms: gain and corr are null
+  int pixels = 0;          // pixels in the region
+  double true_rms = 0;     // RMS of t over the region's RGB values
+  bool negligible = true;  // true_rms < kNegligibleExpressionRms: gain and corr are null
   std::optional<double> gain;
   std::optional<double> corr;
   std::optional<double> gain_coarse;  // with m and t low-passed (null with the gain, or coarse_sigma <= 0)
 };
 
 // All four images RGB (or RGBA, alpha ignored) of the region's size. Errors: size mismatches.
-Result<ExpressionFidelity> MeasureExpression(const Image& render, const Image& render_neutral, const Image& truth,
-                                             const Image& truth_neutral, const Image& region, double coarse_sigma = 0);
+Result<ExpressionFidelity> MeasureExpression(const Image& render, const Image& render_neutral,
+                                             const Image& truth, const Image& truth_neutral,
+                                             const Image& region, double coarse_sigma = 0);
 
 }  // namespace icef::eval

@@ -29,10 +29,12 @@ TEST(ExpressionFidelityTest, KnownGains) {
   const Image render_neutral = Pattern(0.5f, 0.f);  // the model's neutral may differ from the truth's
   for (const double amount : {0.0, 0.5, 1.0}) {
     const Image render = Pattern(0.5f, static_cast<float>(amount));
-    const Result<ExpressionFidelity> f = MeasureExpression(render, render_neutral, truth, truth_neutral, region, 1.5);
+    const Result<ExpressionFidelity> f =
+        MeasureExpression(render, render_neutral, truth, truth_neutral, region, 1.5);
     ASSERT_TRUE(f.ok()) << f.status().message();
     ASSERT_TRUE(f->gain_coarse.has_value());
-    EXPECT_NEAR(*f->gain_coarse, amount, 1e-5) << amount;  // both changes are the same pattern: any scale agrees
+    EXPECT_NEAR(*f->gain_coarse, amount, 1e-5)
+        << amount;  // both changes are the same pattern: any scale agrees
     EXPECT_FALSE(f->negligible);
     EXPECT_EQ(f->pixels, 16 * 16);
     ASSERT_TRUE(f->gain.has_value());
@@ -85,7 +87,8 @@ TEST(ExpressionFidelityTest, CoarseGainForgivesSoftnessNotAbsence) {
   const auto none = MeasureExpression(Bar(32, 1.0), Bar(32, 1.0), truth, truth_neutral, region, 2.0);
   EXPECT_NEAR(*none->gain_coarse, 0.0, 1e-12);
   // Without a coarse scale there is no coarse gain.
-  EXPECT_FALSE(MeasureExpression(Bar(30, 1.0), Bar(32, 1.0), truth, truth_neutral, region)->gain_coarse.has_value());
+  EXPECT_FALSE(
+      MeasureExpression(Bar(30, 1.0), Bar(32, 1.0), truth, truth_neutral, region)->gain_coarse.has_value());
 }
 
 TEST(ExpressionFidelityTest, NegligibleTruthAndErrors) {

@@ -16,19 +16,20 @@ Status Take(const infer::TensorMap& tensors, const std::string& source, const st
   if (it == tensors.end()) return Status::Error(source + ": missing tensor '" + name + "'");
   if (it->second.shape != shape) {
     infer::NamedTensor expected{shape, {}};
-    return Status::Error(source + ": tensor '" + name + "' has shape " + it->second.ToString() + ", expected " +
-                         expected.ToString());
+    return Status::Error(source + ": tensor '" + name + "' has shape " + it->second.ToString() +
+                         ", expected " + expected.ToString());
   }
   out = it->second.values;
   return Status::Ok();
 }
 
-Status TakeConvAffine(const infer::TensorMap& tensors, const std::string& source, const std::string& prefix, int k,
-                      int cin, int cout, ConvAffine& layer) {
+Status TakeConvAffine(const infer::TensorMap& tensors, const std::string& source, const std::string& prefix,
+                      int k, int cin, int cout, ConvAffine& layer) {
   layer.conv.kh = layer.conv.kw = k;
   layer.conv.cin = cin;
   layer.conv.cout = cout;
-  ICEF_RETURN_IF_ERROR(Take(tensors, source, prefix + "/conv/filters", {k, k, cin, cout}, layer.conv.filters));
+  ICEF_RETURN_IF_ERROR(
+      Take(tensors, source, prefix + "/conv/filters", {k, k, cin, cout}, layer.conv.filters));
   ICEF_RETURN_IF_ERROR(Take(tensors, source, prefix + "/conv/bias", {cout}, layer.conv.bias));
   ICEF_RETURN_IF_ERROR(Take(tensors, source, prefix + "/scale/weights", {cout}, layer.scale));
   ICEF_RETURN_IF_ERROR(Take(tensors, source, prefix + "/scale/biases", {cout}, layer.shift));
@@ -59,7 +60,8 @@ std::filesystem::path ResolveFaceIdModelDir(const std::string& explicit_dir) {
   return kDefaultFaceIdModelDir;
 }
 
-infer::Tensor3 ApplyConvAffine(const infer::Tensor3& x, const ConvAffine& layer, int stride, const infer::Padding& pad, bool relu) {
+infer::Tensor3 ApplyConvAffine(const infer::Tensor3& x, const ConvAffine& layer, int stride,
+                               const infer::Padding& pad, bool relu) {
   infer::Tensor3 out = infer::Conv2d(x, layer.conv, stride, pad);
   infer::ChannelAffine(out, layer.scale, layer.shift);
   if (relu) infer::Relu(out);
@@ -81,7 +83,8 @@ infer::Tensor3 ResidualBlock(const infer::Tensor3& x, const ResidualBlockWeights
   return out;
 }
 
-Result<FaceDescriptorNet> FaceDescriptorNet::FromTensors(const infer::TensorMap& tensors, const std::string& source) {
+Result<FaceDescriptorNet> FaceDescriptorNet::FromTensors(const infer::TensorMap& tensors,
+                                                         const std::string& source) {
   FaceDescriptorNet net;
   net.source_ = source;
   ICEF_RETURN_IF_ERROR(TakeConvAffine(tensors, source, "conv32_down", 7, 3, 32, net.stem_));
@@ -92,11 +95,11 @@ Result<FaceDescriptorNet> FaceDescriptorNet::FromTensors(const infer::TensorMap&
     bool down;
   };
   const StageSpec specs[] = {
-      {"conv32_1", 32, 32, false},       {"conv32_2", 32, 32, false},     {"conv32_3", 32, 32, false},
-      {"conv64_down", 32, 64, true},     {"conv64_1", 64, 64, false},     {"conv64_2", 64, 64, false},
-      {"conv64_3", 64, 64, false},       {"conv128_down", 64, 128, true}, {"conv128_1", 128, 128, false},
-      {"conv128_2", 128, 128, false},    {"conv256_down", 128, 256, true}, {"conv256_1", 256, 256, false},
-      {"conv256_2", 256, 256, false},    {"conv256_down_out", 256, 256, true},
+      {"conv32_1", 32, 32, false},    {"conv32_2", 32, 32, false},          {"conv32_3", 32, 32, false},
+      {"conv64_down", 32, 64, true},  {"conv64_1", 64, 64, false},          {"conv64_2", 64, 64, false},
+      {"conv64_3", 64, 64, false},    {"conv128_down", 64, 128, true},      {"conv128_1", 128, 128, false},
+      {"conv128_2", 128, 128, false}, {"conv256_down", 128, 256, true},     {"conv256_1", 256, 256, false},
+      {"conv256_2", 256, 256, false}, {"conv256_down_out", 256, 256, true},
   };
   for (const StageSpec& spec : specs) {
     Stage stage;
@@ -119,7 +122,8 @@ Result<FaceDescriptorNet> FaceDescriptorNet::Load(const std::filesystem::path& d
     return Status::Error(manifest.string() +
                          ": face-identity model not found (install it with scripts/install-deps.sh, or point "
                          "--faceid-model / ICEF_FACEID_MODEL at a directory holding " +
-                         kFaceIdManifestName + " and face_recognition_model.bin from @vladmandic/face-api@1.7.15)");
+                         kFaceIdManifestName +
+                         " and face_recognition_model.bin from @vladmandic/face-api@1.7.15)");
   ICEF_ASSIGN_OR_RETURN(const infer::TensorMap tensors, infer::ReadTfjsWeights(manifest));
   return FromTensors(tensors, manifest.string());
 }
@@ -151,7 +155,8 @@ FaceDescriptor FaceDescriptorNet::Compute(const Image& chip) const {
 
 std::string FaceDescriptorNet::ToString() const {
   std::ostringstream s;
-  s << "FaceDescriptorNet(dlib ResNet-29, " << stages_.size() << " residual stages, 128-D; weights " << source_ << ")";
+  s << "FaceDescriptorNet(dlib ResNet-29, " << stages_.size() << " residual stages, 128-D; weights "
+    << source_ << ")";
   return s.str();
 }
 

@@ -60,7 +60,8 @@ struct ResidualBlockWeights {
 };
 
 // Applies conv + bias + affine (+ ReLU when `relu`), 3x3: stride 1 'same' or stride 2 'valid'.
-infer::Tensor3 ApplyConvAffine(const infer::Tensor3& x, const ConvAffine& layer, int stride, const infer::Padding& pad, bool relu);
+infer::Tensor3 ApplyConvAffine(const infer::Tensor3& x, const ConvAffine& layer, int stride,
+                               const infer::Padding& pad, bool relu);
 // The residual block (down = false) and the down-sampling block (down = true) described above.
 infer::Tensor3 ResidualBlock(const infer::Tensor3& x, const ResidualBlockWeights& weights, bool down);
 

@@ -7,8 +7,8 @@
 #include <filesystem>
 #include <fstream>
 
-#include "icef/infer/cnn_test_util.h"
 #include "icef/eval/face_identity.h"
+#include "icef/infer/cnn_test_util.h"
 
 namespace icef::eval {
 namespace {
@@ -53,7 +53,8 @@ TEST(FaceDescriptorTest, DownBlockMatchesNaiveReference) {
     SCOPED_TRACE("input " + std::to_string(size));
     const infer::Tensor3 x = RandomTensor(size, size, 3, 110 + size);
     ResidualBlockWeights w{RandomConvAffine(3, 6, 111), RandomConvAffine(6, 6, 112)};
-    infer::Tensor3 branch = NaiveAffine(NaiveConv(x, w.conv1.conv, 2, infer::Padding::Valid()), w.conv1, true);
+    infer::Tensor3 branch =
+        NaiveAffine(NaiveConv(x, w.conv1.conv, 2, infer::Padding::Valid()), w.conv1, true);
     branch = NaiveAffine(NaiveConv(branch, w.conv2.conv, 1, infer::Padding::Uniform(1)), w.conv2, false);
     const int ph = size / 2;
     infer::Tensor3 ref(ph, ph, 6);
@@ -62,8 +63,8 @@ TEST(FaceDescriptorTest, DownBlockMatchesNaiveReference) {
         for (int c = 0; c < 6; ++c) {
           double v = 0.0;
           if (c < 3)
-            v += 0.25 * (double(x.At(2 * y, 2 * i, c)) + x.At(2 * y + 1, 2 * i, c) + x.At(2 * y, 2 * i + 1, c) +
-                         x.At(2 * y + 1, 2 * i + 1, c));
+            v += 0.25 * (double(x.At(2 * y, 2 * i, c)) + x.At(2 * y + 1, 2 * i, c) +
+                         x.At(2 * y, 2 * i + 1, c) + x.At(2 * y + 1, 2 * i + 1, c));
           if (y < branch.h && i < branch.w) v += branch.At(y, i, c);
           ref.At(y, i, c) = float(std::max(v, 0.0));
         }
@@ -96,8 +97,10 @@ TEST(FaceDescriptorTest, MissingTensorsAndMissingFilesAreErrors) {
 
 // --- The real network on real photos installed by Debian packages (scripts/install-deps.sh). ---
 
-constexpr const char* kHaar = "/usr/share/doc/opencv-doc/opencv4/html/Cascade_Classifier_Tutorial_Result_Haar.jpg";
-constexpr const char* kLbp = "/usr/share/doc/opencv-doc/opencv4/html/Cascade_Classifier_Tutorial_Result_LBP.jpg";
+constexpr const char* kHaar =
+    "/usr/share/doc/opencv-doc/opencv4/html/Cascade_Classifier_Tutorial_Result_Haar.jpg";
+constexpr const char* kLbp =
+    "/usr/share/doc/opencv-doc/opencv4/html/Cascade_Classifier_Tutorial_Result_LBP.jpg";
 constexpr const char* kAstronaut = "/usr/lib/python3/dist-packages/skimage/data/astronaut.png";
 constexpr const char* kHopper = "/usr/share/matplotlib/mpl-data/sample_data/grace_hopper.jpg";
 
@@ -158,7 +161,8 @@ TEST(FaceDescriptorRealTest, DatasetLandmarksGiveTheDetectorsChipAndSpeedIsBound
   const int runs = 10;
   const auto t0 = std::chrono::steady_clock::now();
   for (int i = 0; i < runs; ++i) EXPECT_EQ(identity->net().Compute(detected->chip), detected->descriptor);
-  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() / runs;
+  const double ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() / runs;
   std::cout << "face descriptor network: " << ms << " ms per 150x150 chip\n";
   EXPECT_LT(ms, 1000.0);
 }

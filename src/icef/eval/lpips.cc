@@ -82,7 +82,8 @@ Status ValidateLpipsWeights(const LpipsWeights& w, const std::string& source) {
     const std::string name = source + ": conv" + std::to_string(i + 1);
     if (c.kh != kKernel[i] || c.kw != kKernel[i])
       return Status::Error(name + ".weight: kernel " + std::to_string(c.kh) + "x" + std::to_string(c.kw) +
-                           ", AlexNet needs " + std::to_string(kKernel[i]) + "x" + std::to_string(kKernel[i]));
+                           ", AlexNet needs " + std::to_string(kKernel[i]) + "x" +
+                           std::to_string(kKernel[i]));
     if (c.cin != cin)
       return Status::Error(name + ".weight: " + std::to_string(c.cin) + " input channels, expected " +
                            std::to_string(cin));
@@ -90,8 +91,8 @@ Status ValidateLpipsWeights(const LpipsWeights& w, const std::string& source) {
     if (c.filters.size() != size_t(c.kh) * c.kw * c.cin * c.cout || c.bias.size() != size_t(c.cout))
       return Status::Error(name + ": filter/bias sizes do not match the shape");
     if (w.lin[i].size() != size_t(c.cout))
-      return Status::Error(source + ": " + LinName(i) + ": " + std::to_string(w.lin[i].size()) + " channels, conv" +
-                           std::to_string(i + 1) + " has " + std::to_string(c.cout));
+      return Status::Error(source + ": " + LinName(i) + ": " + std::to_string(w.lin[i].size()) +
+                           " channels, conv" + std::to_string(i + 1) + " has " + std::to_string(c.cout));
     cin = c.cout;
   }
   return Status::Ok();
@@ -111,7 +112,8 @@ Status WriteLpipsWeights(const std::filesystem::path& path, const LpipsWeights& 
           for (int co = 0; co < c.cout; ++co)
             oihw[((size_t(co) * c.cin + ci) * c.kh + y) * c.kw + x] =
                 c.filters[((size_t(y) * c.kw + x) * c.cin + ci) * c.cout + co];
-    PutTensor(out, ConvName(i, "weight"), {uint32_t(c.cout), uint32_t(c.cin), uint32_t(c.kh), uint32_t(c.kw)}, oihw);
+    PutTensor(out, ConvName(i, "weight"), {uint32_t(c.cout), uint32_t(c.cin), uint32_t(c.kh), uint32_t(c.kw)},
+              oihw);
     PutTensor(out, ConvName(i, "bias"), {uint32_t(c.cout)}, c.bias);
   }
   for (int i = 0; i < kLpipsLayers; ++i)
@@ -125,8 +127,9 @@ Result<LpipsWeights> ReadLpipsWeights(const std::filesystem::path& path) {
   Reader reader(bytes, file);
   ICEF_ASSIGN_OR_RETURN(const std::string magic, reader.Bytes(sizeof(kMagic), "magic"));
   if (std::memcmp(magic.data(), kMagic, sizeof(kMagic)) != 0)
-    return Status::Error(file + ": not an ICEF LPIPS weights file (bad magic; convert the official weights with "
-                                "scripts/convert_lpips_weights.py)");
+    return Status::Error(file +
+                         ": not an ICEF LPIPS weights file (bad magic; convert the official weights with "
+                         "scripts/convert_lpips_weights.py)");
   ICEF_ASSIGN_OR_RETURN(const uint32_t version, reader.U32("version"));
   if (version != kVersion) return Status::Error(file + ": unsupported version " + std::to_string(version));
   ICEF_ASSIGN_OR_RETURN(const uint32_t count, reader.U32("tensor count"));
@@ -134,7 +137,8 @@ Result<LpipsWeights> ReadLpipsWeights(const std::filesystem::path& path) {
   for (uint32_t t = 0; t < count; ++t) {
     const std::string where = "tensor " + std::to_string(t);
     ICEF_ASSIGN_OR_RETURN(const uint32_t name_len, reader.U32(where + " name length"));
-    if (name_len > 256) return Status::Error(file + ": " + where + ": name length " + std::to_string(name_len));
+    if (name_len > 256)
+      return Status::Error(file + ": " + where + ": name length " + std::to_string(name_len));
     ICEF_ASSIGN_OR_RETURN(const std::string name, reader.Bytes(name_len, where + " name"));
     ICEF_ASSIGN_OR_RETURN(const uint32_t rank, reader.U32(name + " rank"));
     if (rank > 4) return Status::Error(file + ": " + name + ": rank " + std::to_string(rank));
@@ -151,7 +155,8 @@ Result<LpipsWeights> ReadLpipsWeights(const std::filesystem::path& path) {
     std::memcpy(tensor.values.data(), data.data(), n * 4);
     for (float v : tensor.values)
       if (!std::isfinite(v)) return Status::Error(file + ": " + name + ": non-finite value");
-    if (!tensors.emplace(name, std::move(tensor)).second) return Status::Error(file + ": duplicate tensor " + name);
+    if (!tensors.emplace(name, std::move(tensor)).second)
+      return Status::Error(file + ": duplicate tensor " + name);
   }
   if (!reader.AtEnd()) return Status::Error(file + ": trailing bytes after the last tensor");
 
@@ -159,8 +164,8 @@ Result<LpipsWeights> ReadLpipsWeights(const std::filesystem::path& path) {
     const auto it = tensors.find(name);
     if (it == tensors.end()) return Status::Error(file + ": missing tensor " + name);
     if (it->second.dims.size() != rank)
-      return Status::Error(file + ": " + name + ": rank " + std::to_string(it->second.dims.size()) + ", expected " +
-                           std::to_string(rank));
+      return Status::Error(file + ": " + name + ": rank " + std::to_string(it->second.dims.size()) +
+                           ", expected " + std::to_string(rank));
     return &it->second;
   };
   LpipsWeights w;
@@ -226,7 +231,8 @@ Result<double> LpipsNet::Distance(const Image& a, const Image& b) const {
   if (a.width != b.width || a.height != b.height)
     return Status::Error("LPIPS: images differ in size: " + a.ToString() + " vs " + b.ToString());
   if (a.width < kLpipsMinSize || a.height < kLpipsMinSize)
-    return Status::Error("LPIPS: image " + a.ToString() + " smaller than " + std::to_string(kLpipsMinSize) + " pixels");
+    return Status::Error("LPIPS: image " + a.ToString() + " smaller than " + std::to_string(kLpipsMinSize) +
+                         " pixels");
   const auto fa = Features(a), fb = Features(b);
   double total = 0.0;
   for (int l = 0; l < kLpipsLayers; ++l) {

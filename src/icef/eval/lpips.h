@@ -38,8 +38,8 @@ constexpr int kLpipsMinSize = 31;
 constexpr const char* kLpipsWeightsFileName = "lpips_alex_v0.1.bin";
 
 struct LpipsWeights {
-  std::array<infer::ConvWeights, kLpipsLayers> conv;       // HWIO filters + bias, AlexNet conv1..conv5
-  std::array<std::vector<float>, kLpipsLayers> lin;  // [C_i] linear-head weights
+  std::array<infer::ConvWeights, kLpipsLayers> conv;  // HWIO filters + bias, AlexNet conv1..conv5
+  std::array<std::vector<float>, kLpipsLayers> lin;   // [C_i] linear-head weights
   std::string ToString() const;
 };
 

@@ -77,7 +77,8 @@ double NaiveLpips(const LpipsWeights& w, const Image& a, const Image& b) {
           nb += std::pow(tb[l].At(y, i, c), 2);
         }
         for (int c = 0; c < ta[l].c; ++c) {
-          const double d = ta[l].At(y, i, c) / (std::sqrt(na) + 1e-10) - tb[l].At(y, i, c) / (std::sqrt(nb) + 1e-10);
+          const double d =
+              ta[l].At(y, i, c) / (std::sqrt(na) + 1e-10) - tb[l].At(y, i, c) / (std::sqrt(nb) + 1e-10);
           sum += w.lin[l][c] * d * d;
         }
       }

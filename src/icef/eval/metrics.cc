@@ -11,10 +11,11 @@ namespace {
 Result<int> CheckPair(const Image& a, const Image& b, const Image* mask, const char* metric) {
   if (a.empty() || b.empty()) return Status::Error(std::string(metric) + ": empty image");
   if (a.width != b.width || a.height != b.height || a.channels != b.channels)
-    return Status::Error(std::string(metric) + ": images differ in size or channels: " + a.ToString() + " vs " +
-                         b.ToString());
+    return Status::Error(std::string(metric) + ": images differ in size or channels: " + a.ToString() +
+                         " vs " + b.ToString());
   if (mask != nullptr && (mask->width != a.width || mask->height != a.height))
-    return Status::Error(std::string(metric) + ": mask " + mask->ToString() + " does not match image " + a.ToString());
+    return Status::Error(std::string(metric) + ": mask " + mask->ToString() + " does not match image " +
+                         a.ToString());
   return a.channels >= 3 ? 3 : a.channels;
 }
 
@@ -46,7 +47,8 @@ std::vector<double> Blur(const std::vector<double>& plane, int w, int h, const s
 std::vector<double> GaussianKernel(double sigma, int radius) {
   std::vector<double> kernel(2 * radius + 1);
   double sum = 0.0;
-  for (int k = -radius; k <= radius; ++k) sum += kernel[k + radius] = std::exp(-0.5 * k * k / (sigma * sigma));
+  for (int k = -radius; k <= radius; ++k)
+    sum += kernel[k + radius] = std::exp(-0.5 * k * k / (sigma * sigma));
   for (double& k : kernel) k /= sum;
   return kernel;
 }
@@ -85,7 +87,8 @@ Result<double> DetailRatio(const Image& render, const Image& truth, const Image*
     return v / channels;
   };
   auto laplacian = [&](const Image& im, int x, int y) {
-    return grey(im, x - 1, y) + grey(im, x + 1, y) + grey(im, x, y - 1) + grey(im, x, y + 1) - 4.0 * grey(im, x, y);
+    return grey(im, x - 1, y) + grey(im, x + 1, y) + grey(im, x, y - 1) + grey(im, x, y + 1) -
+           4.0 * grey(im, x, y);
   };
   double e_render = 0.0, e_truth = 0.0;
   size_t count = 0;
@@ -123,7 +126,8 @@ Result<double> Ssim(const Image& a, const Image& b, const SsimOptions& options, 
     return Status::Error("SSIM: image " + a.ToString() + " smaller than the " + std::to_string(2 * r + 1) +
                          "-pixel window");
   const std::vector<double> kernel = GaussianKernel(options.sigma, r);
-  const double c1 = std::pow(options.k1 * options.data_range, 2), c2 = std::pow(options.k2 * options.data_range, 2);
+  const double c1 = std::pow(options.k1 * options.data_range, 2),
+               c2 = std::pow(options.k2 * options.data_range, 2);
 
   double total = 0.0;
   size_t count = 0;

@@ -20,11 +20,11 @@ namespace icef::eval {
 Result<double> Psnr(const Image& a, const Image& b, const Image* mask = nullptr, double data_range = 1.0);
 
 struct SsimOptions {
-  double sigma = 1.5;        // Gaussian window standard deviation, pixels
-  int radius = 5;            // window half-width: int(3.5 * sigma + 0.5) = 5 gives skimage's 11 taps
-  double k1 = 0.01;          // luminance stabiliser: C1 = (k1 * data_range)^2
-  double k2 = 0.03;          // contrast stabiliser: C2 = (k2 * data_range)^2
-  double data_range = 1.0;   // value range of the images
+  double sigma = 1.5;       // Gaussian window standard deviation, pixels
+  int radius = 5;           // window half-width: int(3.5 * sigma + 0.5) = 5 gives skimage's 11 taps
+  double k1 = 0.01;         // luminance stabiliser: C1 = (k1 * data_range)^2
+  double k2 = 0.03;         // contrast stabiliser: C2 = (k2 * data_range)^2
+  double data_range = 1.0;  // value range of the images
   Status Validate() const;
   std::string ToString() const;
 };
@@ -34,7 +34,8 @@ struct SsimOptions {
 // from a normalised Gaussian window (population statistics), the SSIM map averaged over the
 // pixels at least `radius` from the border, then over channels. Images must be at least
 // 2 * radius + 1 pixels in each dimension; a mask with no pixel in that interior is an error.
-Result<double> Ssim(const Image& a, const Image& b, const SsimOptions& options = {}, const Image* mask = nullptr);
+Result<double> Ssim(const Image& a, const Image& b, const SsimOptions& options = {},
+                    const Image* mask = nullptr);
 
 // One image plane [h, w] (row-major) filtered by a normalised Gaussian of `sigma` pixels (taps to
 // ceil(3 sigma)), separably, with scipy's 'reflect' boundary. sigma <= 0: the plane unchanged.

@@ -18,32 +18,23 @@ namespace icef::eval {
 
 namespace {
 
-using FrameField = std::optional<double> RealFrameMetrics::*;
-using MeanField = std::optional<double> RealMeans::*;
-
-// The measures by name, written once: the JSON keys of frames and of their means (the same keys,
-// in the same order).
-constexpr std::array<std::pair<const char*, FrameField>, 9> kFrameFields = {{
-    {"face_psnr", &RealFrameMetrics::face_psnr},
-    {"face_ssim", &RealFrameMetrics::face_ssim},
-    {"head_psnr", &RealFrameMetrics::head_psnr},
-    {"head_ssim", &RealFrameMetrics::head_ssim},
-    {"lpips", &RealFrameMetrics::lpips},
-    {"id_distance", &RealFrameMetrics::id_distance},
-    {"real_expr_gain", &RealFrameMetrics::real_expr_gain},
-    {"face_psnr_nearest", &RealFrameMetrics::face_psnr_nearest},
-    {"track_rms_iod", &RealFrameMetrics::track_rms_iod},
-}};
-constexpr std::array<std::pair<const char*, MeanField>, 9> kMeanFields = {{
-    {"face_psnr", &RealMeans::face_psnr},
-    {"face_ssim", &RealMeans::face_ssim},
-    {"head_psnr", &RealMeans::head_psnr},
-    {"head_ssim", &RealMeans::head_ssim},
-    {"lpips", &RealMeans::lpips},
-    {"id_distance", &RealMeans::id_distance},
-    {"real_expr_gain", &RealMeans::real_expr_gain},
-    {"face_psnr_nearest", &RealMeans::face_psnr_nearest},
-    {"track_rms_iod", &RealMeans::track_rms_iod},
+// The measures, written once: the JSON key (the same in a frame and in the means), the frame's
+// value and its mean.
+struct RealField {
+  const char* key;
+  std::optional<double> RealFrameMetrics::*frame;
+  std::optional<double> RealMeans::*mean;
+};
+constexpr std::array<RealField, 9> kFields = {{
+    {"face_psnr", &RealFrameMetrics::face_psnr, &RealMeans::face_psnr},
+    {"face_ssim", &RealFrameMetrics::face_ssim, &RealMeans::face_ssim},
+    {"head_psnr", &RealFrameMetrics::head_psnr, &RealMeans::head_psnr},
+    {"head_ssim", &RealFrameMetrics::head_ssim, &RealMeans::head_ssim},
+    {"lpips", &RealFrameMetrics::lpips, &RealMeans::lpips},
+    {"id_distance", &RealFrameMetrics::id_distance, &RealMeans::id_distance},
+    {"real_expr_gain", &RealFrameMetrics::real_expr_gain, &RealMeans::real_expr_gain},
+    {"face_psnr_nearest", &RealFrameMetrics::face_psnr_nearest, &RealMeans::face_psnr_nearest},
+    {"track_rms_iod", &RealFrameMetrics::track_rms_iod, &RealMeans::track_rms_iod},
 }};
 
 // The inner landmarks (brows, eyes, nose, mouth: 17-67) are points of the face's surface; the jaw
@@ -87,7 +78,7 @@ Json RealFrameMetrics::ToJson() const {
   j["file_path"] = file_path;
   j["delta"] = delta;
   j["nearest_train"] = nearest_train;
-  for (const auto& [key, field] : kFrameFields) j[key] = OptionalJson(this->*field);
+  for (const RealField& f : kFields) j[f.key] = OptionalJson(this->*f.frame);
   j["render"] = render_path;
   j["render_nearest"] = nearest_path;
   return j;
@@ -99,9 +90,10 @@ Result<RealFrameMetrics> RealFrameMetrics::FromJson(const Json& j, const std::st
   m.file_path = ReadString(j, "file_path");
   if (m.file_path.empty()) return Status::Error(where + ".file_path: expected a string");
   if (j.contains("delta") && j["delta"].is_number()) m.delta = j["delta"].get<double>();
-  if (j.contains("nearest_train") && j["nearest_train"].is_number_integer()) m.nearest_train = j["nearest_train"].get<int>();
-  for (const auto& [key, field] : kFrameFields) {
-    ICEF_ASSIGN_OR_RETURN(m.*field, ReadOptional(j, where, key));
+  if (j.contains("nearest_train") && j["nearest_train"].is_number_integer())
+    m.nearest_train = j["nearest_train"].get<int>();
+  for (const RealField& f : kFields) {
+    ICEF_ASSIGN_OR_RETURN(m.*f.frame, ReadOptional(j, where, f.key));
   }
   m.render_path = ReadString(j, "render");
   m.nearest_path = ReadString(j, "render_nearest");
@@ -111,15 +103,15 @@ Result<RealFrameMetrics> RealFrameMetrics::FromJson(const Json& j, const std::st
 RealMeans RealMeans::Of(const std::vector<RealFrameMetrics>& frames) {
   RealMeans means;
   means.count = static_cast<int>(frames.size());
-  for (size_t f = 0; f < kMeanFields.size(); ++f) {
+  for (const RealField& f : kFields) {
     double sum = 0;
     int n = 0;
     for (const RealFrameMetrics& m : frames)
-      if (const auto& v = m.*(kFrameFields[f].second)) {
+      if (const auto& v = m.*f.frame) {
         sum += *v;
         ++n;
       }
-    if (n > 0) means.*(kMeanFields[f].second) = sum / n;
+    if (n > 0) means.*f.mean = sum / n;
   }
   return means;
 }
@@ -127,7 +119,7 @@ RealMeans RealMeans::Of(const std::vector<RealFrameMetrics>& frames) {
 Json RealMeans::ToJson() const {
   Json j;
   j["count"] = count;
-  for (const auto& [key, field] : kMeanFields) j[key] = OptionalJson(this->*field);
+  for (const RealField& f : kFields) j[f.key] = OptionalJson(this->*f.mean);
   return j;
 }
 
@@ -135,8 +127,8 @@ Result<RealMeans> RealMeans::FromJson(const Json& j, const std::string& where) {
   if (!j.is_object()) return Status::Error(where + ": expected an object");
   RealMeans m;
   if (j.contains("count") && j["count"].is_number_integer()) m.count = j["count"].get<int>();
-  for (const auto& [key, field] : kMeanFields) {
-    ICEF_ASSIGN_OR_RETURN(m.*field, ReadOptional(j, where, key));
+  for (const RealField& f : kFields) {
+    ICEF_ASSIGN_OR_RETURN(m.*f.mean, ReadOptional(j, where, f.key));
   }
   return m;
 }
@@ -160,8 +152,9 @@ Result<RealEvalResult> RealEvalResult::FromJson(const Json& j, const std::string
   const auto frames = j.find("frames");
   if (frames == j.end() || !frames->is_array()) return Status::Error(where + ".frames: expected an array");
   for (size_t i = 0; i < frames->size(); ++i) {
-    ICEF_ASSIGN_OR_RETURN(RealFrameMetrics f,
-                          RealFrameMetrics::FromJson((*frames)[i], where + ".frames[" + std::to_string(i) + "]"));
+    ICEF_ASSIGN_OR_RETURN(
+        RealFrameMetrics f,
+        RealFrameMetrics::FromJson((*frames)[i], where + ".frames[" + std::to_string(i) + "]"));
     r.frames.push_back(std::move(f));
   }
   r.means = RealMeans::Of(r.frames);
@@ -171,7 +164,8 @@ Result<RealEvalResult> RealEvalResult::FromJson(const Json& j, const std::string
 std::optional<double> RealExpressionGain(const Image& photo, const Image& tracked, const Image& nearest,
                                          const Image& region) {
   ICEF_CHECK(photo.width == tracked.width && photo.width == nearest.width && photo.width == region.width &&
-                 photo.height == tracked.height && photo.height == nearest.height && photo.height == region.height,
+                 photo.height == tracked.height && photo.height == nearest.height &&
+                 photo.height == region.height,
              "RealExpressionGain: images of one size");
   double err_tracked = 0, err_nearest = 0;
   int pixels = 0;
@@ -207,7 +201,8 @@ std::optional<double> TrackingResidualIod(const Frame& frame) {
   return std::sqrt(sum / n) / iod;
 }
 
-std::pair<int, double> NearestTrainingExpression(const Dataset& dataset, const std::vector<float>& expression) {
+std::pair<int, double> NearestTrainingExpression(const Dataset& dataset,
+                                                 const std::vector<float>& expression) {
   int best = -1;
   double best_d = std::numeric_limits<double>::infinity();
   for (size_t k = 0; k < dataset.train.size(); ++k) {
@@ -224,16 +219,21 @@ std::pair<int, double> NearestTrainingExpression(const Dataset& dataset, const s
   return {best, std::sqrt(best_d)};
 }
 
-Result<RealEvalResult> EvaluateReal(const AvatarModel& model, const Dataset& dataset, const RealEvalOptions& options,
-                                    const EvalNetworks& networks, const Executor& executor, ProgressBar* progress) {
+Result<RealEvalResult> EvaluateReal(const AvatarModel& model, const Dataset& dataset,
+                                    const RealEvalOptions& options, const EvalNetworks& networks,
+                                    const Executor& executor, ProgressBar* progress) {
   ICEF_RETURN_IF_ERROR(options.Validate());
-  if (dataset.test.empty()) return Status::Error(dataset.root.string() + ": the dataset has no held-out frames");
-  if (dataset.train.empty()) return Status::Error(dataset.root.string() + ": the dataset has no training frames");
+  if (dataset.test.empty())
+    return Status::Error(dataset.root.string() + ": the dataset has no held-out frames");
+  if (dataset.train.empty())
+    return Status::Error(dataset.root.string() + ": the dataset has no training frames");
   const bool write = !options.out_dir.empty();
   if (write) {
     std::error_code ec;
     fs::create_directories(options.out_dir / "renders", ec);
-    if (ec) return Status::Error((options.out_dir / "renders").string() + ": cannot create directory: " + ec.message());
+    if (ec)
+      return Status::Error((options.out_dir / "renders").string() +
+                           ": cannot create directory: " + ec.message());
   }
   RealEvalResult result;
   result.method = MethodName(model.method());
@@ -241,7 +241,8 @@ Result<RealEvalResult> EvaluateReal(const AvatarModel& model, const Dataset& dat
   result.lpips_available = networks.lpips != nullptr;
   for (size_t i = 0; i < dataset.test.size(); ++i) {
     const Frame& frame = dataset.test[i];
-    const std::string where = dataset.root.string() + ": held-out frame " + std::to_string(i) + " (" + frame.file_path + ")";
+    const std::string where =
+        dataset.root.string() + ": held-out frame " + std::to_string(i) + " (" + frame.file_path + ")";
     if (!frame.landmarks_2d) return Status::Error(where + ": landmarks_2d: missing (icef track writes them)");
     ICEF_ASSIGN_OR_RETURN(const Image raw, LoadFrameImage(dataset, frame));
     if (raw.width != frame.camera.width() || raw.height != frame.camera.height())
@@ -252,7 +253,8 @@ Result<RealEvalResult> EvaluateReal(const AvatarModel& model, const Dataset& dat
     const auto [nearest, delta] = NearestTrainingExpression(dataset, frame.expression);
     m.nearest_train = nearest;
     m.delta = delta;
-    const RenderedImage tracked = RenderImage(model, frame.camera, frame.expression, dataset.background, executor);
+    const RenderedImage tracked =
+        RenderImage(model, frame.camera, frame.expression, dataset.background, executor);
     const RenderedImage still =
         RenderImage(model, frame.camera, dataset.train[nearest].expression, dataset.background, executor);
 

@@ -34,19 +34,19 @@ namespace icef::eval {
 
 // The measures of one held-out real frame (null where a value cannot be computed).
 struct RealFrameMetrics {
-  std::string file_path;                    // the photo, relative to the dataset
-  double delta = 0;                         // distance of its expression to the nearest training frame's
-  int nearest_train = -1;                   // that training frame
-  std::optional<double> face_psnr;          // dB
+  std::string file_path;            // the photo, relative to the dataset
+  double delta = 0;                 // distance of its expression to the nearest training frame's
+  int nearest_train = -1;           // that training frame
+  std::optional<double> face_psnr;  // dB
   std::optional<double> face_ssim;
-  std::optional<double> head_psnr;          // dB
+  std::optional<double> head_psnr;  // dB
   std::optional<double> head_ssim;
   std::optional<double> lpips;
-  std::optional<double> id_distance;        // render vs photo
+  std::optional<double> id_distance;  // render vs photo
   std::optional<double> real_expr_gain;
   std::optional<double> face_psnr_nearest;  // the nearest-expression render's face PSNR, dB
   std::optional<double> track_rms_iod;
-  std::string render_path;                  // renders, relative to the output directory ("" = not written)
+  std::string render_path;  // renders, relative to the output directory ("" = not written)
   std::string nearest_path;
 
   Json ToJson() const;
@@ -83,7 +83,8 @@ std::optional<double> RealExpressionGain(const Image& photo, const Image& tracke
 std::optional<double> TrackingResidualIod(const Frame& frame);
 
 // The training frame whose expression is nearest to `expression` (L2), and the distance.
-std::pair<int, double> NearestTrainingExpression(const Dataset& dataset, const std::vector<float>& expression);
+std::pair<int, double> NearestTrainingExpression(const Dataset& dataset,
+                                                 const std::vector<float>& expression);
 
 struct RealEvalOptions {
   std::filesystem::path out_dir;  // renders go to out_dir/renders/ ("" = none written)
@@ -92,7 +93,8 @@ struct RealEvalOptions {
 
 // Evaluates `model` on the held-out frames of a tracked real dataset (frames need landmarks_2d;
 // landmarks_3d for the tracking residual). progress (may be null) counts test frames.
-Result<RealEvalResult> EvaluateReal(const AvatarModel& model, const Dataset& dataset, const RealEvalOptions& options,
-                                    const EvalNetworks& networks, const Executor& executor, ProgressBar* progress);
+Result<RealEvalResult> EvaluateReal(const AvatarModel& model, const Dataset& dataset,
+                                    const RealEvalOptions& options, const EvalNetworks& networks,
+                                    const Executor& executor, ProgressBar* progress);
 
 }  // namespace icef::eval

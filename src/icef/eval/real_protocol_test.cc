@@ -57,7 +57,8 @@ Frame TrackedFrame(float shift_iod) {
   pose(2, 3) = 3;
   f.camera = Camera(k, pose);
   std::vector<Vec3f> lm3(68);
-  for (int i = 0; i < 68; ++i) lm3[i] = Vec3f(0.01f * (i % 17) - 0.08f, 0.02f * (i / 17) - 0.03f, 0.05f * (i % 3));
+  for (int i = 0; i < 68; ++i)
+    lm3[i] = Vec3f(0.01f * (i % 17) - 0.08f, 0.02f * (i / 17) - 0.03f, 0.05f * (i % 3));
   lm3[36] = Vec3f(-0.2f, 0, 0);
   lm3[39] = Vec3f(-0.1f, 0, 0);
   lm3[42] = Vec3f(0.1f, 0, 0);

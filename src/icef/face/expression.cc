@@ -23,18 +23,27 @@ std::vector<int> ExpressionRegionLandmarks(int e) {
     return v;
   };
   switch (e) {
-    case kJawOpen: return range(48, 67, range(3, 13));
+    case kJawOpen:
+      return range(48, 67, range(3, 13));
     case kSmileLeft:
     case kSmileRight:
     case kLipPucker:
-    case kLipPress: return range(48, 67);
-    case kCheekPuff: return range(48, 67, range(3, 13));
-    case kBrowRaiseLeft: return range(22, 26);
-    case kBrowRaiseRight: return range(17, 21);
-    case kBrowFurrow: return range(17, 26);
-    case kEyeCloseLeft: return range(42, 47);
-    case kEyeCloseRight: return range(36, 41);
-    default: return {};
+    case kLipPress:
+      return range(48, 67);
+    case kCheekPuff:
+      return range(48, 67, range(3, 13));
+    case kBrowRaiseLeft:
+      return range(22, 26);
+    case kBrowRaiseRight:
+      return range(17, 21);
+    case kBrowFurrow:
+      return range(17, 26);
+    case kEyeCloseLeft:
+      return range(42, 47);
+    case kEyeCloseRight:
+      return range(36, 41);
+    default:
+      return {};
   }
 }
 

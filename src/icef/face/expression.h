@@ -29,8 +29,8 @@ enum ExpressionIndex : int {
 };
 
 inline constexpr std::array<const char*, kNumExpressions> kExpressionNames = {
-    "jaw_open",        "smile_left",       "smile_right",   "lip_pucker",     "lip_press",      "brow_raise_left",
-    "brow_raise_right", "brow_furrow",      "eye_close_left", "eye_close_right", "cheek_puff"};
+    "jaw_open",         "smile_left",  "smile_right",    "lip_pucker",      "lip_press", "brow_raise_left",
+    "brow_raise_right", "brow_furrow", "eye_close_left", "eye_close_right", "cheek_puff"};
 
 std::vector<std::string> ExpressionNames();
 

@@ -91,11 +91,13 @@ Vec3f FaceModel::BumpDisplacement(const Vec3f& x, const ExpressionState& s) cons
                  Vec3f(0.f, 0.022f, 0.002f);
     const float furrow = s.styled[kBrowFurrow];
     if (furrow > 0.f)
-      forward += furrow * EllipsoidBump(x, Vec3f(sg * 0.035f, g.brow_y - 0.005f, 0.27f), inv(0.055f, 0.05f, 0.07f)) *
+      forward += furrow *
+                 EllipsoidBump(x, Vec3f(sg * 0.035f, g.brow_y - 0.005f, 0.27f), inv(0.055f, 0.05f, 0.07f)) *
                  Vec3f(-sg * 0.01f, -0.012f, 0.003f);
     const float puff = s.styled[kCheekPuff];
     if (puff > 0.f)
-      forward += puff * EllipsoidBump(x, Vec3f(sg * 0.115f, g.mouth_y + 0.03f, 0.18f), inv(0.085f, 0.085f, 0.09f)) *
+      forward += puff *
+                 EllipsoidBump(x, Vec3f(sg * 0.115f, g.mouth_y + 0.03f, 0.18f), inv(0.085f, 0.085f, 0.09f)) *
                  Vec3f(sg * 0.02f, 0.f, 0.014f);
   }
   const Vec3f mouth(0.f, g.mouth_y, g.lip_z - 0.02f);

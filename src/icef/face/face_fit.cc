@@ -19,7 +19,8 @@ namespace icef::face {
 namespace {
 
 constexpr int kNumLandmarks = 68;
-constexpr int kPoseSize = 7;  // angle-axis [3] (on top of the initial rotation), translation [3], log scale [1]
+constexpr int kPoseSize =
+    7;  // angle-axis [3] (on top of the initial rotation), translation [3], log scale [1]
 
 Vec3d EyeCentre(std::span<const Vec3f> lm, int first) {
   Vec3d c = Vec3d::Zero();
@@ -49,7 +50,8 @@ ExpressionStyle StyleFromBlock(const double* block) {
   ExpressionStyle style;
   const auto fields = style.Fields();
   for (int i = 0; i < ExpressionStyle::kNumFields; ++i)
-    style.SetField(fields[i].first, static_cast<float>(block[i] - (i < ExpressionStyle::kNumGains ? 0.0 : 1.0)));
+    style.SetField(fields[i].first,
+                   static_cast<float>(block[i] - (i < ExpressionStyle::kNumGains ? 0.0 : 1.0)));
   return style;
 }
 
@@ -61,7 +63,8 @@ class LandmarkCache {
   const std::vector<std::array<Vec3f, 68>>& For(const double* shape, const double* style) {
     Key key;
     for (int i = 0; i < ShapeParams::kCount; ++i) key[i] = static_cast<float>(shape[i]);
-    for (int i = 0; i < ExpressionStyle::kNumFields; ++i) key[ShapeParams::kCount + i] = static_cast<float>(style[i]);
+    for (int i = 0; i < ExpressionStyle::kNumFields; ++i)
+      key[ShapeParams::kCount + i] = static_cast<float>(style[i]);
     if (!valid_ || key != key_) {
       std::array<float, ShapeParams::kCount> values;
       std::copy_n(key.begin(), ShapeParams::kCount, values.begin());
@@ -106,7 +109,8 @@ struct Problem {
   mutable LandmarkCache cache;
   int num_residuals = 0;
 
-  Problem(std::span<const FitFrame> f, const Similarity& b, double iod) : frames(f), base(b), iod_head(iod), cache(f) {
+  Problem(std::span<const FitFrame> f, const Similarity& b, double iod)
+      : frames(f), base(b), iod_head(iod), cache(f) {
     for (const FitFrame& fr : frames) {
       iod_px.push_back(fr.landmarks_3d ? 0.0 : InterOcular2d(*fr.landmarks_2d));
       weight.emplace_back(kNumLandmarks, 1.0);
@@ -124,7 +128,8 @@ struct Problem {
       for (int i = 0; i < kNumLandmarks; ++i) {
         const double w = weight[k][i];
         if (f.landmarks_3d) {
-          const Vec3d d = (s.Apply((*f.landmarks_3d)[i].cast<double>()) - model[k][i].cast<double>()) / iod_head;
+          const Vec3d d =
+              (s.Apply((*f.landmarks_3d)[i].cast<double>()) - model[k][i].cast<double>()) / iod_head;
           for (int a = 0; a < 3; ++a) out[r++] = w * d[a];
         } else {
           const auto proj = f.camera->Project(s.ApplyInverse(model[k][i].cast<double>()));
@@ -137,7 +142,8 @@ struct Problem {
   }
 
   // Per-landmark error norms [frame][landmark] in IOD (ignoring the weights).
-  std::vector<std::vector<double>> Errors(const double* shape, const double* style, const double* pose) const {
+  std::vector<std::vector<double>> Errors(const double* shape, const double* style,
+                                          const double* pose) const {
     std::vector<std::vector<double>> saved = weight;
     auto* self = const_cast<Problem*>(this);
     for (auto& row : self->weight) std::fill(row.begin(), row.end(), 1.0);
@@ -203,7 +209,8 @@ Result<Similarity> InitialSimilarity(std::span<const FitFrame> frames, double io
   for (const FitFrame& f : frames) {
     if (!f.landmarks_3d) continue;
     const std::array<Vec3f, 68> m = average.Landmarks(average.Prepare(f.expression));
-    for (int i = 0; i < kNumLandmarks; ++i) src.push_back((*f.landmarks_3d)[i].cast<double>()), dst.push_back(m[i].cast<double>());
+    for (int i = 0; i < kNumLandmarks; ++i)
+      src.push_back((*f.landmarks_3d)[i].cast<double>()), dst.push_back(m[i].cast<double>());
   }
   Similarity s;
   if (!src.empty()) {
@@ -263,15 +270,18 @@ Status CheckFrames(std::span<const FitFrame> frames) {
     const std::string where = "face fit: frame " + std::to_string(k) + ": ";
     if (Status s = ValidateExpression(f.expression); !s.ok()) return Status::Error(where + s.message());
     if (f.landmarks_3d) {
-      if (f.landmarks_3d->size() != kNumLandmarks) return Status::Error(where + "landmarks_3d must have 68 points");
+      if (f.landmarks_3d->size() != kNumLandmarks)
+        return Status::Error(where + "landmarks_3d must have 68 points");
       for (const Vec3f& p : *f.landmarks_3d)
         if (!p.allFinite()) return Status::Error(where + "landmarks_3d has a non-finite value");
     } else if (f.landmarks_2d) {
-      if (f.landmarks_2d->size() != kNumLandmarks) return Status::Error(where + "landmarks_2d must have 68 points");
+      if (f.landmarks_2d->size() != kNumLandmarks)
+        return Status::Error(where + "landmarks_2d must have 68 points");
       if (!f.camera) return Status::Error(where + "landmarks_2d need the frame's camera");
       for (const Vec2f& p : *f.landmarks_2d)
         if (!p.allFinite()) return Status::Error(where + "landmarks_2d has a non-finite value");
-      if (!(InterOcular2d(*f.landmarks_2d) > 0)) return Status::Error(where + "landmarks_2d: the eyes coincide");
+      if (!(InterOcular2d(*f.landmarks_2d) > 0))
+        return Status::Error(where + "landmarks_2d: the eyes coincide");
     } else {
       return Status::Error(where + "no landmarks (landmarks_3d or landmarks_2d)");
     }
@@ -298,16 +308,17 @@ Status FaceFitOptions::Validate() const {
     return Status::Error("style_gain_sigma must be a finite number > 0");
   if (!(style_offset_sigma > 0) || !std::isfinite(style_offset_sigma))
     return Status::Error("style_offset_sigma must be a finite number > 0");
-  if (!(style_min_f >= 0) || !std::isfinite(style_min_f)) return Status::Error("style_min_f must be a finite number >= 0");
+  if (!(style_min_f >= 0) || !std::isfinite(style_min_f))
+    return Status::Error("style_min_f must be a finite number >= 0");
   return Status::Ok();
 }
 
 std::string FaceFitOptions::ToString() const {
   std::ostringstream os;
   os << "FaceFitOptions(shape_prior_sigma=" << shape_prior_sigma << ", fit_shape=" << fit_shape
-     << ", max_iterations=" << max_iterations << ", outlier_iod=" << outlier_iod << ", fit_style=" << fit_style
-     << ", style_gain_sigma=" << style_gain_sigma << ", style_offset_sigma=" << style_offset_sigma
-     << ", style_min_f=" << style_min_f << ")";
+     << ", max_iterations=" << max_iterations << ", outlier_iod=" << outlier_iod
+     << ", fit_style=" << fit_style << ", style_gain_sigma=" << style_gain_sigma
+     << ", style_offset_sigma=" << style_offset_sigma << ", style_min_f=" << style_min_f << ")";
   return os.str();
 }
 
@@ -315,10 +326,11 @@ std::string FaceFit::BriefReport() const {
   std::ostringstream os;
   os.precision(3);
   os << "face fit: landmark RMS " << rms_iod << " IOD (max " << max_iod << "), " << landmarks_used << "/"
-     << landmarks_total << " landmarks, " << iterations << " iterations, head scale " << head_from_world.scale;
+     << landmarks_total << " landmarks, " << iterations << " iterations, head scale "
+     << head_from_world.scale;
   if (style_rejected) {
-    os << "; expression style: generic (a fitted one explained the landmarks no better than noise: F " << style_f
-       << ")";
+    os << "; expression style: generic (a fitted one explained the landmarks no better than noise: F "
+       << style_f << ")";
   } else if (!style.IsGeneric()) {  // the fields the fit moved off the generic style
     os << "; expression style:";
     const auto generic = ExpressionStyle::Generic().Fields();
@@ -349,7 +361,8 @@ Result<FaceFit> FitOnce(std::span<const FitFrame> frames, const FaceFitOptions& 
   Problem problem(frames, base, iod_head);
   std::array<double, ShapeParams::kCount> shape;
   shape.fill(1.0);
-  std::array<double, kPoseSize> pose = {0, 0, 0, base.translation.x(), base.translation.y(), base.translation.z(), 0};
+  std::array<double, kPoseSize> pose = {
+      0, 0, 0, base.translation.x(), base.translation.y(), base.translation.z(), 0};
   StyleBlock style = StyleToBlock(ExpressionStyle::Generic());
 
   FaceFit fit;
@@ -365,19 +378,20 @@ Result<FaceFit> FitOnce(std::span<const FitFrame> frames, const FaceFitOptions& 
     cost->AddParameterBlock(kPoseSize);
     cost->SetNumResiduals(problem.num_residuals);
     cp.AddResidualBlock(cost, nullptr, shape.data(), style.data(), pose.data());
-    cp.AddResidualBlock(new ceres::AutoDiffCostFunction<ShapePriorCost, ShapeParams::kCount, ShapeParams::kCount>(
-                            new ShapePriorCost{1.0 / options.shape_prior_sigma}),
-                        nullptr, shape.data());
+    cp.AddResidualBlock(
+        new ceres::AutoDiffCostFunction<ShapePriorCost, ShapeParams::kCount, ShapeParams::kCount>(
+            new ShapePriorCost{1.0 / options.shape_prior_sigma}),
+        nullptr, shape.data());
     for (int i = 0; i < ShapeParams::kCount; ++i) {  // keep the head buildable
       cp.SetParameterLowerBound(shape.data(), i, 0.5);
       cp.SetParameterUpperBound(shape.data(), i, 1.6);
     }
     if (!options.fit_shape) cp.SetParameterBlockConstant(shape.data());
     if (options.fit_style) {
-      cp.AddResidualBlock(
-          new ceres::AutoDiffCostFunction<StylePriorCost, ExpressionStyle::kNumFields, ExpressionStyle::kNumFields>(
-              new StylePriorCost{1.0 / options.style_gain_sigma, 1.0 / options.style_offset_sigma}),
-          nullptr, style.data());
+      cp.AddResidualBlock(new ceres::AutoDiffCostFunction<StylePriorCost, ExpressionStyle::kNumFields,
+                                                          ExpressionStyle::kNumFields>(new StylePriorCost{
+                              1.0 / options.style_gain_sigma, 1.0 / options.style_offset_sigma}),
+                          nullptr, style.data());
       // ExpressionStyle::Validate's ranges, less the numeric differences' step (1e-3 of the value).
       for (int i = 0; i < ExpressionStyle::kNumFields; ++i) {
         const bool gain = i < ExpressionStyle::kNumGains;
@@ -449,8 +463,9 @@ Result<FaceFit> FitFaceModel(std::span<const FitFrame> frames, const FaceFitOpti
   const double p = ExpressionStyle::kNumFields;
   const double dof = styled.residual_count - ShapeParams::kCount - kPoseSize - p;
   const double gained = generic.sum_squares - styled.sum_squares;
-  styled.style_f = dof > 0 && styled.sum_squares > 0 ? (gained / p) / (styled.sum_squares / dof)
-                                                      : (gained > 0 ? std::numeric_limits<double>::infinity() : 0.0);
+  styled.style_f = dof > 0 && styled.sum_squares > 0
+                       ? (gained / p) / (styled.sum_squares / dof)
+                       : (gained > 0 ? std::numeric_limits<double>::infinity() : 0.0);
   generic.style_f = styled.style_f;
   if (styled.style_f >= options.style_min_f) return styled;
   generic.style_rejected = true;

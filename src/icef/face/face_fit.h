@@ -31,7 +31,9 @@ struct Similarity {
   Vec3d translation = Vec3d::Zero();
 
   Vec3d Apply(const Vec3d& x_world) const { return scale * (rotation * x_world) + translation; }
-  Vec3d ApplyInverse(const Vec3d& x_head) const { return rotation.transpose() * (x_head - translation) / scale; }
+  Vec3d ApplyInverse(const Vec3d& x_head) const {
+    return rotation.transpose() * (x_head - translation) / scale;
+  }
   std::string ToString() const;
 };
 
@@ -44,13 +46,13 @@ struct FitFrame {
 };
 
 struct FaceFitOptions {
-  double shape_prior_sigma = 0.15;  // std of each shape scale around 1 (the plausibility prior)
-  bool fit_shape = true;            // false: the average head, similarity only
-  int max_iterations = 60;          // Levenberg-Marquardt iterations per pass
-  double outlier_iod = 0.08;        // second pass: drop landmarks farther than this (IOD) and 3x the median
-  bool fit_style = false;           // also fit the expression style (else the generic one)
-  double style_gain_sigma = 1.0;    // std of each style gain's log around 0 (generic: gain 1)
-  double style_offset_sigma = 0.03; // std of each style offset around 0 (head units)
+  double shape_prior_sigma = 0.15;   // std of each shape scale around 1 (the plausibility prior)
+  bool fit_shape = true;             // false: the average head, similarity only
+  int max_iterations = 60;           // Levenberg-Marquardt iterations per pass
+  double outlier_iod = 0.08;         // second pass: drop landmarks farther than this (IOD) and 3x the median
+  bool fit_style = false;            // also fit the expression style (else the generic one)
+  double style_gain_sigma = 1.0;     // std of each style gain's log around 0 (generic: gain 1)
+  double style_offset_sigma = 0.03;  // std of each style offset around 0 (head units)
   // The fitted style is kept when it explains the landmarks better than the generic style's fit
   // (which is fitted too) by an F statistic of at least this (its 17 fields against the noise left
   // over; 3 is past the 0.1 % point of F(17, 300+)); else the fit keeps the generic style.
@@ -62,16 +64,16 @@ struct FaceFitOptions {
 
 struct FaceFit {
   ShapeParams shape;
-  ExpressionStyle style;  // generic unless FaceFitOptions::fit_style
+  ExpressionStyle style;             // generic unless FaceFitOptions::fit_style
   double generic_style_rms_iod = 0;  // with fit_style: the RMS of the fit in the generic style
   double style_f = 0;                // with fit_style: the F statistic of the style's fields
   bool style_rejected = false;       // with fit_style: F below style_min_f, the generic style kept
   double sum_squares = 0;            // sum of the inlier landmarks' squared errors (IOD^2)
   int residual_count = 0;            // inlier landmark coordinates (3 per 3D landmark, 2 per 2D)
   Similarity head_from_world;
-  double rms_iod = 0;       // RMS landmark residual of the final pass (inter-ocular distances)
-  double max_iod = 0;       // largest landmark residual
-  int landmarks_used = 0;   // after outlier removal
+  double rms_iod = 0;      // RMS landmark residual of the final pass (inter-ocular distances)
+  double max_iod = 0;      // largest landmark residual
+  int landmarks_used = 0;  // after outlier removal
   int landmarks_total = 0;
   int iterations = 0;
 

@@ -44,7 +44,8 @@ std::vector<std::vector<float>> Expressions(int k, uint64_t seed) {
 }
 
 // Landmarks of the known head in the world frame, with Gaussian noise of `noise_iod` IOD per axis.
-std::vector<FitFrame> Frames3d(const FaceModel& truth, const Similarity& s, int k, double noise_iod, uint64_t seed) {
+std::vector<FitFrame> Frames3d(const FaceModel& truth, const Similarity& s, int k, double noise_iod,
+                               uint64_t seed) {
   const double iod = InterOcularDistance(truth.NeutralLandmarks());
   Rng rng(seed, StreamId("fit_noise"));
   std::vector<FitFrame> frames;

@@ -41,9 +41,11 @@ FaceGeometry FaceGeometry::FromShape(const ShapeParams& p) {
   g.mouth_half_width = 0.056f * p.mouth_width;
   g.lip_z = 0.285f;
   g.upper_lip_c = Vec3f(0.f, g.mouth_y + 0.011f * p.lip_thickness, 0.258f);
-  g.upper_lip_r = Vec3f(g.mouth_half_width * 1.05f, 0.012f * p.lip_thickness, 0.028f + 0.008f * (p.lip_thickness - 1.f));
+  g.upper_lip_r =
+      Vec3f(g.mouth_half_width * 1.05f, 0.012f * p.lip_thickness, 0.028f + 0.008f * (p.lip_thickness - 1.f));
   g.lower_lip_c = Vec3f(0.f, g.mouth_y - 0.013f * p.lip_thickness, 0.253f);
-  g.lower_lip_r = Vec3f(g.mouth_half_width * 0.95f, 0.014f * p.lip_thickness, 0.029f + 0.008f * (p.lip_thickness - 1.f));
+  g.lower_lip_r =
+      Vec3f(g.mouth_half_width * 0.95f, 0.014f * p.lip_thickness, 0.029f + 0.008f * (p.lip_thickness - 1.f));
   g.neck_a = Vec3f(0.f, -0.18f, -0.045f);
   g.neck_b = Vec3f(0.f, -0.9f, -0.06f);
   g.neck_r = 0.14f;

@@ -97,7 +97,6 @@ void FaceModel::BuildNeutralLandmarks() {
   lm[67] = front(-0.4f * mw, my - 0.003f);
   const std::array<Vec3f, 68> with_eyes = Landmarks(neutral_state_);
   for (int i = 36; i <= 47; ++i) lm[i] = with_eyes[i];
-
 }
 
 std::array<Vec3f, 68> FaceModel::Landmarks(const ExpressionState& s) const {
@@ -109,7 +108,8 @@ std::array<Vec3f, 68> FaceModel::Landmarks(const ExpressionState& s) const {
   return Landmarks(s, kNone);
 }
 
-std::array<Vec3f, 68> FaceModel::Landmarks(const ExpressionState& s, std::span<const Vec3f, 68> canonical_offsets) const {
+std::array<Vec3f, 68> FaceModel::Landmarks(const ExpressionState& s,
+                                           std::span<const Vec3f, 68> canonical_offsets) const {
   const FaceGeometry& g = geometry_;
   std::array<Vec3f, 68> canonical = neutral_landmarks_;
   // Eyes, on the lid edges at the state's lid angles. iBUG order per eye: outer corner, two upper,
@@ -135,7 +135,8 @@ std::array<Vec3f, 68> FaceModel::Landmarks(const ExpressionState& s, std::span<c
   std::array<Vec3f, 68> out;
   for (int i = 0; i < 68; ++i) {
     const bool lower_inner_lip = i >= 65 && i <= 67;
-    out[i] = InverseWarp(canonical[i] + canonical_offsets[i], s, lower_inner_lip && s.jaw_angle > 0.f ? 1.f : -1.f);
+    out[i] = InverseWarp(canonical[i] + canonical_offsets[i], s,
+                         lower_inner_lip && s.jaw_angle > 0.f ? 1.f : -1.f);
   }
   return out;
 }

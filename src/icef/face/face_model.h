@@ -54,12 +54,12 @@ struct FaceGeometry {
 struct ExpressionState {
   std::array<float, kNumExpressions> beta{};
   std::array<float, kNumExpressions> styled{};  // beta[i] * style.WeightGain(i): what the warp uses
-  float jaw_angle = 0;                     // radians about the hinge's x axis
-  std::array<float, 2> lid_upper{};        // upper-lid edge elevation per eye (radians)
-  bool cavity = false;                     // mouth cavity carved
+  float jaw_angle = 0;                          // radians about the hinge's x axis
+  std::array<float, 2> lid_upper{};             // upper-lid edge elevation per eye (radians)
+  bool cavity = false;                          // mouth cavity carved
   Vec3f cavity_c = Vec3f::Zero(), cavity_r = Vec3f::Ones();  // observation space
-  float step_scale = 0.8f;                 // sphere-tracing step factor (smaller for larger warps)
-  bool neutral = true;                     // all weights zero
+  float step_scale = 0.8f;  // sphere-tracing step factor (smaller for larger warps)
+  bool neutral = true;      // all weights zero
 };
 
 class FaceModel {
@@ -121,7 +121,8 @@ class FaceModel {
   std::array<Vec3f, 68> Landmarks(const ExpressionState& state) const;
   // The same with each landmark's canonical point moved by canonical_offsets[i] (head units) before
   // the warp: another detector's convention of where the 68 points lie (track/detector_landmarks.h).
-  std::array<Vec3f, 68> Landmarks(const ExpressionState& state, std::span<const Vec3f, 68> canonical_offsets) const;
+  std::array<Vec3f, 68> Landmarks(const ExpressionState& state,
+                                  std::span<const Vec3f, 68> canonical_offsets) const;
   // Canonical (neutral) landmarks.
   const std::array<Vec3f, 68>& NeutralLandmarks() const { return neutral_landmarks_; }
   // The first crossing of the neutral surface (outside -> inside, or inside -> outside when the

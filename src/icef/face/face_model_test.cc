@@ -136,7 +136,8 @@ TEST(FaceModelTest, EachWarpTermIsZeroFarFromItsRegion) {
   const Vec3f top_of_head(0.f, 0.38f, 0.f), back_of_head(0.f, 0.05f, -0.36f), ear = face.geometry().ear_c[0];
   for (int e = 0; e < kNumExpressions; ++e) {
     const ExpressionState s = face.Prepare(One(e, 1.5f));
-    for (const Vec3f& p : {top_of_head, back_of_head, ear}) EXPECT_EQ(face.Warp(p, s), p) << kExpressionNames[e];
+    for (const Vec3f& p : {top_of_head, back_of_head, ear})
+      EXPECT_EQ(face.Warp(p, s), p) << kExpressionNames[e];
   }
 }
 
@@ -145,15 +146,15 @@ TEST(FaceModelTest, LandmarksFollowTheExpression) {
   const auto neutral = face.Landmarks(face.Prepare(Zeros()));
   for (int i = 0; i < 68; ++i) EXPECT_LT((neutral[i] - face.NeutralLandmarks()[i]).norm(), 1e-5f) << i;
   const auto jaw = face.Landmarks(face.Prepare(One(kJawOpen)));
-  EXPECT_LT(jaw[8].y(), neutral[8].y() - 0.03f);    // chin down
-  EXPECT_LT(jaw[57].y(), neutral[57].y() - 0.04f);  // lower lip down
+  EXPECT_LT(jaw[8].y(), neutral[8].y() - 0.03f);      // chin down
+  EXPECT_LT(jaw[57].y(), neutral[57].y() - 0.04f);    // lower lip down
   EXPECT_NEAR(jaw[51].y(), neutral[51].y(), 0.005f);  // upper lip stays
   EXPECT_NEAR(jaw[30].y(), neutral[30].y(), 1e-6f);   // nose tip untouched
   const auto blink = face.Landmarks(face.Prepare(One(kEyeCloseRight)));
   const float open = neutral[37].y() - neutral[41].y();
   EXPECT_GT(open, 0.01f);
   EXPECT_LT(std::abs(blink[37].y() - blink[41].y()), 0.2f * open);  // right upper lid met the lower lid
-  EXPECT_NEAR(blink[43].y(), neutral[43].y(), 1e-6f);                 // left eye unchanged
+  EXPECT_NEAR(blink[43].y(), neutral[43].y(), 1e-6f);               // left eye unchanged
   const auto brow = face.Landmarks(face.Prepare(One(kBrowRaiseLeft)));
   EXPECT_GT(brow[24].y(), neutral[24].y() + 0.01f);
   EXPECT_NEAR(brow[19].y(), neutral[19].y(), 1e-6f);

@@ -71,7 +71,8 @@ struct LidEdges {
   nose = SmoothMin(nose, SdEllipsoid(pm - g.nostril_c[1], g.nostril_r), 0.012f);
   d = SmoothMin(d, nose, 0.025f);
   // Lips.
-  const float lips = std::min(SdEllipsoid(p - g.upper_lip_c, g.upper_lip_r), SdEllipsoid(p - g.lower_lip_c, g.lower_lip_r));
+  const float lips =
+      std::min(SdEllipsoid(p - g.upper_lip_c, g.upper_lip_r), SdEllipsoid(p - g.lower_lip_c, g.lower_lip_r));
   d = SmoothMin(d, lips, 0.012f);
   // Eye socket of the nearer eye (the two sockets are far apart), then the eyeball and the lids.
   // The nearer side's values as a blend with weights 0 and 1 (exact), not a select between two

@@ -7,7 +7,8 @@
 namespace icef {
 
 Status ConfidenceOptions::Validate() const {
-  if (!(std::isfinite(lambda) && lambda > 0)) return Status::Error("confidence.lambda must be a finite number > 0");
+  if (!(std::isfinite(lambda) && lambda > 0))
+    return Status::Error("confidence.lambda must be a finite number > 0");
   return Status::Ok();
 }
 
@@ -50,7 +51,8 @@ Result<ExpressionConfidence> ExpressionConfidence::Create(std::vector<std::vecto
 
 NearestExpression ExpressionConfidence::Nearest(std::span<const float> beta) const {
   ICEF_CHECK(int(beta.size()) == expression_dim(), "expression has " + std::to_string(beta.size()) +
-                                                       " values, expected " + std::to_string(expression_dim()));
+                                                       " values, expected " +
+                                                       std::to_string(expression_dim()));
   NearestExpression best;
   double best_sq = std::numeric_limits<double>::infinity();
   for (int k = 0; k < num_observed(); ++k) {

@@ -23,9 +23,9 @@ struct ConfidenceOptions {
 
 // The nearest observed expression and the confidence there.
 struct NearestExpression {
-  int index = -1;      // training frame index k of beta_n
-  double delta = 0;    // ||beta - beta_n||_2
-  double kappa = 1;    // exp(-delta / lambda)
+  int index = -1;    // training frame index k of beta_n
+  double delta = 0;  // ||beta - beta_n||_2
+  double kappa = 1;  // exp(-delta / lambda)
   std::string ToString() const;
 };
 

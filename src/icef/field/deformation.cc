@@ -26,9 +26,9 @@ Deformation::Deformation(DeformationField* residual, const DeformationPrior* pri
   ICEF_CHECK(confidence_ != nullptr, "the deformation needs the training expressions' confidence");
 }
 
-void Deformation::ForwardTrain(const Executor& executor, int64_t n, const float* positions, const float* betas,
-                               float* offsets, float* residual_offsets, DeformationContext* ctx,
-                               bool keep_for_backward) const {
+void Deformation::ForwardTrain(const Executor& executor, int64_t n, const float* positions,
+                               const float* betas, float* offsets, float* residual_offsets,
+                               DeformationContext* ctx, bool keep_for_backward) const {
   if (residual_) {
     residual_->Forward(executor, n, positions, betas, offsets, ctx, keep_for_backward);
     if (residual_offsets) std::copy(offsets, offsets + 3 * n, residual_offsets);
@@ -43,7 +43,8 @@ void Deformation::ForwardTrain(const Executor& executor, int64_t n, const float*
   }
 }
 
-void Deformation::Backward(const Executor& executor, int64_t n, const float* d_offsets, DeformationContext* ctx) {
+void Deformation::Backward(const Executor& executor, int64_t n, const float* d_offsets,
+                           DeformationContext* ctx) {
   if (residual_) residual_->Backward(executor, n, d_offsets, ctx);
 }
 
@@ -51,8 +52,9 @@ double Deformation::Kappa(std::span<const float> beta) const {
   return blend_ ? confidence_->Nearest(beta).kappa : 1.0;
 }
 
-void Deformation::Offsets(const Executor& executor, int64_t n, const float* positions, std::span<const float> beta,
-                          float* offsets, DeformationWorkspace* ws, WarpPart part) const {
+void Deformation::Offsets(const Executor& executor, int64_t n, const float* positions,
+                          std::span<const float> beta, float* offsets, DeformationWorkspace* ws,
+                          WarpPart part) const {
   BroadcastExpression(beta, n, &ws->betas);
   std::fill(offsets, offsets + 3 * n, 0.f);
   if (prior_) prior_->Offsets(executor, n, positions, ws->betas.data(), offsets);
@@ -72,8 +74,8 @@ void Deformation::Offsets(const Executor& executor, int64_t n, const float* posi
     ws->tangents = ws->betas;
     AddScaled(executor, int64_t(ws->tangents.size()), -1.f, ws->anchors.data(), ws->tangents.data());
     ws->lin.resize(3 * n);
-    residual_->LinearizedForward(executor, n, positions, ws->anchors.data(), ws->tangents.data(), ws->lin.data(),
-                                 &ws->ctx);
+    residual_->LinearizedForward(executor, n, positions, ws->anchors.data(), ws->tangents.data(),
+                                 ws->lin.data(), &ws->ctx);
     AddScaled(executor, 3 * n, static_cast<float>(1.0 - kappa), ws->lin.data(), offsets);
   }
 }

@@ -2,7 +2,8 @@
 // beta maps to the canonical point x + offset with
 //   training (beta a training expression, kappa = 1):  offset = (P(x, beta) - x) + R_phi(x, beta)
 //   any expression (confidence-weighted warping):       offset = (P(x, beta) - x)
-//                                                               + kappa R_phi(x, beta) + (1 - kappa) R_lin(x, beta)
+//                                                               + kappa R_phi(x, beta) + (1 - kappa) R_lin(x,
+//                                                               beta)
 // where P is the optional face-model prior (absent: P(x) = x, the paper's D_phi = x + R_phi),
 // R_phi the learned field (DeformationField) and R_lin its JVP linearisation around the nearest
 // training expression beta_n. kappa comes from ExpressionConfidence; methods without the blend
@@ -40,8 +41,8 @@ class Deformation {
   // residual and prior may each be null; confidence (the training expressions and kappa's length
   // scale) must be given. blend = false: kappa = 1 for every expression. The pointees must outlive
   // this object.
-  Deformation(DeformationField* residual, const DeformationPrior* prior, const ExpressionConfidence* confidence,
-              bool blend);
+  Deformation(DeformationField* residual, const DeformationPrior* prior,
+              const ExpressionConfidence* confidence, bool blend);
 
   bool has_prior() const { return prior_ != nullptr; }
   DeformationField* residual() { return residual_; }
@@ -50,8 +51,9 @@ class Deformation {
 
   // Training: betas [n, B] per sample (training expressions). offsets = (P - x) + R_phi; when
   // residual_offsets is non-null it receives R_phi alone (what L_id regularises).
-  void ForwardTrain(const Executor& executor, int64_t n, const float* positions, const float* betas, float* offsets,
-                    float* residual_offsets, DeformationContext* ctx, bool keep_for_backward) const;
+  void ForwardTrain(const Executor& executor, int64_t n, const float* positions, const float* betas,
+                    float* offsets, float* residual_offsets, DeformationContext* ctx,
+                    bool keep_for_backward) const;
   // After ForwardTrain(keep_for_backward): d loss / d offsets [n, 3] into R_phi's parameters (P has none).
   void Backward(const Executor& executor, int64_t n, const float* d_offsets, DeformationContext* ctx);
 
@@ -60,11 +62,12 @@ class Deformation {
                float* offsets, DeformationWorkspace* ws, WarpPart part = WarpPart::kFinal) const;
 
   // inside [n] (see DeformationPrior::Cavity); all 0 without a prior.
-  void Cavity(const Executor& executor, int64_t n, const float* positions, const float* betas, uint8_t* inside) const;
+  void Cavity(const Executor& executor, int64_t n, const float* positions, const float* betas,
+              uint8_t* inside) const;
 
   // The prior's surface normals (DeformationPrior::Normals); false without a prior that has them.
-  bool Normals(const Executor& executor, int64_t n, const float* positions, const float* betas, float* observed,
-               float* canonical) const {
+  bool Normals(const Executor& executor, int64_t n, const float* positions, const float* betas,
+               float* observed, float* canonical) const {
     return prior_ && prior_->Normals(executor, n, positions, betas, observed, canonical);
   }
 

@@ -41,8 +41,9 @@ std::string DeformationFieldOptions::ToString() const {
   return os.str();
 }
 
-DeformationField::DeformationField(const DeformationFieldOptions& options, int expression_dims, const Aabb& aabb,
-                                   nn::ParameterStore* store, const std::string& name, int group)
+DeformationField::DeformationField(const DeformationFieldOptions& options, int expression_dims,
+                                   const Aabb& aabb, nn::ParameterStore* store, const std::string& name,
+                                   int group)
     : options_(options),
       expression_dims_(expression_dims),
       aabb_(aabb),
@@ -69,8 +70,9 @@ void DeformationField::ToUnit(const Executor& executor, int64_t n, const float* 
   });
 }
 
-void DeformationField::Forward(const Executor& executor, int64_t n, const float* positions, const float* betas,
-                               float* offsets, DeformationContext* ctx, bool keep_for_backward) const {
+void DeformationField::Forward(const Executor& executor, int64_t n, const float* positions,
+                               const float* betas, float* offsets, DeformationContext* ctx,
+                               bool keep_for_backward) const {
   ToUnit(executor, n, positions, ctx);
   mlp_.Forward(executor, n, ctx->unit_positions.data(), betas, ctx->raw.data(), &ctx->mlp, keep_for_backward);
   const float* raw = ctx->raw.data();
@@ -102,7 +104,8 @@ void DeformationField::LinearizedForward(const Executor& executor, int64_t n, co
 }
 
 std::string DeformationField::ToString() const {
-  return "DeformationField(" + options_.ToString() + ", expression_dims=" + std::to_string(expression_dims_) + ")";
+  return "DeformationField(" + options_.ToString() + ", expression_dims=" + std::to_string(expression_dims_) +
+         ")";
 }
 
 }  // namespace icef

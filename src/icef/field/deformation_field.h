@@ -59,8 +59,8 @@ class DeformationField {
   double annealing() const { return mlp_.encoding().alpha(); }
 
   // positions [n, 3] world frame, betas [n, B] -> offsets [n, 3] world frame (D = x + offset).
-  void Forward(const Executor& executor, int64_t n, const float* positions, const float* betas, float* offsets,
-               DeformationContext* ctx, bool keep_for_backward) const;
+  void Forward(const Executor& executor, int64_t n, const float* positions, const float* betas,
+               float* offsets, DeformationContext* ctx, bool keep_for_backward) const;
   // After Forward(keep_for_backward): accumulates parameter gradients from d_offsets [n, 3]
   // (world frame). Positions are data, so no input gradient is produced.
   void Backward(const Executor& executor, int64_t n, const float* d_offsets, DeformationContext* ctx);

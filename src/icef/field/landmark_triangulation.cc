@@ -7,7 +7,8 @@
 namespace icef {
 
 Status TriangulationOptions::Validate() const {
-  if (max_iterations < 0 || max_iterations > 1000) return Status::Error("triangulation.max_iterations must be in [0, 1000]");
+  if (max_iterations < 0 || max_iterations > 1000)
+    return Status::Error("triangulation.max_iterations must be in [0, 1000]");
   if (min_views < 2) return Status::Error("triangulation.min_views must be >= 2");
   return Status::Ok();
 }
@@ -43,14 +44,15 @@ std::optional<Vec3d> TriangulateLinear(const std::vector<PointObservation>& obse
     add_row(-dv * r.row(2) + r.row(1), dv * t.z() - t.y());
   }
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(ata);
-  const Vec3d ev = eig.eigenvalues();  // ascending
+  const Vec3d ev = eig.eigenvalues();                 // ascending
   if (!(ev(0) > 1e-10 * ev(2))) return std::nullopt;  // rank-deficient: depth unobservable
   const Vec3d p = eig.eigenvectors() * ((eig.eigenvectors().transpose() * atb).cwiseQuotient(ev));
   if (!p.allFinite()) return std::nullopt;
   return p;
 }
 
-std::optional<ReprojectionResidual> ReprojectionResidualAt(const PointObservation& observation, const Vec3d& p) {
+std::optional<ReprojectionResidual> ReprojectionResidualAt(const PointObservation& observation,
+                                                           const Vec3d& p) {
   const Camera& cam = *observation.camera;
   const Intrinsics& k = cam.intrinsics();
   const Mat4d cw = cam.cam_from_world();

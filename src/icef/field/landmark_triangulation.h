@@ -16,9 +16,9 @@
 namespace icef {
 
 struct TriangulationOptions {
-  bool refine = true;          // Gauss-Newton refinement of the reprojection error after the DLT
-  int max_iterations = 10;     // Gauss-Newton iterations (each stops early once the step is tiny)
-  int min_views = 2;           // landmarks seen in fewer views are an error
+  bool refine = true;       // Gauss-Newton refinement of the reprojection error after the DLT
+  int max_iterations = 10;  // Gauss-Newton iterations (each stops early once the step is tiny)
+  int min_views = 2;        // landmarks seen in fewer views are an error
 
   Status Validate() const;
   std::string ToString() const;
@@ -45,12 +45,13 @@ struct ReprojectionResidual {
   Vec2d residual;
   Eigen::Matrix<double, 2, 3> jacobian;
 };
-std::optional<ReprojectionResidual> ReprojectionResidualAt(const PointObservation& observation, const Vec3d& p);
+std::optional<ReprojectionResidual> ReprojectionResidualAt(const PointObservation& observation,
+                                                           const Vec3d& p);
 
 struct TriangulatedLandmarks {
-  std::vector<Vec3f> points;              // [68] world frame
-  std::vector<int> num_views;             // [68] views the landmark was visible in
-  std::vector<double> rms_reprojection;   // [68] pixels
+  std::vector<Vec3f> points;             // [68] world frame
+  std::vector<int> num_views;            // [68] views the landmark was visible in
+  std::vector<double> rms_reprojection;  // [68] pixels
   double MeanRms() const;
   std::string ToString() const;
 };

@@ -111,7 +111,8 @@ TEST(LandmarkTriangulationTest, ReprojectionJacobianMatchesCentralDifferences) {
       Vec3d pp = p, pm = p;
       pp[a] += h;
       pm[a] -= h;
-      const Vec2d fd = (ReprojectionResidualAt(obs, pp)->residual - ReprojectionResidualAt(obs, pm)->residual) / (2 * h);
+      const Vec2d fd =
+          (ReprojectionResidualAt(obs, pp)->residual - ReprojectionResidualAt(obs, pm)->residual) / (2 * h);
       EXPECT_NEAR(r->jacobian(0, a), fd.x(), 1e-6 * (1 + std::abs(fd.x())));
       EXPECT_NEAR(r->jacobian(1, a), fd.y(), 1e-6 * (1 + std::abs(fd.y())));
     }

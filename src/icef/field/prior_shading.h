@@ -37,7 +37,7 @@ T PriorShadeRatio(const T* n_obs, const T* n_can, const Vec3f& v) {
 
 // rgb [n, 3] *= s per sample; shade [n] receives s (the backward pass multiplies the gradient of the
 // shaded colour by it).
-void ApplyPriorShading(const Executor& executor, int64_t n, const float* n_obs, const float* n_can, const Vec3f& light,
-                       float* rgb, float* shade);
+void ApplyPriorShading(const Executor& executor, int64_t n, const float* n_obs, const float* n_can,
+                       const Vec3f& light, float* rgb, float* shade);
 
 }  // namespace icef

@@ -9,16 +9,20 @@ namespace icef {
 
 const char* FaceRegionName(FaceRegion region) {
   switch (region) {
-    case FaceRegion::kBrows: return "brows";
-    case FaceRegion::kEyes: return "eyes";
-    case FaceRegion::kMouth: return "mouth";
+    case FaceRegion::kBrows:
+      return "brows";
+    case FaceRegion::kEyes:
+      return "eyes";
+    case FaceRegion::kMouth:
+      return "mouth";
   }
   return "?";
 }
 
 Status RegionMaskOptions::Validate() const {
   auto positive = [](float v) { return std::isfinite(v) && v > 0.f; };
-  if (!brows && !eyes && !mouth) return Status::Error("mask: at least one of brows, eyes, mouth must be enabled");
+  if (!brows && !eyes && !mouth)
+    return Status::Error("mask: at least one of brows, eyes, mouth must be enabled");
   if (!positive(brow_margin)) return Status::Error("mask.brow_margin must be > 0");
   if (!positive(eye_margin)) return Status::Error("mask.eye_margin must be > 0");
   if (!positive(mouth_margin)) return Status::Error("mask.mouth_margin must be > 0");
@@ -35,8 +39,8 @@ std::string RegionMaskOptions::ToString() const {
   std::ostringstream os;
   os << "RegionMaskOptions(brows=" << brows << ", eyes=" << eyes << ", mouth=" << mouth
      << ", brow_margin=" << brow_margin << ", eye_margin=" << eye_margin << ", mouth_margin=" << mouth_margin
-     << ", softness=" << softness << ", grid_cell=" << grid_cell << ", max_grid_resolution=" << max_grid_resolution
-     << ")";
+     << ", softness=" << softness << ", grid_cell=" << grid_cell
+     << ", max_grid_resolution=" << max_grid_resolution << ")";
   return os.str();
 }
 
@@ -63,20 +67,22 @@ float SoftInside(float sd, float w) {
 
 }  // namespace
 
-Result<RegionMask> RegionMask::FromLandmarks(const std::vector<Vec3f>& landmarks, const RegionMaskOptions& options,
-                                             const Executor& executor) {
+Result<RegionMask> RegionMask::FromLandmarks(const std::vector<Vec3f>& landmarks,
+                                             const RegionMaskOptions& options, const Executor& executor) {
   ICEF_RETURN_IF_ERROR(options.Validate());
   if (int(landmarks.size()) != kNumLandmarks)
     return Status::Error("mask: expected " + std::to_string(kNumLandmarks) + " landmarks, got " +
                          std::to_string(landmarks.size()));
   for (int i = 0; i < kNumLandmarks; ++i)
-    if (!landmarks[i].allFinite()) return Status::Error("mask: landmark " + std::to_string(i) + " is not finite");
+    if (!landmarks[i].allFinite())
+      return Status::Error("mask: landmark " + std::to_string(i) + " is not finite");
   RegionMask mask;
   mask.landmarks_ = landmarks;
   mask.options_ = options;
   mask.source_ = "landmarks";
   mask.iod_ = (Mean(landmarks, 36, 42) - Mean(landmarks, 42, 48)).norm();
-  if (!(mask.iod_ > 1e-6f)) return Status::Error("mask: inter-ocular distance is zero (eye landmarks coincide)");
+  if (!(mask.iod_ > 1e-6f))
+    return Status::Error("mask: inter-ocular distance is zero (eye landmarks coincide)");
   mask.BuildGeometry();
   mask.BuildGrid(executor);
   return mask;
@@ -102,7 +108,8 @@ Result<RegionMask> RegionMask::FromDataset(const Dataset& dataset, const RegionM
   } else if (with_2d > 0) {
     Result<TriangulatedLandmarks> tri = TriangulateLandmarks(dataset.train);
     if (!tri.ok())
-      return tri.status().WithContext(dataset.root.string() + ": triangulating landmarks_2d of the training frames");
+      return tri.status().WithContext(dataset.root.string() +
+                                      ": triangulating landmarks_2d of the training frames");
     mean = tri->points;
     std::ostringstream os;
     os << "triangulated from landmarks_2d of " << with_2d << " training views (mean reprojection rms "
@@ -180,7 +187,8 @@ float RegionMask::EvaluateExact(const Vec3f& x) const {
   float outside = 1.f;
   for (int r = 0; r < kNumFaceRegions; ++r) {
     // Outside the region's support box the region contributes exactly 0.
-    if (!enabled_[r] || (x.array() < support_min_[r].array()).any() || (x.array() > support_max_[r].array()).any())
+    if (!enabled_[r] || (x.array() < support_min_[r].array()).any() ||
+        (x.array() > support_max_[r].array()).any())
       continue;
     float d2 = std::numeric_limits<float>::infinity();
     for (const Segment& s : segments_)
@@ -272,8 +280,8 @@ Vec3f RegionMask::LandmarkCentroid() const { return Mean(landmarks_, 0, kNumLand
 
 std::string RegionMask::ToString() const {
   std::ostringstream os;
-  os << "RegionMask(source=" << source_ << ", iod=" << iod_ << ", grid=" << grid_res_.x() << "x" << grid_res_.y()
-     << "x" << grid_res_.z() << ", " << options_.ToString() << ")";
+  os << "RegionMask(source=" << source_ << ", iod=" << iod_ << ", grid=" << grid_res_.x() << "x"
+     << grid_res_.y() << "x" << grid_res_.z() << ", " << options_.ToString() << ")";
   return os.str();
 }
 

@@ -33,14 +33,14 @@ constexpr int kNumFaceRegions = 3;
 const char* FaceRegionName(FaceRegion region);
 
 struct RegionMaskOptions {
-  bool brows = true;          // include the brow region (landmarks 17-26)
-  bool eyes = true;           // include the eye region (landmarks 36-47)
-  bool mouth = true;          // include the mouth region (landmarks 48-67)
-  float brow_margin = 0.15f;  // capsule radius around the brow polylines, fraction of iod
-  float eye_margin = 0.15f;   // capsule radius around the eye contours, fraction of iod
-  float mouth_margin = 0.25f; // capsule radius around the lip contours, fraction of iod
-  float softness = 0.08f;     // half-width of the 1 -> 0 transition, fraction of iod (<= every margin)
-  float grid_cell = 0.03f;    // cell size of the lookup grid, fraction of iod
+  bool brows = true;              // include the brow region (landmarks 17-26)
+  bool eyes = true;               // include the eye region (landmarks 36-47)
+  bool mouth = true;              // include the mouth region (landmarks 48-67)
+  float brow_margin = 0.15f;      // capsule radius around the brow polylines, fraction of iod
+  float eye_margin = 0.15f;       // capsule radius around the eye contours, fraction of iod
+  float mouth_margin = 0.25f;     // capsule radius around the lip contours, fraction of iod
+  float softness = 0.08f;         // half-width of the 1 -> 0 transition, fraction of iod (<= every margin)
+  float grid_cell = 0.03f;        // cell size of the lookup grid, fraction of iod
   int max_grid_resolution = 256;  // cap on lookup-grid cells per axis
 
   bool operator==(const RegionMaskOptions&) const = default;
@@ -52,7 +52,8 @@ class RegionMask {
  public:
   // From 68 world-frame landmarks. Errors: wrong count, non-finite values, zero inter-ocular
   // distance, invalid options.
-  static Result<RegionMask> FromLandmarks(const std::vector<Vec3f>& landmarks, const RegionMaskOptions& options,
+  static Result<RegionMask> FromLandmarks(const std::vector<Vec3f>& landmarks,
+                                          const RegionMaskOptions& options,
                                           const Executor& executor = Executor(1));
 
   // From a dataset's training frames: the mean of their landmarks_3d when every training frame
@@ -101,14 +102,14 @@ class RegionMask {
   float iod_ = 0;
   float margin_[kNumFaceRegions] = {0, 0, 0};  // world units
   bool enabled_[kNumFaceRegions] = {false, false, false};
-  float softness_ = 0;                         // world units
+  float softness_ = 0;  // world units
   std::vector<Segment> segments_;
-  Vec3f support_min_[kNumFaceRegions];         // per region: box outside which m_r = 0
+  Vec3f support_min_[kNumFaceRegions];  // per region: box outside which m_r = 0
   Vec3f support_max_[kNumFaceRegions];
   Vec3f grid_min_ = Vec3f::Zero();
-  Vec3f cell_ = Vec3f::Ones();                 // world units per cell
-  Vec3i grid_res_ = Vec3i::Zero();             // cells per axis; nodes = cells + 1
-  std::vector<float> grid_;                    // [(res.z+1), (res.y+1), (res.x+1)] node values
+  Vec3f cell_ = Vec3f::Ones();      // world units per cell
+  Vec3i grid_res_ = Vec3i::Zero();  // cells per axis; nodes = cells + 1
+  std::vector<float> grid_;         // [(res.z+1), (res.y+1), (res.x+1)] node values
 };
 
 }  // namespace icef

@@ -25,8 +25,9 @@ std::vector<Vec3f> FaceLandmarks(const Vec3f& centre = Vec3f::Zero(), float scal
     p[17 + i] = Vec3f(-x, y, 0.2f);
     p[26 - i] = Vec3f(x, y, 0.2f);
   }
-  for (int i = 0; i < 4; ++i) p[27 + i] = Vec3f(0, 0.3f - 0.1f * i, 0.25f + 0.07f * i);  // nose bridge, tip = 30
-  for (int i = 0; i < 5; ++i) p[31 + i] = Vec3f(-0.12f + 0.06f * i, -0.08f, 0.3f);   // nostrils
+  for (int i = 0; i < 4; ++i)
+    p[27 + i] = Vec3f(0, 0.3f - 0.1f * i, 0.25f + 0.07f * i);                       // nose bridge, tip = 30
+  for (int i = 0; i < 5; ++i) p[31 + i] = Vec3f(-0.12f + 0.06f * i, -0.08f, 0.3f);  // nostrils
   for (int e = 0; e < 2; ++e)
     for (int i = 0; i < 6; ++i) {  // eyes: 36-41 right eye (image left), 42-47 left eye
       const double a = kPi - 2 * kPi * i / 6;
@@ -66,13 +67,13 @@ TEST(RegionMaskTest, OneOnTheExpressionLandmarks) {
 TEST(RegionMaskTest, ZeroAwayFromTheExpressionRegions) {
   const RegionMask mask = MakeMask();
   const std::vector<Vec3f> away = {
-      mask.landmarks()[30],        // nose tip
-      Vec3f(0, 0.95f, 0.1f),       // forehead top
-      mask.landmarks()[2],         // cheek / jaw far points
+      mask.landmarks()[30],   // nose tip
+      Vec3f(0, 0.95f, 0.1f),  // forehead top
+      mask.landmarks()[2],    // cheek / jaw far points
       mask.landmarks()[14],
-      mask.landmarks()[8],         // chin
-      Vec3f(0.6f, -0.05f, 0.1f),   // cheek
-      Vec3f(3, 3, 3),              // far away
+      mask.landmarks()[8],        // chin
+      Vec3f(0.6f, -0.05f, 0.1f),  // cheek
+      Vec3f(3, 3, 3),             // far away
       Vec3f(0, 0, -2),
   };
   for (const Vec3f& x : away) {
@@ -132,7 +133,8 @@ TEST(RegionMaskTest, GradientMatchesCentralDifferencesOfTheInterpolant) {
   mask.EvaluateBatch(positions.data(), 3, m.data(), grads.data());
   for (int i = 0; i < 3; ++i) {
     Vec3f g;
-    EXPECT_EQ(m[i], mask.EvaluateWithGradient(Vec3f(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]), &g));
+    EXPECT_EQ(m[i], mask.EvaluateWithGradient(
+                        Vec3f(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]), &g));
     EXPECT_EQ(grads[3 * i + 1], g[1]);
   }
 }
@@ -196,7 +198,8 @@ TEST(RegionMaskTest, FromDatasetUsesMean3dLandmarksElseTriangulates) {
   with_3d.root = "/tmp/face";
   std::vector<Vec3f> shifted = face;
   for (Vec3f& p : shifted) p += Vec3f(0, 0.1f, 0);
-  with_3d.train = {FrameLookingAtFace(-0.4, face, false, true), FrameLookingAtFace(0.4, shifted, false, true)};
+  with_3d.train = {FrameLookingAtFace(-0.4, face, false, true),
+                   FrameLookingAtFace(0.4, shifted, false, true)};
   Result<RegionMask> a = RegionMask::FromDataset(with_3d, {});
   ASSERT_TRUE(a.ok()) << a.status().ToString();
   EXPECT_NEAR(a->landmarks()[48].y(), face[48].y() + 0.05f, 1e-5);  // the mean

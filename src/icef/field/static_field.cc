@@ -83,8 +83,9 @@ void StaticField::ScaleLevels(int64_t n, float* features) const {
       for (int k = 0; k < f; ++k) features[i * g + l * f + k] *= level_weights_[l];
 }
 
-void StaticField::DensityForward(const Executor& executor, int64_t n, const float* positions, const float* condition,
-                                 StaticFieldContext* ctx, bool keep_for_backward, bool need_position_grad) const {
+void StaticField::DensityForward(const Executor& executor, int64_t n, const float* positions,
+                                 const float* condition, StaticFieldContext* ctx, bool keep_for_backward,
+                                 bool need_position_grad) const {
   const int g = grid_.output_dims(), c = options_.condition_dims, di = g + c;
   ctx->n = n;
   ctx->has_position_jacobian = need_position_grad;
@@ -172,10 +173,11 @@ void StaticField::Forward(const Executor& executor, int64_t n, const float* posi
 }
 
 void StaticField::Backward(const Executor& executor, int64_t n, const float* sigma, const float* rgb,
-                           const float* d_sigma,
-                           const float* d_rgb, StaticFieldContext* ctx, float* d_positions) {
+                           const float* d_sigma, const float* d_rgb, StaticFieldContext* ctx,
+                           float* d_positions) {
   ICEF_CHECK(ctx->n == n, "Backward batch size differs from Forward");
-  ICEF_CHECK(d_positions == nullptr || ctx->has_position_jacobian, "Forward was run without need_position_grad");
+  ICEF_CHECK(d_positions == nullptr || ctx->has_position_jacobian,
+             "Forward was run without need_position_grad");
   const int g = grid_.output_dims(), c = options_.condition_dims, di = g + c;
   const int geo = options_.geo_features, sh = options_.sh_degree * options_.sh_degree, ci = geo + sh;
   const bool all = ctx->color_all;
@@ -208,12 +210,13 @@ void StaticField::Backward(const Executor& executor, int64_t n, const float* sig
       if (h[i * geo] + options_.density_bias < kMaxLogDensity) dh[i * geo] += d_sigma[i] * sigma[i];
     }
   });
-  density_mlp_.Backward(executor, n, ctx->density_input.data(), ctx->density_output.data(), dh, &ctx->density_mlp,
-                        ctx->d_density_input.data());
+  density_mlp_.Backward(executor, n, ctx->density_input.data(), ctx->density_output.data(), dh,
+                        &ctx->density_mlp, ctx->d_density_input.data());
   // Grid gradients want [n, g]: compact the rows in place when a condition widened them.
   float* d_features = ctx->d_density_input.data();
   if (c != 0) {
-    for (int64_t i = 0; i < n; ++i) std::copy(d_features + i * di, d_features + i * di + g, d_features + i * g);
+    for (int64_t i = 0; i < n; ++i)
+      std::copy(d_features + i * di, d_features + i * di + g, d_features + i * g);
   }
   ScaleLevels(n, d_features);  // d(w f)/d(theta, x) = w df/d(theta, x)
   grid_.BackwardParams(executor, n, ctx->unit_positions.data(), d_features);
@@ -232,7 +235,8 @@ void StaticField::Density(const Executor& executor, int64_t n, const float* posi
   DensityForward(executor, n, positions, condition, ctx, false, false);
   const int geo = options_.geo_features;
   const float* h = ctx->density_output.data();
-  for (int64_t i = 0; i < n; ++i) sigma[i] = std::exp(std::min(h[i * geo] + options_.density_bias, kMaxLogDensity));
+  for (int64_t i = 0; i < n; ++i)
+    sigma[i] = std::exp(std::min(h[i * geo] + options_.density_bias, kMaxLogDensity));
 }
 
 std::string StaticField::ToString() const {

@@ -58,20 +58,20 @@ inline constexpr float kMaxLogDensity = 15.f;
 struct StaticFieldContext {
   int64_t n = 0;
   bool has_position_jacobian = false;
-  bool color_all = true;                    // the last ForwardColor coloured every sample
-  std::vector<int32_t> color_rows;          // else the samples it coloured, ascending
-  nn::AlignedVector<float> unit_positions;  // [n, 3] in [0,1]^3
-  nn::AlignedVector<float> density_input;   // [n, L*F + condition_dims]
-  nn::AlignedVector<float> grid_jacobian;   // [n, L*F, 3] when positions need gradients
-  nn::AlignedVector<float> density_output;  // [n, geo]
-  nn::AlignedVector<float> color_input;     // [m, geo + sh] for the m coloured samples
-  nn::AlignedVector<float> color_output;    // [m, 3] when not every sample is coloured
-  nn::AlignedVector<float> grid_features;   // [n, L*F] (only when condition_dims > 0)
-  nn::AlignedVector<float> d_color_input;   // [m, geo + sh]
-  nn::AlignedVector<float> d_color_output;  // [m, 3] when not every sample is coloured
-  nn::AlignedVector<float> d_density_output;// [n, geo]
-  nn::AlignedVector<float> d_density_input; // [n, L*F + condition_dims]
-  nn::AlignedVector<float> d_unit_positions;// [n, 3]
+  bool color_all = true;                      // the last ForwardColor coloured every sample
+  std::vector<int32_t> color_rows;            // else the samples it coloured, ascending
+  nn::AlignedVector<float> unit_positions;    // [n, 3] in [0,1]^3
+  nn::AlignedVector<float> density_input;     // [n, L*F + condition_dims]
+  nn::AlignedVector<float> grid_jacobian;     // [n, L*F, 3] when positions need gradients
+  nn::AlignedVector<float> density_output;    // [n, geo]
+  nn::AlignedVector<float> color_input;       // [m, geo + sh] for the m coloured samples
+  nn::AlignedVector<float> color_output;      // [m, 3] when not every sample is coloured
+  nn::AlignedVector<float> grid_features;     // [n, L*F] (only when condition_dims > 0)
+  nn::AlignedVector<float> d_color_input;     // [m, geo + sh]
+  nn::AlignedVector<float> d_color_output;    // [m, 3] when not every sample is coloured
+  nn::AlignedVector<float> d_density_output;  // [n, geo]
+  nn::AlignedVector<float> d_density_input;   // [n, L*F + condition_dims]
+  nn::AlignedVector<float> d_unit_positions;  // [n, 3]
   nn::MlpContext density_mlp;
   nn::MlpContext color_mlp;
 };
@@ -104,11 +104,11 @@ class StaticField {
   // After Forward(keep_for_backward), with its outputs sigma [n] and rgb [n, 3]: accumulates
   // parameter gradients into the store from d_sigma [n] and d_rgb [n, 3] (the rows ForwardColor
   // coloured); writes d_positions [n, 3] (world frame) unless null.
-  void Backward(const Executor& executor, int64_t n, const float* sigma, const float* rgb, const float* d_sigma,
-                const float* d_rgb, StaticFieldContext* ctx, float* d_positions);
+  void Backward(const Executor& executor, int64_t n, const float* sigma, const float* rgb,
+                const float* d_sigma, const float* d_rgb, StaticFieldContext* ctx, float* d_positions);
   // Density only (occupancy-grid updates): positions [n, 3] -> sigma [n].
-  void Density(const Executor& executor, int64_t n, const float* positions, const float* condition, float* sigma,
-               StaticFieldContext* ctx) const;
+  void Density(const Executor& executor, int64_t n, const float* positions, const float* condition,
+               float* sigma, StaticFieldContext* ctx) const;
 
   // Coarse-to-fine: level l's features are multiplied by weights[l] in [0, 1] (size L; empty =
   // all ones). Gradients are scaled alike, so a level at weight 0 is neither used nor trained.

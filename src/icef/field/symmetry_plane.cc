@@ -10,16 +10,17 @@ namespace {
 
 // iBUG 68 pairs that swap under left-right mirroring (mouth left out, see the header).
 constexpr std::pair<int, int> kMirrorPairs[] = {
-    {0, 16},  {1, 15},  {2, 14},  {3, 13},  {4, 12},  {5, 11},  {6, 10},  {7, 9},    // jaw
-    {17, 26}, {18, 25}, {19, 24}, {20, 23}, {21, 22},                                // brows
-    {31, 35}, {32, 34},                                                              // nostrils
-    {36, 45}, {37, 44}, {38, 43}, {39, 42}, {40, 47}, {41, 46},                      // eyes
+    {0, 16},  {1, 15},  {2, 14},  {3, 13},  {4, 12},  {5, 11},  {6, 10}, {7, 9},  // jaw
+    {17, 26}, {18, 25}, {19, 24}, {20, 23}, {21, 22},                             // brows
+    {31, 35}, {32, 34},                                                           // nostrils
+    {36, 45}, {37, 44}, {38, 43}, {39, 42}, {40, 47}, {41, 46},                   // eyes
 };
 constexpr int kMidline[] = {8, 27, 28, 29, 30, 33};
 
 }  // namespace
 
-SymmetryPlane::SymmetryPlane(const Vec3f& normal, float offset) : normal_(normal.normalized()), offset_(offset) {}
+SymmetryPlane::SymmetryPlane(const Vec3f& normal, float offset)
+    : normal_(normal.normalized()), offset_(offset) {}
 
 Result<SymmetryPlane> SymmetryPlane::FromLandmarks(std::span<const Vec3f> landmarks) {
   if (landmarks.size() != 68)
@@ -56,7 +57,8 @@ Result<SymmetryPlane> SymmetryPlane::FromLandmarks(std::span<const Vec3f> landma
   const float iod = (eye_l - eye_r).norm();
   if (!(iod > 0)) return Status::Error("symmetry plane: the eye centres coincide");
   double sq = 0;
-  for (const auto& [l, r] : kMirrorPairs) sq += (plane.ReflectPoint(landmarks[l]) - landmarks[r]).squaredNorm();
+  for (const auto& [l, r] : kMirrorPairs)
+    sq += (plane.ReflectPoint(landmarks[l]) - landmarks[r]).squaredNorm();
   plane.residual_ = static_cast<float>(std::sqrt(sq / std::size(kMirrorPairs)) / iod);
   return plane;
 }
@@ -64,8 +66,8 @@ Result<SymmetryPlane> SymmetryPlane::FromLandmarks(std::span<const Vec3f> landma
 std::string SymmetryPlane::ToString() const {
   std::ostringstream os;
   os.precision(4);
-  os << "SymmetryPlane(n=[" << normal_.x() << ", " << normal_.y() << ", " << normal_.z() << "], offset=" << offset_
-     << ", residual=" << residual_ << " iod)";
+  os << "SymmetryPlane(n=[" << normal_.x() << ", " << normal_.y() << ", " << normal_.z()
+     << "], offset=" << offset_ << ", residual=" << residual_ << " iod)";
   return os.str();
 }
 

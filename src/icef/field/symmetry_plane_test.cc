@@ -18,9 +18,9 @@ std::vector<Vec3f> SymmetricLandmarks(const SymmetryPlane& plane, uint32_t seed)
   std::uniform_real_distribution<float> u(-1.f, 1.f);
   std::vector<Vec3f> p(68);
   for (Vec3f& x : p) x = Vec3f(u(rng), u(rng), u(rng));
-  const int pairs[][2] = {{0, 16}, {1, 15}, {2, 14}, {3, 13}, {4, 12}, {5, 11}, {6, 10}, {7, 9},
-                          {17, 26}, {18, 25}, {19, 24}, {20, 23}, {21, 22}, {31, 35}, {32, 34},
-                          {36, 45}, {37, 44}, {38, 43}, {39, 42}, {40, 47}, {41, 46}};
+  const int pairs[][2] = {{0, 16},  {1, 15},  {2, 14},  {3, 13},  {4, 12},  {5, 11},  {6, 10},
+                          {7, 9},   {17, 26}, {18, 25}, {19, 24}, {20, 23}, {21, 22}, {31, 35},
+                          {32, 34}, {36, 45}, {37, 44}, {38, 43}, {39, 42}, {40, 47}, {41, 46}};
   // Keep the "right" points on one side so the pairs are well separated.
   for (const auto& pr : pairs) {
     Vec3f& a = p[pr[0]];

@@ -99,7 +99,8 @@ Tensor3 Conv2d(const Tensor3& input, const ConvWeights& weights, int stride, con
 Tensor3 DepthwiseConv2d(const Tensor3& input, const std::vector<float>& filters, int kh, int kw, int stride,
                         const Padding& pad) {
   ICEF_CHECK(stride >= 1 && kh >= 1 && kw >= 1);
-  ICEF_CHECK(filters.size() == size_t(kh) * kw * input.c, "DepthwiseConv2d: filters do not match the input's channels");
+  ICEF_CHECK(filters.size() == size_t(kh) * kw * input.c,
+             "DepthwiseConv2d: filters do not match the input's channels");
   const int out_h = PooledSize(input.h + pad.top + pad.bottom, kh, stride);
   const int out_w = PooledSize(input.w + pad.left + pad.right, kw, stride);
   Tensor3 out(out_h, out_w, input.c);
@@ -124,7 +125,8 @@ Tensor3 DepthwiseConv2d(const Tensor3& input, const std::vector<float>& filters,
 }
 
 void Prelu(Tensor3& x, const std::vector<float>& alpha) {
-  ICEF_CHECK(alpha.size() == size_t(x.c), "Prelu: " + std::to_string(alpha.size()) + " slopes for " + x.ToString());
+  ICEF_CHECK(alpha.size() == size_t(x.c),
+             "Prelu: " + std::to_string(alpha.size()) + " slopes for " + x.ToString());
   const size_t pixels = size_t(x.h) * x.w;
   for (size_t p = 0; p < pixels; ++p) {
     float* v = &x.data[p * x.c];
@@ -196,7 +198,8 @@ Tensor3 AvgPool(const Tensor3& input, int window, int stride) {
   return out;
 }
 
-Tensor3 ResizeBilinear(const Tensor3& input, int out_h, int out_w, bool align_corners, bool half_pixel_centers) {
+Tensor3 ResizeBilinear(const Tensor3& input, int out_h, int out_w, bool align_corners,
+                       bool half_pixel_centers) {
   ICEF_CHECK(out_h > 0 && out_w > 0 && input.h > 0 && input.w > 0, "ResizeBilinear: empty size");
   // Per output row / column: the two source indices and the weight of the second.
   auto axis = [&](int in, int out) {
@@ -220,7 +223,8 @@ Tensor3 ResizeBilinear(const Tensor3& input, int out_h, int out_w, bool align_co
         const auto [y0, y1] = ys[size_t(y)];
         const auto [x0, x1] = xs[size_t(x)];
         const float top = input.At(y0, x0, c) + (input.At(y0, x1, c) - input.At(y0, x0, c)) * fx[size_t(x)];
-        const float bottom = input.At(y1, x0, c) + (input.At(y1, x1, c) - input.At(y1, x0, c)) * fx[size_t(x)];
+        const float bottom =
+            input.At(y1, x0, c) + (input.At(y1, x1, c) - input.At(y1, x0, c)) * fx[size_t(x)];
         out.At(y, x, c) = top + (bottom - top) * fy[size_t(y)];
       }
   return out;
@@ -254,7 +258,8 @@ Tensor3 ZeroPadTo(const Tensor3& input, int h, int w, int c) {
   Tensor3 out(h, w, c);
   for (int y = 0; y < input.h; ++y)
     for (int x = 0; x < input.w; ++x)
-      std::copy_n(&input.data[(size_t(y) * input.w + x) * input.c], input.c, &out.data[(size_t(y) * w + x) * c]);
+      std::copy_n(&input.data[(size_t(y) * input.w + x) * input.c], input.c,
+                  &out.data[(size_t(y) * w + x) * c]);
   return out;
 }
 

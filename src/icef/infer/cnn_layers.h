@@ -78,7 +78,8 @@ Tensor3 AvgPool(const Tensor3& input, int window, int stride);
 // Bilinear resampling to [out_h, out_w] as TF's ResizeBilinear: source coordinate
 // (o + 0.5) * in / out - 0.5 with half_pixel_centers, o * (in - 1) / (out - 1) with align_corners,
 // else o * in / out; the two neighbours clamped to the input, weighted by the fractional part.
-Tensor3 ResizeBilinear(const Tensor3& input, int out_h, int out_w, bool align_corners, bool half_pixel_centers);
+Tensor3 ResizeBilinear(const Tensor3& input, int out_h, int out_w, bool align_corners,
+                       bool half_pixel_centers);
 // Transposed convolution (TF's Conv2DBackpropInput, the gradient of Conv2d with respect to its
 // input): filters [kh, kw, cout, cin] (TF's order for this op), output [out_h, out_w, cout],
 // out[y * stride + i - pad_top, x * stride + j - pad_left, o] += in[y, x, c] * filters[i, j, o, c].

@@ -21,12 +21,12 @@ struct ConvCase {
 
 TEST(CnnLayersTest, Conv2dMatchesNaiveReference) {
   const ConvCase cases[] = {
-      {9, 7, 3, 5, 3, 1, Padding::Uniform(1), true},   // 3x3 'same'
-      {11, 10, 4, 6, 3, 2, Padding::Valid(), true},    // 3x3 stride 2 valid (odd and even sizes)
-      {15, 15, 3, 4, 7, 2, Padding::Valid(), true},    // 7x7 stride 2 valid (face-id stem)
+      {9, 7, 3, 5, 3, 1, Padding::Uniform(1), true},     // 3x3 'same'
+      {11, 10, 4, 6, 3, 2, Padding::Valid(), true},      // 3x3 stride 2 valid (odd and even sizes)
+      {15, 15, 3, 4, 7, 2, Padding::Valid(), true},      // 7x7 stride 2 valid (face-id stem)
       {19, 17, 3, 4, 11, 4, Padding::Uniform(2), true},  // 11x11 stride 4 pad 2 (AlexNet conv1)
-      {6, 8, 5, 3, 5, 1, Padding{2, 1, 0, 2}, false},  // asymmetric padding, no bias
-      {5, 5, 2, 2, 1, 1, Padding::Valid(), false},     // 1x1
+      {6, 8, 5, 3, 5, 1, Padding{2, 1, 0, 2}, false},    // asymmetric padding, no bias
+      {5, 5, 2, 2, 1, 1, Padding::Valid(), false},       // 1x1
   };
   uint64_t item = 0;
   for (const ConvCase& c : cases) {
@@ -109,7 +109,11 @@ TEST(CnnLayersTest, ResizeBilinearFollowsTfCoordinateConventions) {
   // One row 0, 10, 20, 30 doubled to 8 columns.
   Tensor3 row(1, 4, 1);
   for (int x = 0; x < 4; ++x) row.At(0, x, 0) = 10.f * x;
-  auto values = [](const Tensor3& t) { std::vector<float> v; for (int x = 0; x < t.w; ++x) v.push_back(t.At(0, x, 0)); return v; };
+  auto values = [](const Tensor3& t) {
+    std::vector<float> v;
+    for (int x = 0; x < t.w; ++x) v.push_back(t.At(0, x, 0));
+    return v;
+  };
   // half_pixel_centers: source (o + 0.5) / 2 - 0.5 = -0.25, 0.25, 0.75, ... clamped at the edges.
   EXPECT_EQ(values(ResizeBilinear(row, 1, 8, false, true)),
             (std::vector<float>{0.f, 2.5f, 7.5f, 12.5f, 17.5f, 22.5f, 27.5f, 30.f}));
@@ -133,7 +137,9 @@ TEST(CnnLayersTest, ResizeBilinearFollowsTfCoordinateConventions) {
 // The transposed convolution is the adjoint of the convolution: <conv(x), y> = <x, conv^T(y)>
 // for every x and y, strides and paddings included.
 TEST(CnnLayersTest, TransposedConvIsTheAdjointOfConv) {
-  struct Case { int h, w, k, stride, pad, cin, cout; };
+  struct Case {
+    int h, w, k, stride, pad, cin, cout;
+  };
   for (const Case& c : {Case{8, 8, 2, 2, 0, 3, 2}, Case{7, 9, 3, 2, 1, 2, 4}, Case{6, 5, 3, 1, 1, 4, 3}}) {
     const Tensor3 x = RandomTensor(c.h, c.w, c.cin, 50 + c.k);
     const ConvWeights w = RandomConv(c.k, c.k, c.cin, c.cout, false, 60 + c.k);

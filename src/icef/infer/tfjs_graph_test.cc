@@ -41,23 +41,39 @@ fs::path WriteTinyGraph(const fs::path& dir, TinyGraph& g, const std::string& co
   g.depthwise = dw.filters;
   g.slope = {0.125f, 0.75f, -0.25f};
   json nodes = json::array();
-  nodes.push_back({{"name", "x"}, {"op", "Placeholder"},
-                   {"attr", {{"shape", {{"shape", {{"dim", {{{"size", "-1"}}, {{"size", "3"}}, {{"size", "4"}}, {{"size", "2"}}}}}}}}}}});
-  for (const char* c : {"w1", "b1", "a1", "w2", "a2", "pads", "shape"}) nodes.push_back({{"name", c}, {"op", "Const"}});
-  nodes.push_back({{"name", "conv"}, {"op", "_FusedConv2D"}, {"input", {"x", "w1", "b1", "a1"}},
-                   {"attr", {{"strides", Ints({1, 2, 2, 1})}, {"padding", Str("U0FNRQ==")},
-                             {"dilations", Ints({1, 1, 1, 1})},
-                             {"fused_ops", {{"list", {{"s", {"Qmlhc0FkZA==", "UHJlbHU="}}}}}}}}});
-  nodes.push_back({{"name", "dw"}, {"op", "DepthwiseConv2dNative"}, {"input", {"conv:0", "w2"}},
+  nodes.push_back(
+      {{"name", "x"},
+       {"op", "Placeholder"},
+       {"attr",
+        {{"shape",
+          {{"shape", {{"dim", {{{"size", "-1"}}, {{"size", "3"}}, {{"size", "4"}}, {{"size", "2"}}}}}}}}}}});
+  for (const char* c : {"w1", "b1", "a1", "w2", "a2", "pads", "shape"})
+    nodes.push_back({{"name", c}, {"op", "Const"}});
+  nodes.push_back({{"name", "conv"},
+                   {"op", "_FusedConv2D"},
+                   {"input", {"x", "w1", "b1", "a1"}},
+                   {"attr",
+                    {{"strides", Ints({1, 2, 2, 1})},
+                     {"padding", Str("U0FNRQ==")},
+                     {"dilations", Ints({1, 1, 1, 1})},
+                     {"fused_ops", {{"list", {{"s", {"Qmlhc0FkZA==", "UHJlbHU="}}}}}}}}});
+  nodes.push_back({{"name", "dw"},
+                   {"op", "DepthwiseConv2dNative"},
+                   {"input", {"conv:0", "w2"}},
                    {"attr", {{"strides", Ints({1, 1, 1, 1})}, {"padding", Str("U0FNRQ==")}}}});
   nodes.push_back({{"name", "sum"}, {"op", "AddV2"}, {"input", {"conv", "dw", "^x"}}});
   nodes.push_back({{"name", "act"}, {"op", corrupt == "op" ? "Softmax" : "Prelu"}, {"input", {"sum", "a2"}}});
   nodes.push_back({{"name", "pad"}, {"op", "Pad"}, {"input", {"act", "pads"}}});
-  nodes.push_back({{"name", "pool"}, {"op", "MaxPool"}, {"input", {"pad"}},
-                   {"attr", {{"strides", Ints({1, 2, 2, 1})}, {"ksize", Ints({1, 2, 2, 1})}, {"padding", Str("VkFMSUQ=")}}}});
+  nodes.push_back(
+      {{"name", "pool"},
+       {"op", "MaxPool"},
+       {"input", {"pad"}},
+       {"attr",
+        {{"strides", Ints({1, 2, 2, 1})}, {"ksize", Ints({1, 2, 2, 1})}, {"padding", Str("VkFMSUQ=")}}}});
   nodes.push_back({{"name", "flat"}, {"op", "Reshape"}, {"input", {"pool", "shape"}}});
   nodes.push_back({{"name", "prob"}, {"op", "Sigmoid"}, {"input", {"flat"}}});
-  nodes.push_back({{"name", "Identity"}, {"op", "Identity"}, {"input", {corrupt == "input" ? "nowhere" : "prob"}}});
+  nodes.push_back(
+      {{"name", "Identity"}, {"op", "Identity"}, {"input", {corrupt == "input" ? "nowhere" : "prob"}}});
 
   std::string bin;
   json specs = json::array();
@@ -68,7 +84,9 @@ fs::path WriteTinyGraph(const fs::path& dir, TinyGraph& g, const std::string& co
   add_f32("w1", {3, 3, 2, 3}, g.conv.filters);
   add_f32("b1", {3}, g.conv.bias);
   // a1 as float16: 0.25 = 0x3400, -0.5 = 0xb800, 1.5 = 0x3e00.
-  specs.push_back({{"name", "a1"}, {"shape", {1, 1, 3}}, {"dtype", "float32"},
+  specs.push_back({{"name", "a1"},
+                   {"shape", {1, 1, 3}},
+                   {"dtype", "float32"},
                    {"quantization", {{"dtype", "float16"}, {"original_dtype", "float32"}}}});
   for (uint16_t h : {uint16_t(0x3400), uint16_t(0xb800), uint16_t(0x3e00)}) {
     bin.push_back(char(h & 0xff));
@@ -150,7 +168,8 @@ TEST(TfjsGraphTest, RunsEveryOpAsItsDefinitionSays) {
 
 TEST(TfjsGraphTest, AnInputOfAnotherSizeIsRefusedNamingTheFile) {
   TinyGraph g;
-  Result<TfjsGraph> graph = TfjsGraph::Load(WriteTinyGraph(fs::path(::testing::TempDir()) / "icef_tfjs_graph_size", g));
+  Result<TfjsGraph> graph =
+      TfjsGraph::Load(WriteTinyGraph(fs::path(::testing::TempDir()) / "icef_tfjs_graph_size", g));
   ASSERT_TRUE(graph.ok()) << graph.status().message();
   auto refused = graph->Run(testing::RandomTensor(4, 4, 2, 4), {"probability"});
   ASSERT_FALSE(refused.ok());
@@ -166,7 +185,8 @@ TEST(TfjsGraphTest, UnsupportedOpOrDanglingInputFailsAtLoadNamingTheNode) {
   ASSERT_FALSE(op.ok());
   EXPECT_NE(op.status().message().find("'act'"), std::string::npos) << op.status().message();
   EXPECT_NE(op.status().message().find("Softmax"), std::string::npos) << op.status().message();
-  auto in = TfjsGraph::Load(WriteTinyGraph(fs::path(::testing::TempDir()) / "icef_tfjs_graph_in", g, "input"));
+  auto in =
+      TfjsGraph::Load(WriteTinyGraph(fs::path(::testing::TempDir()) / "icef_tfjs_graph_in", g, "input"));
   ASSERT_FALSE(in.ok());
   EXPECT_NE(in.status().message().find("nowhere"), std::string::npos) << in.status().message();
   auto missing = TfjsGraph::Load(fs::path(::testing::TempDir()) / "icef_tfjs_graph_none" / "m.json");
@@ -185,14 +205,16 @@ TEST(TfjsGraphTest, FaceMeshMatchesTfjs) {
   for (int y = 0; y < 192; ++y)
     for (int xx = 0; xx < 192; ++xx)
       for (int c = 0; c < 3; ++c)
-        x.At(y, xx, c) = float(0.5 + 0.4 * std::sin(0.05 * xx * (c + 1) + 0.07 * y) * std::cos(0.03 * (xx + y) + c));
+        x.At(y, xx, c) =
+            float(0.5 + 0.4 * std::sin(0.05 * xx * (c + 1) + 0.07 * y) * std::cos(0.03 * (xx + y) + c));
   auto out = graph->Run(x, {"output_mesh", "output_faceflag", "output_contours"});
   ASSERT_TRUE(out.ok()) << out.status().message();
-  const auto text = ReadFile(fs::path(ICEF_SOURCE_DIR) / "tests" / "fixtures" / "facemesh" / "pattern_reference.json");
+  const auto text =
+      ReadFile(fs::path(ICEF_SOURCE_DIR) / "tests" / "fixtures" / "facemesh" / "pattern_reference.json");
   ASSERT_TRUE(text.ok());
   const json ref = json::parse(*text);
-  for (const auto& [name, key] : {std::pair{"output_mesh", "mesh"}, {"output_faceflag", "faceflag"},
-                                  {"output_contours", "contours"}}) {
+  for (const auto& [name, key] :
+       {std::pair{"output_mesh", "mesh"}, {"output_faceflag", "faceflag"}, {"output_contours", "contours"}}) {
     const Tensor3& got = out->at(name);
     ASSERT_EQ(got.data.size(), ref[key].size()) << name;
     double worst = 0;
@@ -200,7 +222,8 @@ TEST(TfjsGraphTest, FaceMeshMatchesTfjs) {
       worst = std::max(worst, std::abs(double(got.data[i]) - ref[key][i].get<double>()));
     // Mesh and contours are pixel coordinates in the 192 px crop (up to ~160); the face flag is a
     // probability. Summation order differs from TF.js's, so agreement is to float rounding.
-    EXPECT_LT(worst, std::string(key) == "faceflag" ? 1e-6 : 2e-3) << name << ": largest difference " << worst;
+    EXPECT_LT(worst, std::string(key) == "faceflag" ? 1e-6 : 2e-3)
+        << name << ": largest difference " << worst;
     std::printf("%s: largest difference from TF.js %.3g\n", name, worst);
   }
 }
@@ -218,8 +241,10 @@ TEST(TfjsGraphTest, SelfieSegmentationMatchesTfjs) {
   for (int y = 0; y < 256; ++y)
     for (int xx = 0; xx < 256; ++xx)
       for (int c = 0; c < 3; ++c)
-        x.At(y, xx, c) = float(0.5 + 0.4 * std::sin(0.05 * xx * (c + 1) + 0.07 * y) * std::cos(0.03 * (xx + y) + c));
-  const auto text = ReadFile(fs::path(ICEF_SOURCE_DIR) / "tests" / "fixtures" / "selfie" / "pattern_reference.json");
+        x.At(y, xx, c) =
+            float(0.5 + 0.4 * std::sin(0.05 * xx * (c + 1) + 0.07 * y) * std::cos(0.03 * (xx + y) + c));
+  const auto text =
+      ReadFile(fs::path(ICEF_SOURCE_DIR) / "tests" / "fixtures" / "selfie" / "pattern_reference.json");
   ASSERT_TRUE(text.ok());
   const json ref = json::parse(*text);
   std::vector<std::string> names;
@@ -230,7 +255,8 @@ TEST(TfjsGraphTest, SelfieSegmentationMatchesTfjs) {
     const json& r = ref["nodes"][name];
     const Tensor3& got = out->at(name);
     const std::vector<int> shape = r["shape"];
-    ASSERT_EQ(std::vector<int>({got.h, got.w, got.c}), std::vector<int>(shape.begin() + 1, shape.end())) << name;
+    ASSERT_EQ(std::vector<int>({got.h, got.w, got.c}), std::vector<int>(shape.begin() + 1, shape.end()))
+        << name;
     const size_t stride = r["stride"];
     double worst = 0, scale = 0;
     for (size_t k = 0; k * stride < got.data.size() && k < r["values"].size(); ++k) {
@@ -239,7 +265,8 @@ TEST(TfjsGraphTest, SelfieSegmentationMatchesTfjs) {
       scale = std::max(scale, std::abs(want));
     }
     // Float rounding in another summation order, relative to the node's largest value.
-    EXPECT_LT(worst, 2e-5 * std::max(1.0, scale)) << name << ": largest difference " << worst << " (values up to " << scale << ")";
+    EXPECT_LT(worst, 2e-5 * std::max(1.0, scale))
+        << name << ": largest difference " << worst << " (values up to " << scale << ")";
     std::printf("%s: largest difference from TF.js %.3g (values up to %.3g)\n", name.c_str(), worst, scale);
   }
 }

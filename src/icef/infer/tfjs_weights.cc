@@ -25,17 +25,21 @@ float HalfToFloat(uint16_t h) {
   const int exponent = (h >> 10) & 0x1f;
   const int mantissa = h & 0x3ff;
   double v;
-  if (exponent == 0) v = std::ldexp(double(mantissa), -24);  // subnormal (or zero)
-  else if (exponent == 31) v = mantissa ? std::nan("") : HUGE_VAL;
-  else v = std::ldexp(double(mantissa | 0x400), exponent - 25);
+  if (exponent == 0)
+    v = std::ldexp(double(mantissa), -24);  // subnormal (or zero)
+  else if (exponent == 31)
+    v = mantissa ? std::nan("") : HUGE_VAL;
+  else
+    v = std::ldexp(double(mantissa | 0x400), exponent - 25);
   return float(sign ? -v : v);
 }
 
 // Decodes `count` values of `dtype` (optionally quantised) from `bytes` at `offset`.
-Status Decode(const nlohmann::json& entry, const std::string& where, const std::string& bytes,
-              size_t& offset, size_t count, std::vector<float>& out) {
+Status Decode(const nlohmann::json& entry, const std::string& where, const std::string& bytes, size_t& offset,
+              size_t count, std::vector<float>& out) {
   const std::string dtype = entry.value("dtype", "");
-  if (dtype != "float32" && dtype != "int32") return Status::Error(where + ".dtype: unsupported '" + dtype + "'");
+  if (dtype != "float32" && dtype != "int32")
+    return Status::Error(where + ".dtype: unsupported '" + dtype + "'");
   out.resize(count);
   const std::string qtype = entry.contains("quantization") ? entry["quantization"].value("dtype", "") : "";
   if (qtype == "float16") {  // IEEE half precision, no scale / min
@@ -53,12 +57,16 @@ Status Decode(const nlohmann::json& entry, const std::string& where, const std::
     const double scale = q["scale"].get<double>();
     const double min = q["min"].get<double>();
     size_t width = 0;
-    if (qtype == "uint8") width = 1;
-    else if (qtype == "uint16") width = 2;
-    else return Status::Error(where + ".quantization.dtype: unsupported '" + qtype + "'");
+    if (qtype == "uint8")
+      width = 1;
+    else if (qtype == "uint16")
+      width = 2;
+    else
+      return Status::Error(where + ".quantization.dtype: unsupported '" + qtype + "'");
     if (offset + count * width > bytes.size())
-      return Status::Error(where + ": weights file too short (needs " + std::to_string(offset + count * width) +
-                           " bytes, has " + std::to_string(bytes.size()) + ")");
+      return Status::Error(where + ": weights file too short (needs " +
+                           std::to_string(offset + count * width) + " bytes, has " +
+                           std::to_string(bytes.size()) + ")");
     const auto* p = reinterpret_cast<const unsigned char*>(bytes.data() + offset);
     for (size_t i = 0; i < count; ++i) {
       const unsigned v = width == 1 ? p[i] : unsigned(p[2 * i]) | (unsigned(p[2 * i + 1]) << 8);
@@ -107,20 +115,22 @@ Result<TensorMap> ReadTfjsWeights(const std::filesystem::path& manifest_path) {
     std::string bytes;
     for (const auto& p : group["paths"]) {
       if (!p.is_string()) return Status::Error(group_where + ".paths: expected strings");
-      ICEF_ASSIGN_OR_RETURN(const std::string shard, ReadFile(manifest_path.parent_path() / p.get<std::string>()));
+      ICEF_ASSIGN_OR_RETURN(const std::string shard,
+                            ReadFile(manifest_path.parent_path() / p.get<std::string>()));
       bytes += shard;
     }
     size_t offset = 0;
     for (size_t w = 0; w < group["weights"].size(); ++w) {
       const auto& entry = group["weights"][w];
       const std::string where = group_where + ".weights[" + std::to_string(w) + "]";
-      if (!entry.is_object() || !entry.contains("name") || !entry["name"].is_string() || !entry.contains("shape") ||
-          !entry["shape"].is_array())
+      if (!entry.is_object() || !entry.contains("name") || !entry["name"].is_string() ||
+          !entry.contains("shape") || !entry["shape"].is_array())
         return Status::Error(where + ": expected 'name' and 'shape'");
       NamedTensor tensor;
       size_t count = 1;
       for (const auto& d : entry["shape"]) {
-        if (!d.is_number_integer() || d.get<int>() < 0) return Status::Error(where + ".shape: expected non-negative integers");
+        if (!d.is_number_integer() || d.get<int>() < 0)
+          return Status::Error(where + ".shape: expected non-negative integers");
         tensor.shape.push_back(d.get<int>());
         count *= size_t(d.get<int>());
       }
@@ -130,8 +140,8 @@ Result<TensorMap> ReadTfjsWeights(const std::filesystem::path& manifest_path) {
         return Status::Error(where + ".name: duplicate tensor '" + name + "'");
     }
     if (offset != bytes.size())
-      return Status::Error(group_where + ": weights use " + std::to_string(offset) + " bytes but the shards hold " +
-                           std::to_string(bytes.size()));
+      return Status::Error(group_where + ": weights use " + std::to_string(offset) +
+                           " bytes but the shards hold " + std::to_string(bytes.size()));
   }
   return tensors;
 }

@@ -22,8 +22,9 @@ struct NamedTensor {
 
 using TensorMap = std::map<std::string, NamedTensor>;
 
-// Reads the manifest (or a graph model's model.json, whose 'weightsManifest' it is) and its shard files (paths relative to the manifest's directory). Errors
-// name the file and the field, e.g. "m.json: [0].weights[3].quantization.dtype: unsupported 'float16'".
+// Reads the manifest (or a graph model's model.json, whose 'weightsManifest' it is) and its shard files
+// (paths relative to the manifest's directory). Errors name the file and the field, e.g. "m.json:
+// [0].weights[3].quantization.dtype: unsupported 'float16'".
 Result<TensorMap> ReadTfjsWeights(const std::filesystem::path& manifest_path);
 
 }  // namespace icef::infer

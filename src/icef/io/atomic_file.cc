@@ -17,12 +17,14 @@ namespace fs = std::filesystem;
 Status WriteFileAtomic(const fs::path& path, std::string_view bytes) {
   const fs::path dir = path.has_parent_path() ? path.parent_path() : fs::path(".");
   std::error_code ec;
-  if (!fs::is_directory(dir, ec)) return Status::Error(path.string() + ": directory " + dir.string() + " does not exist");
+  if (!fs::is_directory(dir, ec))
+    return Status::Error(path.string() + ": directory " + dir.string() + " does not exist");
   // A unique temporary name beside the destination (same filesystem, so rename is atomic).
   const uint64_t tag = Mix64(static_cast<uint64_t>(getpid()) ^ reinterpret_cast<uintptr_t>(&bytes) ^
                              static_cast<uint64_t>(bytes.size()));
   char suffix[32];
-  std::snprintf(suffix, sizeof suffix, ".tmp.%012llx", static_cast<unsigned long long>(tag & 0xffffffffffffULL));
+  std::snprintf(suffix, sizeof suffix, ".tmp.%012llx",
+                static_cast<unsigned long long>(tag & 0xffffffffffffULL));
   const fs::path tmp = dir / (path.filename().string() + suffix);
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) return Status::Error(path.string() + ": cannot create temporary file: " + std::strerror(errno));
@@ -58,12 +60,14 @@ Status CreateDirectoryAtomic(const fs::path& dir, const std::function<Status(con
   const fs::path parent = dir.has_parent_path() ? dir.parent_path() : fs::path(".");
   const fs::path tmp = parent / (dir.filename().string() + ".tmp-" + std::to_string(getpid()));
   fs::remove_all(tmp, ec);
-  if (!fs::create_directories(tmp, ec)) return Status::Error(tmp.string() + ": cannot create the directory: " + ec.message());
+  if (!fs::create_directories(tmp, ec))
+    return Status::Error(tmp.string() + ": cannot create the directory: " + ec.message());
   Status status = fill(tmp);
   if (status.ok()) {
     if (fs::exists(dir, ec)) fs::remove(dir, ec);  // an empty directory
     fs::rename(tmp, dir, ec);
-    if (ec) status = Status::Error(dir.string() + ": cannot move the new directory into place: " + ec.message());
+    if (ec)
+      status = Status::Error(dir.string() + ": cannot move the new directory into place: " + ec.message());
   }
   if (!status.ok()) fs::remove_all(tmp, ec);
   return status;

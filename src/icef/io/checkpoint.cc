@@ -81,8 +81,11 @@ Status CheckpointWriter::WriteAtomic(const std::filesystem::path& path) const {
 }
 
 Result<Checkpoint> Checkpoint::Parse(std::string bytes, const std::string& origin) {
-  auto fail = [&](const std::string& why) { return Status::Error(origin + ": not a valid ICEF checkpoint: " + why); };
-  if (bytes.size() < sizeof kMagic + 16) return fail("file too short (" + std::to_string(bytes.size()) + " bytes)");
+  auto fail = [&](const std::string& why) {
+    return Status::Error(origin + ": not a valid ICEF checkpoint: " + why);
+  };
+  if (bytes.size() < sizeof kMagic + 16)
+    return fail("file too short (" + std::to_string(bytes.size()) + " bytes)");
   if (std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0) return fail("bad magic");
   uint64_t stored = 0;
   std::memcpy(&stored, bytes.data() + bytes.size() - 8, 8);

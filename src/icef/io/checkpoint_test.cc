@@ -49,7 +49,8 @@ TEST(CheckpointTest, EveryTruncationAndManyBitFlipsAreRefused) {
 }
 
 TEST(CheckpointTest, FileRoundTripAndMissingFile) {
-  const auto path = std::filesystem::temp_directory_path() / ("icef_ckpt_" + std::to_string(::getpid()) + ".bin");
+  const auto path =
+      std::filesystem::temp_directory_path() / ("icef_ckpt_" + std::to_string(::getpid()) + ".bin");
   CheckpointWriter w;
   w.Add("x", "payload");
   ASSERT_TRUE(w.WriteAtomic(path).ok());

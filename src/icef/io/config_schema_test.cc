@@ -51,8 +51,8 @@ TEST(ConfigSchemaTest, UnknownKeyIsAnErrorListingValidKeys) {
 }
 
 TEST(ConfigSchemaTest, WrongTypesAndValuesNameTheKey) {
-  for (const char* bad : {R"({"steps": "x"})", R"({"steps": 1.5})", R"({"widths": [1, 2.5]})", R"({"flag": 1})",
-                          R"({"lr": NaN})", R"({"scale": 1e300})"}) {
+  for (const char* bad : {R"({"steps": "x"})", R"({"steps": 1.5})", R"({"widths": [1, 2.5]})",
+                          R"({"flag": 1})", R"({"lr": NaN})", R"({"scale": 1e300})"}) {
     auto e = Parse(bad);
     ASSERT_FALSE(e.ok()) << bad;
   }

@@ -51,8 +51,8 @@ Result<std::string> EncodeGif(const std::vector<Image>& frames, int delay_centis
       r[p] = ToByte(c.x()), g[p] = ToByte(c.y()), b[p] = ToByte(c.z());
     }
     int palette_size = 256;
-    if (GifQuantizeBuffer(w, h, &palette_size, r.data(), g.data(), b.data(), indices.data(), palette.data()) ==
-        GIF_ERROR)
+    if (GifQuantizeBuffer(w, h, &palette_size, r.data(), g.data(), b.data(), indices.data(),
+                          palette.data()) == GIF_ERROR)
       return fail("quantize");
     ColorMapObject* map = GifMakeMapObject(256, palette.data());
     GraphicsControlBlock gcb{};
@@ -67,7 +67,8 @@ Result<std::string> EncodeGif(const std::vector<Image>& frames, int delay_centis
     GifFreeMapObject(map);
     if (!ok) return fail("frame");
   }
-  if (EGifCloseFile(gif, &error) == GIF_ERROR) return Status::Error(std::string("gif: ") + GifErrorString(error));
+  if (EGifCloseFile(gif, &error) == GIF_ERROR)
+    return Status::Error(std::string("gif: ") + GifErrorString(error));
   return out;
 }
 

@@ -74,11 +74,14 @@ std::string EncodePng(const Image& image) {
   std::vector<unsigned char> bytes(image.pixels.size());
   for (size_t i = 0; i < bytes.size(); ++i) {
     const float v = image.pixels[i];
-    bytes[i] = static_cast<unsigned char>(std::lround(std::clamp(std::isfinite(v) ? v : 0.f, 0.f, 1.f) * 255.f));
+    bytes[i] =
+        static_cast<unsigned char>(std::lround(std::clamp(std::isfinite(v) ? v : 0.f, 0.f, 1.f) * 255.f));
   }
   std::string out;
   stbi_write_png_to_func(
-      [](void* ctx, void* data, int size) { static_cast<std::string*>(ctx)->append(static_cast<char*>(data), size); },
+      [](void* ctx, void* data, int size) {
+        static_cast<std::string*>(ctx)->append(static_cast<char*>(data), size);
+      },
       &out, image.width, image.height, image.channels, bytes.data(), image.width * image.channels);
   return out;
 }

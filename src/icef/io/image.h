@@ -21,7 +21,8 @@ struct Image {
   std::vector<float> pixels;  // [height, width, channels]
 
   Image() = default;
-  Image(int w, int h, int c, float fill = 0.f) : width(w), height(h), channels(c), pixels(size_t(w) * h * c, fill) {}
+  Image(int w, int h, int c, float fill = 0.f)
+      : width(w), height(h), channels(c), pixels(size_t(w) * h * c, fill) {}
 
   float& At(int x, int y, int c) { return pixels[(size_t(y) * width + x) * channels + c]; }
   float At(int x, int y, int c) const { return pixels[(size_t(y) * width + x) * channels + c]; }

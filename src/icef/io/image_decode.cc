@@ -1,16 +1,16 @@
 #include "icef/io/image_decode.h"
 
+#include <jerror.h>
+#include <jpeglib.h>  // after <cstdio>: jpeglib.h needs FILE and size_t
+#include <png.h>
+#include <zlib.h>
+
 #include <algorithm>
 #include <bit>
 #include <csetjmp>
 #include <cstdio>
 #include <cstring>
 #include <string>
-
-#include <jpeglib.h>  // after <cstdio>: jpeglib.h needs FILE and size_t
-#include <jerror.h>
-#include <png.h>
-#include <zlib.h>
 
 namespace icef {
 
@@ -20,7 +20,9 @@ namespace {
 // bytes than this many times its IDAT bytes.
 constexpr uint64_t kMaxDeflateRatio = 1032;
 
-uint32_t Be32(const unsigned char* p) { return uint32_t(p[0]) << 24 | uint32_t(p[1]) << 16 | uint32_t(p[2]) << 8 | p[3]; }
+uint32_t Be32(const unsigned char* p) {
+  return uint32_t(p[0]) << 24 | uint32_t(p[1]) << 16 | uint32_t(p[2]) << 8 | p[3];
+}
 
 // Writes "unsupported image size" into `error` when w x h is beyond the bounds; true when it is not.
 bool SizeWithinBounds(uint64_t w, uint64_t h, char* error, size_t n) {
@@ -35,7 +37,9 @@ bool SizeWithinBounds(uint64_t w, uint64_t h, char* error, size_t n) {
 
 // ---- PNG --------------------------------------------------------------------------------------
 
-bool IsPng(std::string_view b) { return b.size() >= 8 && png_sig_cmp(reinterpret_cast<png_const_bytep>(b.data()), 0, 8) == 0; }
+bool IsPng(std::string_view b) {
+  return b.size() >= 8 && png_sig_cmp(reinterpret_cast<png_const_bytep>(b.data()), 0, 8) == 0;
+}
 
 // Walks the chunks without inflating anything; returns what is wrong ("" when nothing) and adds up
 // the IDAT bytes. Ancillary chunks' CRCs are not checked: libpng only warns about them too.
@@ -46,7 +50,8 @@ std::string CheckPngChunks(std::string_view bytes, uint64_t* idat_bytes) {
   bool seen_idat = false;
   for (int index = 0;; ++index) {
     if (n - pos < 12)
-      return "truncated file: it ends " + std::string(index ? "after chunk " + std::to_string(index) : "after the signature") +
+      return "truncated file: it ends " +
+             std::string(index ? "after chunk " + std::to_string(index) : "after the signature") +
              ", before IEND";
     const uint32_t length = Be32(b + pos);
     const unsigned char* type = b + pos + 4;
@@ -130,7 +135,8 @@ bool RunPng(PngReader* r, uint64_t idat_bytes, bool decode, DecodedImage* out) {
     return false;
   }
   png_set_expand(r->png);  // palette -> RGB(A), grey below 8 bits -> 8 bits, tRNS -> alpha
-  if (png_get_bit_depth(r->png, r->info) == 16 && std::endian::native == std::endian::little) png_set_swap(r->png);
+  if (png_get_bit_depth(r->png, r->info) == 16 && std::endian::native == std::endian::little)
+    png_set_swap(r->png);
   png_set_interlace_handling(r->png);
   png_read_update_info(r->png, r->info);
   out->width = static_cast<int>(w);
@@ -173,10 +179,12 @@ std::string CheckJpegMarkers(std::string_view bytes) {
     const unsigned char marker = b[pos++];
     if (marker == 0xD9) return seen_scan ? "" : "no image data (end-of-image before any scan)";
     if (marker == 0x01 || (marker >= 0xD0 && marker <= 0xD7)) continue;  // TEM, RSTn: no length
-    if (marker == 0x00 || marker == 0xD8) return "corrupt file: unexpected marker at byte " + std::to_string(pos - 2);
+    if (marker == 0x00 || marker == 0xD8)
+      return "corrupt file: unexpected marker at byte " + std::to_string(pos - 2);
     if (n - pos < 2) return truncated;
     const size_t length = size_t(b[pos]) << 8 | b[pos + 1];
-    if (length < 2) return "corrupt file: segment length " + std::to_string(length) + " at byte " + std::to_string(pos);
+    if (length < 2)
+      return "corrupt file: segment length " + std::to_string(length) + " at byte " + std::to_string(pos);
     if (n - pos < length) return truncated;
     pos += length;
     if (marker != 0xDA) continue;
@@ -246,7 +254,8 @@ bool RunJpeg(JpegReader* r, std::string_view bytes, bool decode, DecodedImage* o
   r->error.pub.output_message = JpegOutputMessage;
   if (setjmp(r->error.jump)) return false;
   jpeg_create_decompress(&r->cinfo);
-  jpeg_mem_src(&r->cinfo, reinterpret_cast<const unsigned char*>(bytes.data()), static_cast<unsigned long>(bytes.size()));
+  jpeg_mem_src(&r->cinfo, reinterpret_cast<const unsigned char*>(bytes.data()),
+               static_cast<unsigned long>(bytes.size()));
   jpeg_read_header(&r->cinfo, TRUE);
   jpeg_decompress_struct& c = r->cinfo;
   int channels = 3;
@@ -264,8 +273,8 @@ bool RunJpeg(JpegReader* r, std::string_view bytes, bool decode, DecodedImage* o
       c.out_color_space = JCS_RGB;
       break;
     default:
-      std::snprintf(r->error.message, sizeof r->error.message, "unsupported JPEG colour space (%d components)",
-                    c.num_components);
+      std::snprintf(r->error.message, sizeof r->error.message,
+                    "unsupported JPEG colour space (%d components)", c.num_components);
       return false;
   }
   const uint64_t w = c.image_width, h = c.image_height;
@@ -291,7 +300,8 @@ bool RunJpeg(JpegReader* r, std::string_view bytes, bool decode, DecodedImage* o
   if (!decode) return true;
   jpeg_start_decompress(&c);
   const size_t stride = size_t(w) * c.output_components;
-  if (c.output_width != w || c.output_height != h || (c.output_components != channels && c.output_components != 4)) {
+  if (c.output_width != w || c.output_height != h ||
+      (c.output_components != channels && c.output_components != 4)) {
     std::snprintf(r->error.message, sizeof r->error.message, "corrupt JPEG: unexpected output layout");
     return false;
   }
@@ -299,7 +309,8 @@ bool RunJpeg(JpegReader* r, std::string_view bytes, bool decode, DecodedImage* o
   while (c.output_scanline < c.output_height) {
     JSAMPROW row = out->samples.data() + size_t(c.output_scanline) * stride;
     if (jpeg_read_scanlines(&c, &row, 1) != 1) {
-      std::snprintf(r->error.message, sizeof r->error.message, "corrupt JPEG: decoding stalled at row %u", c.output_scanline);
+      std::snprintf(r->error.message, sizeof r->error.message, "corrupt JPEG: decoding stalled at row %u",
+                    c.output_scanline);
       return false;
     }
   }
@@ -344,7 +355,8 @@ Result<DecodedImage> DecodeImage(std::string_view bytes, bool decode) {
     return out;
   }
   if (IsJpeg(bytes)) {
-    if (const std::string why = CheckJpegMarkers(bytes); !why.empty()) return Status::Error("corrupt JPEG: " + why);
+    if (const std::string why = CheckJpegMarkers(bytes); !why.empty())
+      return Status::Error("corrupt JPEG: " + why);
     JpegReader reader;
     if (!RunJpeg(&reader, bytes, decode, &out)) return Status::Error(reader.error.message);
     return out;

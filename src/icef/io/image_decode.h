@@ -27,9 +27,9 @@ inline constexpr int64_t kMaxImagePixels = int64_t(1) << 26;
 struct DecodedImage {
   int width = 0;
   int height = 0;
-  int channels = 0;               // samples per pixel: 1 grey, 2 grey+alpha, 3 RGB, 4 RGBA
-  int bit_depth = 0;              // 8 or 16 bits per sample
-  std::vector<uint8_t> samples;   // [height, width, channels]; 16-bit samples in native byte order
+  int channels = 0;              // samples per pixel: 1 grey, 2 grey+alpha, 3 RGB, 4 RGBA
+  int bit_depth = 0;             // 8 or 16 bits per sample
+  std::vector<uint8_t> samples;  // [height, width, channels]; 16-bit samples in native byte order
 };
 
 // Checks and reads a PNG or JPEG held in `bytes`; with `decode` false only the structure and the

@@ -1,6 +1,10 @@
 #include "icef/io/image.h"
 
 #include <gtest/gtest.h>
+#include <jpeglib.h>
+#include <stb_image_write.h>
+#include <unistd.h>
+#include <zlib.h>
 
 #include <cstdio>
 #include <filesystem>
@@ -8,10 +12,6 @@
 
 #include "icef/io/atomic_file.h"
 #include "icef/io/image_decode.h"
-#include <jpeglib.h>
-#include <stb_image_write.h>
-#include <unistd.h>
-#include <zlib.h>
 
 namespace icef {
 namespace {
@@ -80,7 +80,8 @@ Image Gradient(int w, int h, int c) {
   Image img(w, h, c);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x)
-      for (int k = 0; k < c; ++k) img.At(x, y, k) = static_cast<float>((x * 7 + y * 13 + k * 50) % 256) / 255.f;
+      for (int k = 0; k < c; ++k)
+        img.At(x, y, k) = static_cast<float>((x * 7 + y * 13 + k * 50) % 256) / 255.f;
   return img;
 }
 
@@ -117,8 +118,10 @@ TEST(ImageTest, ReadsJpeg) {
 
 TEST(ImageTest, CompositingOverBackground) {
   Image rgba(2, 1, 4);
-  rgba.At(0, 0, 0) = 1; rgba.At(0, 0, 3) = 1;     // opaque red
-  rgba.At(1, 0, 0) = 1; rgba.At(1, 0, 3) = 0.25;  // quarter red over white
+  rgba.At(0, 0, 0) = 1;
+  rgba.At(0, 0, 3) = 1;  // opaque red
+  rgba.At(1, 0, 0) = 1;
+  rgba.At(1, 0, 3) = 0.25;  // quarter red over white
   Image rgb = CompositeOver(rgba, Vec3f(1, 1, 1));
   EXPECT_EQ(rgb.channels, 3);
   EXPECT_FLOAT_EQ(rgb.At(0, 0, 1), 0.f);
@@ -148,19 +151,23 @@ TEST(ImageTest, BadFilesGiveErrorsNamingTheFile) {
 TEST(ImageTest, SixteenBitGreyAlphaPaletteAndLowBitPngs) {
   const fs::path dir = TempDir("formats");
   // 16-bit RGB: big-endian samples in the file, [0, 1] floats exactly v / 65535.
-  auto rgb16 = ReadImage(WriteBytes(dir / "rgb16.png", MakePng(3, 2, 16, 2, RawRows(2, 18, [](int i, int y) {
-    return (i % 2 == 0) ? 0x12 + y : 0x34 + i;  // sample = (0x12+y) << 8 | (0x34+i+1)
-  }))));
+  auto rgb16 = ReadImage(WriteBytes(
+      dir / "rgb16.png", MakePng(3, 2, 16, 2, RawRows(2, 18, [](int i, int y) {
+                                   return (i % 2 == 0) ? 0x12 + y
+                                                       : 0x34 + i;  // sample = (0x12+y) << 8 | (0x34+i+1)
+                                 }))));
   ASSERT_TRUE(rgb16.ok()) << rgb16.status().message();
   EXPECT_EQ(rgb16->channels, 3);
   EXPECT_FLOAT_EQ(rgb16->At(0, 0, 0), float(0x1235) / 65535.f);
   EXPECT_FLOAT_EQ(rgb16->At(2, 1, 2), float(0x1345) / 65535.f);
   // Grey stays one channel; grey + alpha becomes RGBA.
-  auto grey = ReadImage(WriteBytes(dir / "grey.png", MakePng(4, 1, 8, 0, RawRows(1, 4, [](int i, int) { return 60 * i; }))));
+  auto grey = ReadImage(
+      WriteBytes(dir / "grey.png", MakePng(4, 1, 8, 0, RawRows(1, 4, [](int i, int) { return 60 * i; }))));
   ASSERT_TRUE(grey.ok()) << grey.status().message();
   EXPECT_EQ(grey->channels, 1);
   EXPECT_FLOAT_EQ(grey->At(3, 0, 0), 180.f / 255.f);
-  auto ga = ReadImage(WriteBytes(dir / "ga.png", MakePng(2, 1, 8, 4, RawRows(1, 4, [](int i, int) { return 10 + i; }))));
+  auto ga = ReadImage(
+      WriteBytes(dir / "ga.png", MakePng(2, 1, 8, 4, RawRows(1, 4, [](int i, int) { return 10 + i; }))));
   ASSERT_TRUE(ga.ok()) << ga.status().message();
   EXPECT_EQ(ga->channels, 4);
   EXPECT_FLOAT_EQ(ga->At(1, 0, 1), 12.f / 255.f);
@@ -168,23 +175,26 @@ TEST(ImageTest, SixteenBitGreyAlphaPaletteAndLowBitPngs) {
   EXPECT_EQ(ReadImageInfo(dir / "ga.png")->channels, 2);
   // Palette with transparency -> RGBA; 1-bit grey -> 0 or 1.
   const std::string plte = std::string("\xff\x00\x00\x00\x00\xff", 6);
-  auto pal = ReadImage(WriteBytes(dir / "pal.png", MakePng(2, 1, 8, 3, RawRows(1, 2, [](int i, int) { return i; }),
-                                                              {{"PLTE", plte}, {"tRNS", std::string("\x80", 1)}})));
+  auto pal =
+      ReadImage(WriteBytes(dir / "pal.png", MakePng(2, 1, 8, 3, RawRows(1, 2, [](int i, int) { return i; }),
+                                                    {{"PLTE", plte}, {"tRNS", std::string("\x80", 1)}})));
   ASSERT_TRUE(pal.ok()) << pal.status().message();
   EXPECT_EQ(pal->channels, 4);
   EXPECT_FLOAT_EQ(pal->At(0, 0, 0), 1.f);
   EXPECT_FLOAT_EQ(pal->At(0, 0, 3), 128.f / 255.f);
   EXPECT_FLOAT_EQ(pal->At(1, 0, 2), 1.f);
   EXPECT_FLOAT_EQ(pal->At(1, 0, 3), 1.f);
-  auto bits = ReadImage(WriteBytes(dir / "bits.png", MakePng(8, 1, 1, 0, RawRows(1, 1, [](int, int) { return 0xA0; }))));
+  auto bits = ReadImage(
+      WriteBytes(dir / "bits.png", MakePng(8, 1, 1, 0, RawRows(1, 1, [](int, int) { return 0xA0; }))));
   ASSERT_TRUE(bits.ok()) << bits.status().message();
   EXPECT_EQ(bits->channels, 1);
   EXPECT_FLOAT_EQ(bits->At(0, 0, 0), 1.f);
   EXPECT_FLOAT_EQ(bits->At(1, 0, 0), 0.f);
   EXPECT_FLOAT_EQ(bits->At(2, 0, 0), 1.f);
   // An empty first IDAT chunk is legal (stb_image passed memcpy a null pointer for it).
-  auto empty_idat = ReadImage(WriteBytes(dir / "empty_idat.png",
-                                         MakePng(4, 4, 8, 2, RawRows(4, 12, [](int i, int y) { return i * 20 + y; }), {}, true)));
+  auto empty_idat = ReadImage(
+      WriteBytes(dir / "empty_idat.png",
+                 MakePng(4, 4, 8, 2, RawRows(4, 12, [](int i, int y) { return i * 20 + y; }), {}, true)));
   ASSERT_TRUE(empty_idat.ok()) << empty_idat.status().message();
   EXPECT_FLOAT_EQ(empty_idat->At(3, 2, 1), float(10 * 20 + 2) / 255.f);
   fs::remove_all(dir);
@@ -229,7 +239,7 @@ TEST(ImageTest, ReadsCmykJpegAsRgb) {
   auto img = ReadImage(WriteBytes(dir / "cmyk.jpg", CmykJpeg(16, 8, 255, 128, 0, 200)));
   ASSERT_TRUE(img.ok()) << img.status().message();
   EXPECT_EQ(img->channels, 3);
-  EXPECT_NEAR(img->At(5, 5, 0), 200.f / 255.f, 3.f / 255.f);           // c * k / 255
+  EXPECT_NEAR(img->At(5, 5, 0), 200.f / 255.f, 3.f / 255.f);  // c * k / 255
   EXPECT_NEAR(img->At(5, 5, 1), 128.f * 200.f / 255.f / 255.f, 3.f / 255.f);
   EXPECT_NEAR(img->At(5, 5, 2), 0.f, 3.f / 255.f);
   EXPECT_EQ(ReadImageInfo(dir / "cmyk.jpg")->channels, 3);
@@ -262,7 +272,8 @@ TEST(ImageTest, HeaderReadRefusesTruncatedAndCorruptFiles) {
   // A header that claims more pixels than the compressed data can hold is refused before any
   // pixel buffer exists (it would be 768 MiB of floats).
   refused("huge.png", MakePng(16384, 4096, 8, 2, RawRows(1, 3, [](int, int) { return 0; })), "cannot hold");
-  refused("wide.png", MakePng(20000, 1, 8, 0, RawRows(1, 20000, [](int, int) { return 0; })), "unsupported image size");
+  refused("wide.png", MakePng(20000, 1, 8, 0, RawRows(1, 20000, [](int, int) { return 0; })),
+          "unsupported image size");
 
   std::vector<unsigned char> rgb(64 * 64 * 3);
   for (size_t i = 0; i < rgb.size(); ++i) rgb[i] = uint8_t(i * 31 % 251);

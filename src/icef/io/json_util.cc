@@ -138,15 +138,22 @@ std::string FormatJson(const Json& value) {
 std::string JsonTypeDescription(const Json& value) {
   if (IsNonFinite(value)) return "a non-finite number (" + NonFiniteName(value) + ")";
   switch (value.type()) {
-    case Json::value_t::null: return "null";
-    case Json::value_t::boolean: return "a boolean";
-    case Json::value_t::string: return "a string";
-    case Json::value_t::array: return "an array of " + std::to_string(value.size());
-    case Json::value_t::object: return "an object";
+    case Json::value_t::null:
+      return "null";
+    case Json::value_t::boolean:
+      return "a boolean";
+    case Json::value_t::string:
+      return "a string";
+    case Json::value_t::array:
+      return "an array of " + std::to_string(value.size());
+    case Json::value_t::object:
+      return "an object";
     case Json::value_t::number_integer:
     case Json::value_t::number_unsigned:
-    case Json::value_t::number_float: return "a number";
-    default: return value.type_name();
+    case Json::value_t::number_float:
+      return "a number";
+    default:
+      return value.type_name();
   }
 }
 
@@ -230,8 +237,8 @@ Result<uint64_t> JsonObjectView::Uint64(std::string_view key) const {
   ICEF_ASSIGN_OR_RETURN(const Json* v, Get(key));
   if (v->is_number_unsigned()) return v->get<uint64_t>();
   if (v->is_number_integer() && v->get<int64_t>() >= 0) return static_cast<uint64_t>(v->get<int64_t>());
-  return Error(key, "expected a non-negative integer, got " +
-                        (v->is_number() ? v->dump() : JsonTypeDescription(*v)));
+  return Error(
+      key, "expected a non-negative integer, got " + (v->is_number() ? v->dump() : JsonTypeDescription(*v)));
 }
 
 Result<bool> JsonObjectView::Bool(std::string_view key) const {
@@ -242,7 +249,8 @@ Result<bool> JsonObjectView::Bool(std::string_view key) const {
 
 Result<std::string> JsonObjectView::String(std::string_view key) const {
   ICEF_ASSIGN_OR_RETURN(const Json* v, Get(key));
-  if (!v->is_string() || IsNonFinite(*v)) return Error(key, "expected a string, got " + JsonTypeDescription(*v));
+  if (!v->is_string() || IsNonFinite(*v))
+    return Error(key, "expected a string, got " + JsonTypeDescription(*v));
   return v->get<std::string>();
 }
 
@@ -264,7 +272,8 @@ Result<std::vector<double>> JsonObjectView::NumberArray(std::string_view key, in
   out.reserve(v->size());
   for (size_t i = 0; i < v->size(); ++i) {
     const Json& e = (*v)[i];
-    if (IsNonFinite(e)) return Error(key, "non-finite value " + NonFiniteName(e) + " at [" + std::to_string(i) + "]");
+    if (IsNonFinite(e))
+      return Error(key, "non-finite value " + NonFiniteName(e) + " at [" + std::to_string(i) + "]");
     if (!e.is_number())
       return Error(key, expected + ", got " + JsonTypeDescription(e) + " at [" + std::to_string(i) + "]");
     out.push_back(e.get<double>());
@@ -307,8 +316,7 @@ Result<std::vector<bool>> JsonObjectView::BoolArray(std::string_view key, int ex
 Result<std::vector<std::vector<double>>> JsonObjectView::NumberMatrix(std::string_view key, int rows,
                                                                       int cols) const {
   ICEF_ASSIGN_OR_RETURN(const Json* v, Get(key));
-  const std::string expected =
-      "expected " + ArrayOf(rows, "arrays of " + std::to_string(cols) + " numbers");
+  const std::string expected = "expected " + ArrayOf(rows, "arrays of " + std::to_string(cols) + " numbers");
   if (!v->is_array()) return Error(key, expected + ", got " + JsonTypeDescription(*v));
   if (rows >= 0 && v->size() != size_t(rows))
     return Error(key, expected + ", got " + std::to_string(v->size()) + " entries");
@@ -347,14 +355,16 @@ Result<std::vector<JsonObjectView>> JsonObjectView::ObjectArray(std::string_view
   for (size_t i = 0; i < v->size(); ++i) {
     const std::string element = Where(key) + "[" + std::to_string(i) + "]";
     if (!(*v)[i].is_object())
-      return Status::Error(file_ + ": " + element + ": expected an object, got " + JsonTypeDescription((*v)[i]));
+      return Status::Error(file_ + ": " + element + ": expected an object, got " +
+                           JsonTypeDescription((*v)[i]));
     out.push_back(JsonObjectView(&(*v)[i], file_, element));
   }
   return out;
 }
 
 namespace {
-void CollectDifferences(const Json& a, const Json& b, const std::string& prefix, std::vector<std::string>* out) {
+void CollectDifferences(const Json& a, const Json& b, const std::string& prefix,
+                        std::vector<std::string>* out) {
   if (!a.is_object() || !b.is_object()) {
     if (a != b) out->push_back(prefix);
     return;

@@ -33,7 +33,8 @@ TEST(JsonUtil, ErrorsNameFileAndField) {
   const auto frame = JsonObjectView::Make(doc, "f.json", "").value().ObjectArray("frames").value()[0];
   EXPECT_EQ(frame.NumberArray("expression", 12).status().message(),
             "f.json: frames[0].expression: expected an array of 12 numbers, got 2 values");
-  EXPECT_EQ(frame.String("tier").status().message(), "f.json: frames[0].tier: expected a string, got a number");
+  EXPECT_EQ(frame.String("tier").status().message(),
+            "f.json: frames[0].tier: expected a string, got a number");
   EXPECT_EQ(frame.Number("x").status().message(), "f.json: frames[0].x: expected a number, got a string");
   EXPECT_EQ(frame.Number("missing").status().message(), "f.json: frames[0].missing: missing required field");
   EXPECT_FALSE(frame.Int("expression").ok());
@@ -97,8 +98,10 @@ TEST(JsonUtil, Int64AndUint64AreExactAndRangeChecked) {
   const JsonObjectView t = JsonObjectView::Make(doc, "ckpt", "trainer").value();
   EXPECT_EQ(t.Int64("step", 0, 1000).value(), 120);
   EXPECT_EQ(t.Int64("whole", 0, 1000).value(), 3);
-  EXPECT_EQ(t.Int64("neg", 0, 1000).status().message(), "ckpt: trainer.neg: expected an integer in [0, 1000], got -1");
-  EXPECT_EQ(t.Int64("half", 0, 1000).status().message(), "ckpt: trainer.half: expected an integer in [0, 1000], got 1.5");
+  EXPECT_EQ(t.Int64("neg", 0, 1000).status().message(),
+            "ckpt: trainer.neg: expected an integer in [0, 1000], got -1");
+  EXPECT_EQ(t.Int64("half", 0, 1000).status().message(),
+            "ckpt: trainer.half: expected an integer in [0, 1000], got 1.5");
   EXPECT_FALSE(t.Int64("big", 0, int64_t(1) << 53).ok());
   EXPECT_FALSE(t.Int64("hash", 0, int64_t(1) << 53).ok());
   EXPECT_FALSE(t.Int64("s", 0, 10).ok());
@@ -112,7 +115,8 @@ TEST(JsonUtil, DifferencesNameNestedKeys) {
   const Json a = Parse(R"({"model": {"method": "icef", "hidden": [16]}, "train": {"steps": 10, "lr": 0.1}})");
   const Json b = Parse(R"({"model": {"method": "warp", "hidden": [16]}, "train": {"steps": 20, "seed": 1}})");
   EXPECT_EQ(JsonDifferences(a, a), std::vector<std::string>{});
-  EXPECT_EQ(JsonDifferences(a, b), (std::vector<std::string>{"model.method", "train.steps", "train.lr", "train.seed"}));
+  EXPECT_EQ(JsonDifferences(a, b),
+            (std::vector<std::string>{"model.method", "train.steps", "train.lr", "train.seed"}));
 }
 
 }  // namespace

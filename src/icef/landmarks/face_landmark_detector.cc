@@ -1,5 +1,4 @@
 #include "icef/landmarks/face_landmark_detector.h"
-#include "icef/landmarks/dlib_image.h"
 
 #include <dlib/image_processing.h>
 #include <dlib/image_processing/frontal_face_detector.h>
@@ -9,6 +8,8 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+
+#include "icef/landmarks/dlib_image.h"
 
 namespace icef {
 namespace {
@@ -23,14 +24,14 @@ std::array<int, 68> MakeMirrorIndex() {
   std::array<int, 68> m{};
   for (int i = 0; i < 68; ++i) m[i] = i;
   auto pair = [&m](int a, int b) { m[a] = b, m[b] = a; };
-  for (int i = 0; i <= 7; ++i) pair(i, 16 - i);        // jaw line
-  for (int i = 17; i <= 21; ++i) pair(i, 43 - i);      // brows 17-21 <-> 26-22
-  for (int i = 31; i <= 32; ++i) pair(i, 66 - i);      // nostrils 31, 32 <-> 35, 34
-  for (int i = 36; i <= 39; ++i) pair(i, 81 - i);      // upper eye lids 36-39 <-> 45-42
-  pair(40, 47), pair(41, 46);                          // lower eye lids
-  for (int i = 48; i <= 50; ++i) pair(i, 102 - i);     // upper outer lip 48-50 <-> 54-52
-  pair(55, 59), pair(56, 58);                          // lower outer lip
-  pair(60, 64), pair(61, 63), pair(65, 67);            // inner lips
+  for (int i = 0; i <= 7; ++i) pair(i, 16 - i);     // jaw line
+  for (int i = 17; i <= 21; ++i) pair(i, 43 - i);   // brows 17-21 <-> 26-22
+  for (int i = 31; i <= 32; ++i) pair(i, 66 - i);   // nostrils 31, 32 <-> 35, 34
+  for (int i = 36; i <= 39; ++i) pair(i, 81 - i);   // upper eye lids 36-39 <-> 45-42
+  pair(40, 47), pair(41, 46);                       // lower eye lids
+  for (int i = 48; i <= 50; ++i) pair(i, 102 - i);  // upper outer lip 48-50 <-> 54-52
+  pair(55, 59), pair(56, 58);                       // lower outer lip
+  pair(60, 64), pair(61, 63), pair(65, 67);         // inner lips
   return m;
 }
 
@@ -43,9 +44,9 @@ const std::array<int, 68>& FaceLandmarkDetector::MirrorIndex() {
 
 std::string FaceDetection::ToString() const {
   std::ostringstream s;
-  s << "FaceDetection(landmarks=" << landmarks.size() << ", box=[" << box_min.x() << ", " << box_min.y() << "]-["
-    << box_max.x() << ", " << box_max.y() << "], faces=" << num_faces << ", upsampled=" << (upsampled ? "yes" : "no")
-    << ")";
+  s << "FaceDetection(landmarks=" << landmarks.size() << ", box=[" << box_min.x() << ", " << box_min.y()
+    << "]-[" << box_max.x() << ", " << box_max.y() << "], faces=" << num_faces
+    << ", upsampled=" << (upsampled ? "yes" : "no") << ")";
   return s.str();
 }
 
@@ -96,14 +97,14 @@ Result<FaceDetection> FaceLandmarkDetector::DetectFace(const Image& image, bool 
   }
   if (faces.empty()) return Status::Error("no face found");
   // The first of the largest boxes (dlib returns them in a fixed order): deterministic.
-  const auto largest = std::max_element(faces.begin(), faces.end(), [](const auto& a, const auto& b) {
-    return a.area() < b.area();
-  });
+  const auto largest = std::max_element(faces.begin(), faces.end(),
+                                        [](const auto& a, const auto& b) { return a.area() < b.area(); });
   out.num_faces = int(faces.size());
   out.landmarks.assign(68, Vec2f::Zero());
   if (!averaged) {
     const dlib::full_object_detection shape = (*impl_->predictor)(img, *largest);
-    for (unsigned long i = 0; i < shape.num_parts(); ++i) out.landmarks[i] = FromDlib(dlib::dpoint(shape.part(i)), out.upsampled);
+    for (unsigned long i = 0; i < shape.num_parts(); ++i)
+      out.landmarks[i] = FromDlib(dlib::dpoint(shape.part(i)), out.upsampled);
   } else {
     // dlib coordinates: x -> (columns - 1) - x mirrors the image about its centre, pixel centres
     // at integers; a box [l, r] becomes [w - 1 - r, w - 1 - l].
@@ -115,7 +116,8 @@ Result<FaceDetection> FaceLandmarkDetector::DetectFace(const Image& image, bool 
     int runs = 0;
     for (int dy = -1; dy <= 1; ++dy)
       for (int dx = -1; dx <= 1; ++dx) {
-        const dlib::rectangle box = dlib::translate_rect(*largest, dlib::point(long(std::lround(dx * step)), long(std::lround(dy * step))));
+        const dlib::rectangle box = dlib::translate_rect(
+            *largest, dlib::point(long(std::lround(dx * step)), long(std::lround(dy * step))));
         const dlib::full_object_detection a = (*impl_->predictor)(img, box);
         const dlib::rectangle mbox(long(w1) - box.right(), box.top(), long(w1) - box.left(), box.bottom());
         const dlib::full_object_detection b = (*impl_->predictor)(mirrored, mbox);
@@ -129,7 +131,8 @@ Result<FaceDetection> FaceLandmarkDetector::DetectFace(const Image& image, bool 
   }
   // A box's corners are pixel centres in dlib; ours bound the pixels.
   out.box_min = FromDlib(dlib::dpoint(largest->left(), largest->top()), out.upsampled) - Vec2f(0.5f, 0.5f);
-  out.box_max = FromDlib(dlib::dpoint(largest->right(), largest->bottom()), out.upsampled) + Vec2f(0.5f, 0.5f);
+  out.box_max =
+      FromDlib(dlib::dpoint(largest->right(), largest->bottom()), out.upsampled) + Vec2f(0.5f, 0.5f);
   return out;
 }
 

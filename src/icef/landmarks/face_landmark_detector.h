@@ -22,11 +22,11 @@ constexpr const char* kDefaultShapePredictorPath = "/usr/share/dlib/shape_predic
 
 // One detected face.
 struct FaceDetection {
-  std::vector<Vec2f> landmarks;  // [68] iBUG-68, image coordinates (+0.5 centres)
+  std::vector<Vec2f> landmarks;   // [68] iBUG-68, image coordinates (+0.5 centres)
   Vec2f box_min = Vec2f::Zero();  // the detector's face box, image coordinates
   Vec2f box_max = Vec2f::Zero();
-  int num_faces = 0;             // faces the detector found (the largest is kept)
-  bool upsampled = false;        // found only after upsampling the image 2x
+  int num_faces = 0;       // faces the detector found (the largest is kept)
+  bool upsampled = false;  // found only after upsampling the image 2x
   std::string ToString() const;
 };
 

@@ -41,8 +41,8 @@ TEST(FaceLandmarkDetector, FindsTheSyntheticHeadAndClonesAgree) {
   k.fl_x = k.fl_y = 3.6 * 160;
   k.cx = k.cy = 80;
   const Camera camera = synth::OrbitCamera(k, 3.5, 0, 0);
-  const Image rgba = synth::RenderGroundTruth(head, camera, std::vector<float>(face::kNumExpressions, 0.f),
-                                              Executor(2));
+  const Image rgba =
+      synth::RenderGroundTruth(head, camera, std::vector<float>(face::kNumExpressions, 0.f), Executor(2));
   const Image rgb = CompositeOver(rgba, Vec3f::Ones());
   const FaceLandmarkDetector detector = FaceLandmarkDetector::Load().value();
   const Result<FaceDetection> face = detector.DetectFace(rgb);
@@ -109,7 +109,8 @@ TEST(FaceLandmarkDetector, AveragedLandmarksFollowTheMirroredImage) {
   const Camera camera = synth::OrbitCamera(k, 3.5, 15, 5);
   std::vector<float> expression(face::kNumExpressions, 0.f);
   expression[face::kSmileLeft] = 0.8f;
-  const Image rgb = CompositeOver(synth::RenderGroundTruth(head, camera, expression, Executor(2)), Vec3f::Ones());
+  const Image rgb =
+      CompositeOver(synth::RenderGroundTruth(head, camera, expression, Executor(2)), Vec3f::Ones());
   const FaceLandmarkDetector detector = FaceLandmarkDetector::Load().value();
   const Result<FaceDetection> one = detector.DetectFace(rgb);
   const Result<FaceDetection> avg = detector.DetectFace(rgb, /*averaged=*/true);

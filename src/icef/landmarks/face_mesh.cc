@@ -15,8 +15,8 @@ struct FaceMesh::Impl {
 
 std::string FaceMeshResult::ToString() const {
   std::ostringstream s;
-  s << "FaceMeshResult(" << mesh.size() << " points, score " << face_score << ", crop " << roi_size << " px at ("
-    << roi_center.x() << ", " << roi_center.y() << "), " << roi_angle << " rad)";
+  s << "FaceMeshResult(" << mesh.size() << " points, score " << face_score << ", crop " << roi_size
+    << " px at (" << roi_center.x() << ", " << roi_center.y() << "), " << roi_angle << " rad)";
   return s.str();
 }
 
@@ -36,9 +36,10 @@ const std::array<int, 68>& FaceMesh::Ibug68Index() {
 }
 
 Result<FaceMesh> FaceMesh::Load(const std::filesystem::path& dir) {
-  ICEF_ASSIGN_OR_RETURN(infer::TfjsGraph graph,
-                        infer::LoadInstalledGraph(dir, "ICEF_FACEMESH_MODEL", kDefaultFaceMeshDir, "facemesh.json",
-                                                  {kInputSize, kInputSize, 3}, "face-mesh model"));
+  ICEF_ASSIGN_OR_RETURN(
+      infer::TfjsGraph graph,
+      infer::LoadInstalledGraph(dir, "ICEF_FACEMESH_MODEL", kDefaultFaceMeshDir, "facemesh.json",
+                                {kInputSize, kInputSize, 3}, "face-mesh model"));
   FaceMesh mesh;
   auto impl = std::make_shared<Impl>();
   impl->graph = std::move(graph);
@@ -83,7 +84,8 @@ float Sample(const Image& image, float x, float y, int ch) {
 
 }  // namespace
 
-Result<FaceMeshResult> FaceMesh::RunCrop(const Image& image, const Vec2f& center, float size, float angle) const {
+Result<FaceMeshResult> FaceMesh::RunCrop(const Image& image, const Vec2f& center, float size,
+                                         float angle) const {
   if (image.empty()) return Status::Error("face mesh: empty image");
   if (!(size > 1.f) || !std::isfinite(size) || !center.allFinite())
     return Status::Error("face mesh: bad crop (size " + std::to_string(size) + ")");
@@ -119,7 +121,8 @@ Result<FaceMeshResult> FaceMesh::RunCrop(const Image& image, const Vec2f& center
   for (int p = 0; p < kPoints; ++p) {
     const float du = (raw.data[3 * p] / float(n) - 0.5f) * size;
     const float dv = (raw.data[3 * p + 1] / float(n) - 0.5f) * size;
-    result.mesh[p] = Vec3f(center.x() + c * du - s * dv, center.y() + s * du + c * dv, raw.data[3 * p + 2] * step);
+    result.mesh[p] =
+        Vec3f(center.x() + c * du - s * dv, center.y() + s * du + c * dv, raw.data[3 * p + 2] * step);
   }
   result.landmarks.resize(68);
   for (int i = 0; i < 68; ++i) result.landmarks[i] = result.mesh[Ibug68Index()[i]].head<2>();
@@ -127,7 +130,8 @@ Result<FaceMeshResult> FaceMesh::RunCrop(const Image& image, const Vec2f& center
 }
 
 Result<FaceMeshResult> FaceMesh::Run(const Image& image, const std::vector<Vec2f>& landmarks) const {
-  if (landmarks.size() != 68) return Status::Error("face mesh: expected 68 landmarks, got " + std::to_string(landmarks.size()));
+  if (landmarks.size() != 68)
+    return Status::Error("face mesh: expected 68 landmarks, got " + std::to_string(landmarks.size()));
   // First pass: dlib's 68 points span brows to chin; the mesh also covers the forehead, so the
   // crop is taken a little larger and higher than MediaPipe's mesh-based one.
   auto mean = [&](int a, int b) {
@@ -147,12 +151,14 @@ Result<FaceMeshResult> FaceMesh::Run(const Image& image, const std::vector<Vec2f
   return RunCrop(image, center, size, angle);
 }
 
-Result<FaceDetection> DetectFaceWithMesh(const FaceLandmarkDetector& detector, const FaceMesh& mesh, const Image& image) {
+Result<FaceDetection> DetectFaceWithMesh(const FaceLandmarkDetector& detector, const FaceMesh& mesh,
+                                         const Image& image) {
   ICEF_ASSIGN_OR_RETURN(FaceDetection face, detector.DetectFace(image, /*averaged=*/true));
   const Image rgb = image.HasAlpha() ? CompositeOver(image, Vec3f::Ones()) : image;
   ICEF_ASSIGN_OR_RETURN(const FaceMeshResult result, mesh.Run(rgb, face.landmarks));
   if (!(result.face_score >= FaceMesh::kMinFaceScore))
-    return Status::Error("no face found (the face mesh's face score is " + std::to_string(result.face_score) + ")");
+    return Status::Error("no face found (the face mesh's face score is " + std::to_string(result.face_score) +
+                         ")");
   face.landmarks = result.landmarks;
   return face;
 }

@@ -31,8 +31,8 @@ struct FaceMeshResult {
   std::vector<Vec2f> landmarks;  // [68] iBUG-68 points read off the mesh (FaceMesh::Ibug68Index)
   float face_score = 0.f;        // the network's probability that the crop holds a face
   Vec2f roi_center = Vec2f::Zero();
-  float roi_size = 0.f;          // side of the square crop, pixels
-  float roi_angle = 0.f;         // its rotation, radians (image x towards image y)
+  float roi_size = 0.f;   // side of the square crop, pixels
+  float roi_angle = 0.f;  // its rotation, radians (image x towards image y)
   std::string ToString() const;
 };
 
@@ -67,7 +67,8 @@ class FaceMesh {
 // dlib's face (DetectFace, averaged) with its 68 landmarks replaced by those the face mesh reads
 // (FaceMesh::Run placed by dlib's). The box and face count stay dlib's. Error "no face found" when
 // the mesh's face score is below kMinFaceScore: what dlib took for a face, the mesh does not.
-Result<FaceDetection> DetectFaceWithMesh(const FaceLandmarkDetector& detector, const FaceMesh& mesh, const Image& image);
+Result<FaceDetection> DetectFaceWithMesh(const FaceLandmarkDetector& detector, const FaceMesh& mesh,
+                                         const Image& image);
 
 // The square crop (MediaPipe's region of interest) around `points`: centred on their bounding box,
 // its longer side times `scale`, turned by the angle of the line from `left_eye` to `right_eye`

@@ -29,7 +29,9 @@ TEST(FaceMeshTest, RoiIsTheTurnedBoundingBoxScaled) {
   const float a = float(M_PI / 6);
   std::vector<Vec2f> points;
   for (float u : {-20.f, 20.f})
-    for (float v : {-10.f, 10.f}) points.push_back(Vec2f(100 + std::cos(a) * u - std::sin(a) * v, 50 + std::sin(a) * u + std::cos(a) * v));
+    for (float v : {-10.f, 10.f})
+      points.push_back(
+          Vec2f(100 + std::cos(a) * u - std::sin(a) * v, 50 + std::sin(a) * u + std::cos(a) * v));
   Vec2f center;
   float size = 0, angle = 0;
   FaceMeshRoi(points, Vec2f(0, 0), Vec2f(std::cos(a), std::sin(a)), 1.5f, center, size, angle);

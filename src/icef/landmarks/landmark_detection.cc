@@ -44,16 +44,18 @@ std::string LandmarkDetectionOptions::ToString() const {
   std::string s = "LandmarkDetectionOptions(splits=";
   for (size_t i = 0; i < splits.size(); ++i) s += (i ? "," : "") + splits[i];
   return s + ", overwrite=" + (overwrite ? "true" : "false") + ", averaged=" + (averaged ? "true" : "false") +
-         ", mesh=" + (mesh ? "true" : "false") +
-         ", predictor=" + (predictor_path.empty() ? std::string(kDefaultShapePredictorPath) : predictor_path.string()) +
-         ")";
+         ", mesh=" + (mesh ? "true" : "false") + ", predictor=" +
+         (predictor_path.empty() ? std::string(kDefaultShapePredictorPath) : predictor_path.string()) + ")";
 }
 
 const char* LandmarkOutcomeName(LandmarkOutcome outcome) {
   switch (outcome) {
-    case LandmarkOutcome::kKept: return "kept";
-    case LandmarkOutcome::kDetected: return "detected";
-    case LandmarkOutcome::kNoFace: return "no face";
+    case LandmarkOutcome::kKept:
+      return "kept";
+    case LandmarkOutcome::kDetected:
+      return "detected";
+    case LandmarkOutcome::kNoFace:
+      return "no face";
   }
   return "?";
 }
@@ -61,12 +63,14 @@ const char* LandmarkOutcomeName(LandmarkOutcome outcome) {
 std::string FrameLandmarks::Name() const { return split + "[" + std::to_string(index) + "] " + file_path; }
 
 int LandmarkDetectionReport::Count(const std::string& split, LandmarkOutcome outcome) const {
-  return int(std::count_if(frames.begin(), frames.end(),
-                           [&](const FrameLandmarks& f) { return f.split == split && f.outcome == outcome; }));
+  return int(std::count_if(frames.begin(), frames.end(), [&](const FrameLandmarks& f) {
+    return f.split == split && f.outcome == outcome;
+  }));
 }
 
 int LandmarkDetectionReport::CountAll(LandmarkOutcome outcome) const {
-  return int(std::count_if(frames.begin(), frames.end(), [&](const FrameLandmarks& f) { return f.outcome == outcome; }));
+  return int(std::count_if(frames.begin(), frames.end(),
+                           [&](const FrameLandmarks& f) { return f.outcome == outcome; }));
 }
 
 std::vector<const FrameLandmarks*> LandmarkDetectionReport::NoFace(const std::string& split) const {
@@ -79,7 +83,8 @@ std::vector<const FrameLandmarks*> LandmarkDetectionReport::NoFace(const std::st
 std::string LandmarkDetectionReport::Summary() const {
   std::ostringstream s;
   for (const char* split : kSplitNames) {
-    const int total = int(std::count_if(frames.begin(), frames.end(), [&](const FrameLandmarks& f) { return f.split == split; }));
+    const int total = int(std::count_if(frames.begin(), frames.end(),
+                                        [&](const FrameLandmarks& f) { return f.split == split; }));
     if (total == 0) continue;
     s << split << ": " << total << " frame" << (total == 1 ? "" : "s") << ", "
       << Count(split, LandmarkOutcome::kDetected) << " detected, " << Count(split, LandmarkOutcome::kNoFace)
@@ -98,7 +103,8 @@ std::string LandmarkDetectionReport::Summary() const {
 Result<Image> LoadDetectionImage(const Dataset& dataset, const Frame& frame, const Image& background_image) {
   ICEF_ASSIGN_OR_RETURN(const Image image, LoadFrameImage(dataset, frame));
   if (!image.HasAlpha()) return CompositeOver(image, dataset.background);  // RGB (grey expanded)
-  if (background_image.empty() || background_image.width != image.width || background_image.height != image.height)
+  if (background_image.empty() || background_image.width != image.width ||
+      background_image.height != image.height)
     return CompositeOver(image, dataset.background);
   Image out(image.width, image.height, 3);
   for (int y = 0; y < image.height; ++y)
@@ -135,7 +141,8 @@ Result<LandmarkDetectionReport> DetectDatasetLandmarks(
   if (dataset.background_file_path) {
     ICEF_ASSIGN_OR_RETURN(background_image, ReadImage(dataset.root / *dataset.background_file_path));
   }
-  ICEF_ASSIGN_OR_RETURN(const FaceLandmarkDetector detector, FaceLandmarkDetector::Load(options.predictor_path));
+  ICEF_ASSIGN_OR_RETURN(const FaceLandmarkDetector detector,
+                        FaceLandmarkDetector::Load(options.predictor_path));
   std::optional<FaceMesh> face_mesh;
   if (options.mesh) {
     ICEF_ASSIGN_OR_RETURN(FaceMesh loaded, FaceMesh::Load(options.mesh_dir));
@@ -184,7 +191,8 @@ Status WriteDetectedLandmarks(const Dataset& dataset, const LandmarkDetectionRep
     const std::filesystem::path file = dataset.root / ("transforms_" + std::string(split) + ".json");
     ICEF_ASSIGN_OR_RETURN(Json doc, ReadJsonFile(file));
     const size_t expected = SplitFrames(dataset, split).size();
-    if (!doc.is_object() || !doc.contains("frames") || !doc["frames"].is_array() || doc["frames"].size() != expected)
+    if (!doc.is_object() || !doc.contains("frames") || !doc["frames"].is_array() ||
+        doc["frames"].size() != expected)
       return Status::Error(file.string() + ": frames: changed since the dataset was loaded (expected " +
                            std::to_string(expected) + " frames); nothing written to it");
     Json& frames = doc["frames"];
@@ -195,7 +203,8 @@ Status WriteDetectedLandmarks(const Dataset& dataset, const LandmarkDetectionRep
       if (!frame.is_object())
         return Status::Error(file.string() + ": frames[" + std::to_string(f->index) + "]: not an object");
       Json points = Json::array();
-      for (const Vec2f& p : f->detection.landmarks) points.push_back(Json::array({JsonFloat(p.x()), JsonFloat(p.y())}));
+      for (const Vec2f& p : f->detection.landmarks)
+        points.push_back(Json::array({JsonFloat(p.x()), JsonFloat(p.y())}));
       frame["landmarks_2d"] = std::move(points);
       frame["landmarks_2d_visible"] = Json(std::vector<bool>(kNumLandmarks, true));
     }

@@ -49,7 +49,7 @@ struct FrameLandmarks {
   int index = 0;          // frame index within the split
   std::string file_path;  // the frame's image, relative to the dataset directory
   LandmarkOutcome outcome = LandmarkOutcome::kKept;
-  FaceDetection detection;  // when kDetected
+  FaceDetection detection;   // when kDetected
   std::string Name() const;  // "train[2] images/train_002.png"
 };
 

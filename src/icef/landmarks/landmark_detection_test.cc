@@ -21,8 +21,8 @@ bool HavePredictor() { return fs::exists(kDefaultShapePredictorPath); }
 // are kept aside and removed from the returned dataset.
 struct SynthFixture {
   Dataset dataset;
-  std::vector<std::vector<Vec2f>> truth;          // per training frame
-  std::vector<std::vector<bool>> truth_visible;   // per training frame
+  std::vector<std::vector<Vec2f>> truth;         // per training frame
+  std::vector<std::vector<bool>> truth_visible;  // per training frame
 };
 
 SynthFixture MakeSynthFixture(const std::string& name) {
@@ -139,7 +139,8 @@ TEST(DetectDatasetLandmarks, ReportsFramesWithoutFace) {
 }
 
 // A report as the detector would return it, with recognisable landmarks on the given frames.
-LandmarkDetectionReport FakeReport(const std::string& split, const std::vector<int>& detected, int num_frames) {
+LandmarkDetectionReport FakeReport(const std::string& split, const std::vector<int>& detected,
+                                   int num_frames) {
   LandmarkDetectionReport report;
   for (int i = 0; i < num_frames; ++i) {
     FrameLandmarks f;
@@ -148,7 +149,8 @@ LandmarkDetectionReport FakeReport(const std::string& split, const std::vector<i
     f.outcome = LandmarkOutcome::kNoFace;
     if (std::find(detected.begin(), detected.end(), i) != detected.end()) {
       f.outcome = LandmarkOutcome::kDetected;
-      for (int p = 0; p < kNumLandmarks; ++p) f.detection.landmarks.emplace_back(0.25f * p + i, 0.5f * p + 0.125f);
+      for (int p = 0; p < kNumLandmarks; ++p)
+        f.detection.landmarks.emplace_back(0.25f * p + i, 0.5f * p + 0.125f);
     }
     report.frames.push_back(f);
   }
@@ -199,7 +201,8 @@ TEST(WriteDetectedLandmarks, RefusesAFileThatChanged) {
   ASSERT_TRUE(WriteFileAtomic(dir / "transforms_train.json", changed).ok());
   const Status status = WriteDetectedLandmarks(dataset, FakeReport("train", {0}, 3));
   ASSERT_FALSE(status.ok());
-  EXPECT_NE(status.message().find("transforms_train.json: frames: changed"), std::string::npos) << status.message();
+  EXPECT_NE(status.message().find("transforms_train.json: frames: changed"), std::string::npos)
+      << status.message();
   EXPECT_EQ(ReadFile(dir / "transforms_train.json").value(), changed);
 }
 

@@ -26,7 +26,7 @@ struct Intrinsics {
   int height = 0;
   double fl_x = 0;  // focal length in pixels; nonzero, negative flips the image's x axis (see above)
   double fl_y = 0;  // likewise for the y axis
-  double cx = 0;  // principal point in image coordinates (pixels)
+  double cx = 0;    // principal point in image coordinates (pixels)
   double cy = 0;
 
   // instant-ngp / NeRF style: fl_x = 0.5 * width / tan(0.5 * camera_angle_x); principal point at

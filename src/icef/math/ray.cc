@@ -32,7 +32,8 @@ std::string Ray::ToString() const {
 }
 
 std::string Aabb::ToString() const {
-  return "Aabb(min=" + icef::ToString(min.cast<double>()) + ", max=" + icef::ToString(max.cast<double>()) + ")";
+  return "Aabb(min=" + icef::ToString(min.cast<double>()) + ", max=" + icef::ToString(max.cast<double>()) +
+         ")";
 }
 
 }  // namespace icef

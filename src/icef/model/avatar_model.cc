@@ -34,8 +34,8 @@ void ApplyCavity(int64_t n, const uint8_t* inside, const float colour[3], float*
 // The cavity samples' colour gradients, summed (in sample order, in double) onto the cavity colour's
 // logits (d rgb / d logit = rgb (1 - rgb)); then both their gradients are dropped (the static field
 // did not produce them).
-void CavityBackward(int64_t n, const uint8_t* inside, std::span<const float> logits, float* d_sigma, float* d_rgb,
-                    std::span<float> d_logits) {
+void CavityBackward(int64_t n, const uint8_t* inside, std::span<const float> logits, float* d_sigma,
+                    float* d_rgb, std::span<float> d_logits) {
   double sum[3] = {0, 0, 0};
   for (int64_t i = 0; i < n; ++i) {
     if (!inside[i]) continue;
@@ -68,8 +68,8 @@ AvatarModel::AvatarModel(const ModelConfig& config, const ModelSetup& setup, Reg
 AvatarModel::~AvatarModel() = default;
 
 Result<std::unique_ptr<AvatarModel>> AvatarModel::Create(const ModelConfig& config, const ModelSetup& setup,
-                                                     const Executor& executor,
-                                                     std::unique_ptr<DeformationPrior> prior) {
+                                                         const Executor& executor,
+                                                         std::unique_ptr<DeformationPrior> prior) {
   ICEF_RETURN_IF_ERROR(config.Validate().WithContext("model config"));
   if (!setup.aabb.IsValid()) return Status::Error("model setup: invalid aabb " + setup.aabb.ToString());
   if (setup.expression_dim < 1) return Status::Error("model setup: expression_dim must be >= 1");
@@ -85,8 +85,9 @@ Result<std::unique_ptr<AvatarModel>> AvatarModel::Create(const ModelConfig& conf
   model->static_field_ = std::make_unique<StaticField>(config.StaticOptions(setup.expression_dim), setup.aabb,
                                                        &model->store_, "static", kGridGroup, kMlpGroup);
   if (model->traits_.deformation) {
-    model->residual_field_ = std::make_unique<DeformationField>(
-        config.DeformationOptions(), setup.expression_dim, setup.aabb, &model->store_, "deformation", kDeformGroup);
+    model->residual_field_ =
+        std::make_unique<DeformationField>(config.DeformationOptions(), setup.expression_dim, setup.aabb,
+                                           &model->store_, "deformation", kDeformGroup);
   }
   if (model->traits_.prior) {
     if (prior) {
@@ -116,21 +117,24 @@ void AvatarModel::Initialize(uint64_t seed) {
   occupancy_.Fill(true);
 }
 
-NearestExpression AvatarModel::Nearest(std::span<const float> beta) const { return confidence_.Nearest(beta); }
+NearestExpression AvatarModel::Nearest(std::span<const float> beta) const {
+  return confidence_.Nearest(beta);
+}
 
 float AvatarModel::CavityColour(int channel) const {
   ICEF_CHECK(cavity_block_ >= 0, "no mouth cavity without a prior");
   return Sigmoid(store_.params(cavity_block_)[channel]);
 }
 
-void AvatarModel::QueryStatic(const Executor& executor, int64_t n, const float* canonical, const float* directions,
-                            const float* condition, float* sigma, float* rgb) const {
+void AvatarModel::QueryStatic(const Executor& executor, int64_t n, const float* canonical,
+                              const float* directions, const float* condition, float* sigma,
+                              float* rgb) const {
   StaticFieldContext ctx;
   static_field_->Forward(executor, n, canonical, directions, condition, sigma, rgb, &ctx, false, false);
 }
 
-void AvatarModel::WarpOffsets(const Executor& executor, int64_t n, const float* positions, std::span<const float> beta,
-                              float* offsets, WarpPart part) const {
+void AvatarModel::WarpOffsets(const Executor& executor, int64_t n, const float* positions,
+                              std::span<const float> beta, float* offsets, WarpPart part) const {
   ICEF_CHECK(static_cast<int>(beta.size()) == setup_.expression_dim, "beta has the wrong length");
   if (!warp_) {
     std::fill(offsets, offsets + 3 * n, 0.f);
@@ -140,18 +144,18 @@ void AvatarModel::WarpOffsets(const Executor& executor, int64_t n, const float* 
   warp_->Offsets(executor, n, positions, beta, offsets, &ws, part);
 }
 
-void AvatarModel::Offsets(const Executor& executor, int64_t n, const float* positions, std::span<const float> beta,
-                        float* offsets) const {
+void AvatarModel::Offsets(const Executor& executor, int64_t n, const float* positions,
+                          std::span<const float> beta, float* offsets) const {
   WarpOffsets(executor, n, positions, beta, offsets, WarpPart::kFinal);
 }
 
 void AvatarModel::OffsetsPhi(const Executor& executor, int64_t n, const float* positions,
-                           std::span<const float> beta, float* offsets) const {
+                             std::span<const float> beta, float* offsets) const {
   WarpOffsets(executor, n, positions, beta, offsets, WarpPart::kPhi);
 }
 
 void AvatarModel::OffsetsLinearized(const Executor& executor, int64_t n, const float* positions,
-                                  std::span<const float> beta, float* offsets) const {
+                                    std::span<const float> beta, float* offsets) const {
   WarpOffsets(executor, n, positions, beta, offsets, WarpPart::kLinearized);
 }
 
@@ -267,14 +271,16 @@ bool AvatarModel::ShadingNormals(ModelWorkspace& ws, int64_t n, std::optional<st
   return true;
 }
 
-void AvatarModel::PlaceTrainingSamples(const TrainRays& batch, ModelWorkspace& ws, uint64_t seed, int64_t step,
-                                       const Executor& executor) const {
+void AvatarModel::PlaceTrainingSamples(const TrainRays& batch, ModelWorkspace& ws, uint64_t seed,
+                                       int64_t step, const Executor& executor) const {
   if (!config_.importance.enabled()) {
-    SampleRays(batch.rays, setup_.aabb, config_.SamplerOptions(true), &occupancy_, seed, step, executor, &ws.samples);
+    SampleRays(batch.rays, setup_.aabb, config_.SamplerOptions(true), &occupancy_, seed, step, executor,
+               &ws.samples);
     return;
   }
   // Coarse pass: the density at the stratified samples, through the warp at each ray's expression.
-  SampleRays(batch.rays, setup_.aabb, config_.SamplerOptions(true), &occupancy_, seed, step, executor, &ws.coarse);
+  SampleRays(batch.rays, setup_.aabb, config_.SamplerOptions(true), &occupancy_, seed, step, executor,
+             &ws.coarse);
   const int64_t m = ws.coarse.size();
   const int b = setup_.expression_dim;
   const bool need_betas = warp_ || traits_.entangled_beta;
@@ -334,17 +340,22 @@ LossTerms AvatarModel::TrainForwardBackward(const TrainRays& batch, const LossWe
   // Compositing over the known background.
   const float bg[3] = {setup_.background.x(), setup_.background.y(), setup_.background.z()};
   ICEF_CHECK(batch.background.empty() || int64_t(batch.background.size()) == 3 * num_rays, "background size");
-  CompositeInputs<float> in{ws.sigma, ws.rgb, ws.samples.t, ws.samples.dt, ws.samples.ray_offset,
-                            ws.samples.ray_count,
-                            batch.background.empty() ? std::span<const float>(bg, 3) : std::span<const float>(batch.background)};
+  CompositeInputs<float> in{
+      ws.sigma,
+      ws.rgb,
+      ws.samples.t,
+      ws.samples.dt,
+      ws.samples.ray_offset,
+      ws.samples.ray_count,
+      batch.background.empty() ? std::span<const float>(bg, 3) : std::span<const float>(batch.background)};
   CompositeForward(in, config_.compositing, executor, &ws.composite);
 
   // The loss terms stage by stage along the backward pass: rays, back through compositing to the
   // samples, through the static field to the canonical positions, through the warp.
   LossTerms terms;
   terms.samples = n;
-  LossContext ctx{batch, ws, weights, setup_, traits_, *static_field_, residual_field_.get(), warp_.get(),
-                  mask_, symmetry_, seed, step, executor};
+  LossContext ctx{batch,       ws,    weights,   setup_, traits_, *static_field_, residual_field_.get(),
+                  warp_.get(), mask_, symmetry_, seed,   step,    executor};
   ws.d_color.assign(3 * num_rays, 0.f);
   ws.d_opacity.assign(num_rays, 0.f);
   ws.d_weights.clear();
@@ -364,7 +375,8 @@ LossTerms AvatarModel::TrainForwardBackward(const TrainRays& batch, const LossWe
         for (int a = 0; a < 3; ++a) ws.d_rgb[3 * i + a] *= ws.shade[i];
     });
   static_field_->Backward(executor, n, ws.sigma.data(), shaded ? ws.rgb_unshaded.data() : ws.rgb.data(),
-                          ws.d_sigma.data(), ws.d_rgb.data(), &ws.static_ctx, warp_ ? ws.d_canonical.data() : nullptr);
+                          ws.d_sigma.data(), ws.d_rgb.data(), &ws.static_ctx,
+                          warp_ ? ws.d_canonical.data() : nullptr);
   for (Loss* loss : evaluated_losses_) loss->AfterStaticBackward(ctx);
   RunLosses(LossStage::kCanonical, ctx, &terms);  // the terms on the warp have weight 0 without one
   if (warp_) warp_->Backward(executor, n, ws.d_canonical.data(), &ws.deform_ctx);
@@ -437,8 +449,8 @@ void AvatarModel::Render(std::span<const Ray> rays, std::span<const float> beta,
   constexpr int64_t kChunk = 1 << 14;
   for (int64_t r0 = 0; r0 < total_rays; r0 += kChunk) {
     const int64_t nr = std::min(kChunk, total_rays - r0);
-    SampleRays(rays.subspan(r0, nr), setup_.aabb, config_.RenderSamplerOptions(), occupancy ? occupancy : &occupancy_,
-               0, 0, executor, &ws.samples);
+    SampleRays(rays.subspan(r0, nr), setup_.aabb, config_.RenderSamplerOptions(),
+               occupancy ? occupancy : &occupancy_, 0, 0, executor, &ws.samples);
     RayMarch march;
     march.Start(ws.samples, 2);  // extras: the region mask M(x) and the warp's length ||D_final(x) - x||
     while (march.NextRound(ws.samples)) {
@@ -450,7 +462,8 @@ void AvatarModel::Render(std::span<const Ray> rays, std::span<const float> beta,
           const Vec3f& dir = rays[r0 + march.ray(k)].direction;
           for (int64_t i = march.round_begin(k); i < march.round_end(k); ++i) {
             const int64_t s = march.Sample(k, i);
-            for (int a = 0; a < 3; ++a) ws.positions[3 * i + a] = ws.samples.positions[3 * s + a], ws.dirs[3 * i + a] = dir[a];
+            for (int a = 0; a < 3; ++a)
+              ws.positions[3 * i + a] = ws.samples.positions[3 * s + a], ws.dirs[3 * i + a] = dir[a];
           }
         }
       });
@@ -469,7 +482,8 @@ void AvatarModel::Render(std::span<const Ray> rays, std::span<const float> beta,
         mask_.EvaluateBatch(positions + 3 * i0, i1 - i0, ws.mask_values.data() + i0);
         for (int64_t i = i0; i < i1; ++i) {
           ws.extras[2 * i] = ws.mask_values[i];
-          ws.extras[2 * i + 1] = Vec3f(ws.offsets[3 * i], ws.offsets[3 * i + 1], ws.offsets[3 * i + 2]).norm();
+          ws.extras[2 * i + 1] =
+              Vec3f(ws.offsets[3 * i], ws.offsets[3 * i + 1], ws.offsets[3 * i + 2]).norm();
         }
       });
       march.Composite(ws.samples, ws.sigma.data(), ws.rgb.data(), ws.extras.data(),
@@ -503,7 +517,8 @@ void AvatarModel::UpdateOccupancy(uint64_t seed, int64_t step, const Executor& e
         for (int64_t i = 0; i < 3 * n; ++i) canonical[i] = positions[i] + offsets[i];
         c = canonical.data();
       }
-      static_field_->Density(executor, n, c, traits_.entangled_beta ? betas.data() : nullptr, sigma.data(), &sctx);
+      static_field_->Density(executor, n, c, traits_.entangled_beta ? betas.data() : nullptr, sigma.data(),
+                             &sctx);
       for (int64_t i = 0; i < n; ++i) out[i] = std::max(out[i], sigma[i]);
       if (!warp_ && !traits_.entangled_beta) break;  // density does not depend on beta
     }

@@ -55,8 +55,8 @@ class AvatarModel {
   // (tests), else the face-model prior of setup.face_fit (model/face_prior.h). Errors: invalid
   // config or setup, a *-prior method without a face-model fit.
   static Result<std::unique_ptr<AvatarModel>> Create(const ModelConfig& config, const ModelSetup& setup,
-                                                   const Executor& executor,
-                                                   std::unique_ptr<DeformationPrior> prior = nullptr);
+                                                     const Executor& executor,
+                                                     std::unique_ptr<DeformationPrior> prior = nullptr);
   ~AvatarModel();
 
   // Draws initial parameters (deterministic for the seed).
@@ -68,8 +68,8 @@ class AvatarModel {
   // normals: no term reads a colour elsewhere (the unseen views' rays carry a depth alone), unless
   // the symmetry prior's colour part (train.symmetry_colour) compares samples with their mirror
   // images, which then colours every sample.
-  LossTerms TrainForwardBackward(const TrainRays& batch, const LossWeights& weights, uint64_t seed, int64_t step,
-                                 const Executor& executor);
+  LossTerms TrainForwardBackward(const TrainRays& batch, const LossWeights& weights, uint64_t seed,
+                                 int64_t step, const Executor& executor);
   // false: every training sample is coloured, as before the above (the same function; float sums in
   // another order). For tests and benchmarks.
   void set_color_composited_only(bool on) { color_composited_only_ = on; }
@@ -111,8 +111,8 @@ class AvatarModel {
   // P + R_phi (kappa forced to 1) and P + R_lin around beta_n separately (tests).
   void OffsetsPhi(const Executor& executor, int64_t n, const float* positions, std::span<const float> beta,
                   float* offsets) const;
-  void OffsetsLinearized(const Executor& executor, int64_t n, const float* positions, std::span<const float> beta,
-                         float* offsets) const;
+  void OffsetsLinearized(const Executor& executor, int64_t n, const float* positions,
+                         std::span<const float> beta, float* offsets) const;
 
   nn::ParameterStore& store() { return store_; }
   const nn::ParameterStore& store() const { return store_; }
@@ -137,7 +137,8 @@ class AvatarModel {
   std::string ToString() const;
 
  private:
-  AvatarModel(const ModelConfig& config, const ModelSetup& setup, RegionMask mask, ExpressionConfidence confidence);
+  AvatarModel(const ModelConfig& config, const ModelSetup& setup, RegionMask mask,
+              ExpressionConfidence confidence);
   // Pieces of TrainForwardBackward / Render.
   // The training step's samples into ws.samples: the stratified sampler's, or (config importance)
   // those importance resampling draws from them by the current density (render/importance_sampler.h).

@@ -20,7 +20,8 @@ using testing_model::TinyModelConfig;
 using testing_model::TinySetup;
 
 // bf16 = false: inference in FP32 (finite-difference checks need more than BF16's 8 bits).
-std::unique_ptr<AvatarModel> MakeModel(const std::string& method, float deform_scale = 0.5f, bool bf16 = true) {
+std::unique_ptr<AvatarModel> MakeModel(const std::string& method, float deform_scale = 0.5f,
+                                       bool bf16 = true) {
   ModelConfig config = TinyModelConfig(method);
   config.deformation.output_init_scale = deform_scale;  // a clearly non-zero warp from the start
   config.bf16_inference = bf16;
@@ -174,10 +175,14 @@ TEST(IdentityLossTest, GradientsMatchFiniteDifferences) {
     std::vector<double> p = off, m = off;
     p[i] += h;
     m[i] -= h;
-    const double fd_id = 0.3 * (IdentityLoss<double>(2 * n, p.data(), mask.data(), inv_half2, 1.0, nullptr) -
-                                IdentityLoss<double>(2 * n, m.data(), mask.data(), inv_half2, 1.0, nullptr)) / (2 * h);
-    const double fd_sm = 0.7 * (SmoothnessLoss<double>(n, p.data(), weights.data(), half, eps, 1.0, nullptr) -
-                                SmoothnessLoss<double>(n, m.data(), weights.data(), half, eps, 1.0, nullptr)) / (2 * h);
+    const double fd_id = 0.3 *
+                         (IdentityLoss<double>(2 * n, p.data(), mask.data(), inv_half2, 1.0, nullptr) -
+                          IdentityLoss<double>(2 * n, m.data(), mask.data(), inv_half2, 1.0, nullptr)) /
+                         (2 * h);
+    const double fd_sm = 0.7 *
+                         (SmoothnessLoss<double>(n, p.data(), weights.data(), half, eps, 1.0, nullptr) -
+                          SmoothnessLoss<double>(n, m.data(), weights.data(), half, eps, 1.0, nullptr)) /
+                         (2 * h);
     EXPECT_NEAR(g_id[i], fd_id, 1e-7 * (1 + std::abs(fd_id))) << i;
     EXPECT_NEAR(g_sm[i], fd_sm, 1e-7 * (1 + std::abs(fd_sm))) << i;
   }
@@ -217,7 +222,8 @@ TEST(RenderImageTest, SupersamplingAveragesSubpixelRays) {
         EXPECT_NEAR(img.color.At(i, j, c), mean, 1e-5) << i << "," << j;
         max_spread = std::max<double>(max_spread, std::abs(out.color[c] - out.color[9 + c]));
       }
-      EXPECT_NEAR(img.opacity.At(i, j, 0), 0.25f * (out.opacity[0] + out.opacity[1] + out.opacity[2] + out.opacity[3]), 1e-5);
+      EXPECT_NEAR(img.opacity.At(i, j, 0),
+                  0.25f * (out.opacity[0] + out.opacity[1] + out.opacity[2] + out.opacity[3]), 1e-5);
     }
   EXPECT_GT(max_spread, 1e-3);  // the sub-pixel rays really saw different things
 }
@@ -318,7 +324,8 @@ TEST(AvatarModelTest, RenderEqualsCompositingEverySampleWhileSkippingOccludedOne
     model.Render(rays, beta, Vec3f(1, 1, 1), ex, &out);
 
     RaySamples samples;
-    SampleRays(rays, model.setup().aabb, config.RenderSamplerOptions(), &model.occupancy(), 0, 0, ex, &samples);
+    SampleRays(rays, model.setup().aabb, config.RenderSamplerOptions(), &model.occupancy(), 0, 0, ex,
+               &samples);
     const int64_t n = samples.size();
     std::vector<float> dirs(3 * n), offsets(3 * n, 0.f), canonical(samples.positions), sigma(n), rgb(3 * n);
     for (int64_t r = 0; r < samples.num_rays(); ++r)
@@ -330,10 +337,15 @@ TEST(AvatarModelTest, RenderEqualsCompositingEverySampleWhileSkippingOccludedOne
       model.Offsets(ex, n, samples.positions.data(), beta, offsets.data());
       for (int64_t i = 0; i < 3 * n; ++i) canonical[i] += offsets[i];
     }
-    model.QueryStatic(ex, n, canonical.data(), dirs.data(), model.warp() ? nullptr : betas.data(), sigma.data(),
-                      rgb.data());
+    model.QueryStatic(ex, n, canonical.data(), dirs.data(), model.warp() ? nullptr : betas.data(),
+                      sigma.data(), rgb.data());
     const float bg[3] = {1.f, 1.f, 1.f};
-    CompositeInputs<float> in{sigma, rgb, samples.t, samples.dt, samples.ray_offset, samples.ray_count,
+    CompositeInputs<float> in{sigma,
+                              rgb,
+                              samples.t,
+                              samples.dt,
+                              samples.ray_offset,
+                              samples.ray_count,
                               std::span<const float>(bg, 3)};
     CompositeOutputs<float> ref;
     CompositeOptions render_eps;
@@ -402,7 +414,7 @@ TEST(AvatarModelTest, TrainLossGradientMatchesFiniteDifferences) {
     w.lambda_depth_prior = 300.0;
     w.depth_prior_window = 0.05;  // offsets clamped to +-0.05 diagonals, samples 0.25 behind left out:
     w.depth_prior_reach = 0.25;   // both fixed along each ray, so L_depth stays smooth in the parameters
-    w.lambda_symmetry = 0.3;  // mirrored samples through the warp and both fields
+    w.lambda_symmetry = 0.3;      // mirrored samples through the warp and both fields
     w.symmetry_colour = 0.0;  // its colour weight is a stop-gradient (symmetry_loss_test checks that part)
     w.symmetry_max_samples = 64;
     const Executor ex(1);
@@ -416,9 +428,13 @@ TEST(AvatarModelTest, TrainLossGradientMatchesFiniteDifferences) {
     check.skip_kinks = false;
     check.abs_tol_frac = 0;
     check.abs_tol = 1e-6;
-    const auto report = check.Run(store.params(), grads, [&] { return model->TrainForwardBackward(batch, w, 3, 0, ex).total; });
+    const auto report = check.Run(store.params(), grads,
+                                  [&] { return model->TrainForwardBackward(batch, w, 3, 0, ex).total; });
     EXPECT_TRUE(report.ok()) << method << ":\n" << report.failures;
-    EXPECT_GT(std::abs(*std::max_element(grads.begin(), grads.end(), [](double a, double b) { return std::abs(a) < std::abs(b); })), 1e-6) << method;
+    EXPECT_GT(std::abs(*std::max_element(grads.begin(), grads.end(),
+                                         [](double a, double b) { return std::abs(a) < std::abs(b); })),
+              1e-6)
+        << method;
     store.ZeroGrads();
   }
 }

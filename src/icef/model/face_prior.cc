@@ -52,8 +52,8 @@ class FacePrior final : public DeformationPrior {
     });
   }
 
-  bool Normals(const Executor& executor, int64_t n, const float* positions, const float* betas, float* observed,
-               float* canonical) const override {
+  bool Normals(const Executor& executor, int64_t n, const float* positions, const float* betas,
+               float* observed, float* canonical) const override {
     ParallelFor(executor, n, [&](int64_t i0, int64_t i1, int) {
       StateCache cache;
       std::vector<Vec3f> canonical_points(size_t(i1 - i0)), neutral_normals(size_t(i1 - i0));
@@ -78,7 +78,8 @@ class FacePrior final : public DeformationPrior {
           Mat3f jacobian;
           for (int a = 0; a < 3; ++a) {
             const Vec3f e = Vec3f::Unit(a) * kJacobianStep;
-            jacobian.col(a) = (model_.PriorWarp(x_h + e, state) - model_.PriorWarp(x_h - e, state)) / (2.f * kJacobianStep);
+            jacobian.col(a) =
+                (model_.PriorWarp(x_h + e, state) - model_.PriorWarp(x_h - e, state)) / (2.f * kJacobianStep);
           }
           const Vec3f m = jacobian.transpose() * g;
           if (m.norm() > 0.f) carried = m.normalized();
@@ -97,7 +98,8 @@ class FacePrior final : public DeformationPrior {
   int expression_dims() const override { return face::kNumExpressions; }
   std::string ToString() const override {
     std::ostringstream os;
-    os << "FacePrior(" << fit_.shape.ToString() << ", " << fit_.style.ToString() << ", " << fit_.head_from_world.ToString() << ")";
+    os << "FacePrior(" << fit_.shape.ToString() << ", " << fit_.style.ToString() << ", "
+       << fit_.head_from_world.ToString() << ")";
     return os.str();
   }
 
@@ -127,16 +129,18 @@ class FacePrior final : public DeformationPrior {
 
 }  // namespace
 
-Status CheckFaceModelExpressions(const std::vector<std::string>& expression_names, const std::string& origin) {
+Status CheckFaceModelExpressions(const std::vector<std::string>& expression_names,
+                                 const std::string& origin) {
   const std::vector<std::string> want = face::ExpressionNames();
   if (expression_names == want) return Status::Ok();
   std::string got;
   for (const std::string& s : expression_names) got += (got.empty() ? "" : ", ") + s;
-  return Status::Error(origin + ": the face-model prior needs the face model's " + std::to_string(want.size()) +
-                       " expressions (jaw_open, smile_left, ...; docs/face_model.md), but expression_names are [" +
-                       (got.empty() ? std::string("none") : got) +
-                       "]: re-express the dataset in them with `icef track DATASET --keep-cameras --out NEW`, or "
-                       "train it with a method without the prior (icef, warp, nerface)");
+  return Status::Error(
+      origin + ": the face-model prior needs the face model's " + std::to_string(want.size()) +
+      " expressions (jaw_open, smile_left, ...; docs/face_model.md), but expression_names are [" +
+      (got.empty() ? std::string("none") : got) +
+      "]: re-express the dataset in them with `icef track DATASET --keep-cameras --out NEW`, or "
+      "train it with a method without the prior (icef, warp, nerface)");
 }
 
 Result<face::FaceFit> FitFaceModelToDataset(const Dataset& dataset, const face::FaceFitOptions& options) {
@@ -158,9 +162,10 @@ Result<face::FaceFit> FitFaceModelToDataset(const Dataset& dataset, const face::
     frames.push_back(std::move(ff));
   }
   if (frames.empty())
-    return Status::Error(dataset.root.string() +
-                         ": the face-model fit needs landmarks (landmarks_3d or landmarks_2d) on the training frames; "
-                         "add them with `icef landmarks`");
+    return Status::Error(
+        dataset.root.string() +
+        ": the face-model fit needs landmarks (landmarks_3d or landmarks_2d) on the training frames; "
+        "add them with `icef landmarks`");
   Result<face::FaceFit> fit = face::FitFaceModel(frames, options);
   if (!fit.ok()) return fit.status().WithContext(dataset.root.string());
   return fit;
@@ -168,7 +173,8 @@ Result<face::FaceFit> FitFaceModelToDataset(const Dataset& dataset, const face::
 
 Result<std::unique_ptr<DeformationPrior>> MakeFacePrior(const ModelSetup& setup) {
   ICEF_RETURN_IF_ERROR(CheckFaceModelExpressions(setup.expression_names, "model setup"));
-  if (!setup.face_fit) return Status::Error("model setup: the face-model prior needs a face-model fit (none saved)");
+  if (!setup.face_fit)
+    return Status::Error("model setup: the face-model prior needs a face-model fit (none saved)");
   return std::unique_ptr<DeformationPrior>(std::make_unique<FacePrior>(*setup.face_fit));
 }
 

@@ -19,7 +19,8 @@ namespace icef {
 Status CheckFaceModelExpressions(const std::vector<std::string>& expression_names, const std::string& origin);
 
 // Fits the face model to the dataset's training frames (landmarks_3d, else landmarks_2d and the
-// cameras); options.fit_style fits the subject's expression style too. Errors: another expression space, frames without landmarks, a failed fit.
+// cameras); options.fit_style fits the subject's expression style too. Errors: another expression space,
+// frames without landmarks, a failed fit.
 Result<face::FaceFit> FitFaceModelToDataset(const Dataset& dataset, const face::FaceFitOptions& options = {});
 
 // The prior of setup.face_fit. Errors: no face-model fit, another expression space.

@@ -37,7 +37,8 @@ inline float BoundaryWeight(float m) { return 4.f * m * (1.f - m); }
 // offsets [2m, 3]: rows 0..m-1 at x_j, rows m..2m-1 at x_j + eps e_j (e_j in half-extent units);
 // weights [m] = w_b; half[a] = half-extent. d_offsets [2m, 3] is OVERWRITTEN.
 template <typename T>
-T SmoothnessLoss(int64_t m, const T* offsets, const float* weights, const T half[3], T eps, T scale, T* d_offsets) {
+T SmoothnessLoss(int64_t m, const T* offsets, const float* weights, const T half[3], T eps, T scale,
+                 T* d_offsets) {
   if (m == 0) return T(0);
   T loss = T(0);
   const T g_scale = scale * T(6) / (T(m) * eps * eps);

@@ -120,9 +120,11 @@ class DistortionTerm final : public Loss {
     for (int64_t r = 0; r < num_rays; ++r) {
       const int64_t off = ws.samples.ray_offset[r], cnt = ws.samples.ray_count[r];
       if (cnt == 0) continue;
-      dist += DistortionLossRay<float>(cnt, &ws.composite.weights[off], &ws.samples.t[off], &ws.samples.dt[off]);
-      DistortionLossRayBackward<float>(cnt, &ws.composite.weights[off], &ws.samples.t[off], &ws.samples.dt[off],
-                                       static_cast<float>(weight * inv_r * inv_diag), &ws.d_weights[off]);
+      dist +=
+          DistortionLossRay<float>(cnt, &ws.composite.weights[off], &ws.samples.t[off], &ws.samples.dt[off]);
+      DistortionLossRayBackward<float>(cnt, &ws.composite.weights[off], &ws.samples.t[off],
+                                       &ws.samples.dt[off], static_cast<float>(weight * inv_r * inv_diag),
+                                       &ws.d_weights[off]);
     }
     return dist * inv_r * inv_diag;
   }
@@ -153,8 +155,9 @@ class DepthPriorTerm final : public Loss {
       const float target = ctx.batch.depth_target[r];
       const int64_t off = ws.samples.ray_offset[r], cnt = ws.samples.ray_count[r];
       if (!std::isfinite(target) || cnt == 0) continue;
-      loss += DepthMomentLossRay<float>(static_cast<int>(cnt), &ws.composite.weights[off], &ws.samples.t[off], target,
-                                        shape, scale, &ws.d_weights[off]) * inv_diag * inv_diag;
+      loss += DepthMomentLossRay<float>(static_cast<int>(cnt), &ws.composite.weights[off], &ws.samples.t[off],
+                                        target, shape, scale, &ws.d_weights[off]) *
+              inv_diag * inv_diag;
     }
     return loss * inv_r;
   }
@@ -181,7 +184,8 @@ class OcclusionTerm final : public Loss {
     for (int64_t r = 0; r < num_rays; ++r) {
       const int64_t off = ws.samples.ray_offset[r], cnt = ws.samples.ray_count[r];
       occ += OcclusionLossRay<float>(static_cast<int>(cnt), &ws.composite.weights[off], &ws.sigma[off],
-                                     &ws.samples.dt[off], scale, &ws.d_sigma[off], region ? region + off : nullptr);
+                                     &ws.samples.dt[off], scale, &ws.d_sigma[off],
+                                     region ? region + off : nullptr);
     }
     return occ * inv_r;
   }
@@ -220,9 +224,11 @@ double SymmetryTerm::Evaluate(LossContext& ctx, double weight) {
   ws.sym_index.clear();
   if (m <= 0) return 0.0;
   Fit(ws.sym_index, m);
-  for (auto* v : {&ws.sym_positions, &ws.sym_dirs, &ws.sym_rgb_a, &ws.sym_rgb_b, &ws.sym_d_rgb_a, &ws.sym_d_rgb_b})
+  for (auto* v :
+       {&ws.sym_positions, &ws.sym_dirs, &ws.sym_rgb_a, &ws.sym_rgb_b, &ws.sym_d_rgb_a, &ws.sym_d_rgb_b})
     Fit(*v, 3 * m);
-  for (auto* v : {&ws.sym_sigma_a, &ws.sym_sigma_b, &ws.sym_dt, &ws.sym_d_sigma_a, &ws.sym_d_sigma_b}) Fit(*v, m);
+  for (auto* v : {&ws.sym_sigma_a, &ws.sym_sigma_b, &ws.sym_dt, &ws.sym_d_sigma_a, &ws.sym_d_sigma_b})
+    Fit(*v, m);
   const SymmetryPlane& plane = *ctx.symmetry;
   for (int64_t j = 0; j < m; ++j) {
     const int64_t i = j * n / m;
@@ -240,11 +246,10 @@ double SymmetryTerm::Evaluate(LossContext& ctx, double weight) {
   const bool warp = ctx.warp != nullptr;
   ctx.static_field.Forward(ctx.executor, m, ws.sym_positions.data(), ws.sym_dirs.data(), nullptr,
                            ws.sym_sigma_b.data(), ws.sym_rgb_b.data(), &ws.sym_ctx, true, warp);
-  const double loss = SymmetryLoss<float>(m, ws.sym_sigma_a.data(), ws.sym_rgb_a.data(), ws.sym_sigma_b.data(),
-                                          ws.sym_rgb_b.data(), ws.sym_dt.data(),
-                                          static_cast<float>(ctx.weights.symmetry_colour), static_cast<float>(weight),
-                                          ws.sym_d_sigma_a.data(), ws.sym_d_rgb_a.data(), ws.sym_d_sigma_b.data(),
-                                          ws.sym_d_rgb_b.data());
+  const double loss = SymmetryLoss<float>(
+      m, ws.sym_sigma_a.data(), ws.sym_rgb_a.data(), ws.sym_sigma_b.data(), ws.sym_rgb_b.data(),
+      ws.sym_dt.data(), static_cast<float>(ctx.weights.symmetry_colour), static_cast<float>(weight),
+      ws.sym_d_sigma_a.data(), ws.sym_d_rgb_a.data(), ws.sym_d_sigma_b.data(), ws.sym_d_rgb_b.data());
   // The original samples' share joins the main backward pass; the mirror images get their own.
   for (int64_t j = 0; j < m; ++j) {
     const int64_t i = ws.sym_index[j];
@@ -252,8 +257,9 @@ double SymmetryTerm::Evaluate(LossContext& ctx, double weight) {
     for (int a = 0; a < 3; ++a) ws.d_rgb[3 * i + a] += ws.sym_d_rgb_a[3 * j + a];
   }
   if (warp) Fit(ws.sym_d_positions, 3 * m);
-  ctx.static_field.Backward(ctx.executor, m, ws.sym_sigma_b.data(), ws.sym_rgb_b.data(), ws.sym_d_sigma_b.data(),
-                            ws.sym_d_rgb_b.data(), &ws.sym_ctx, warp ? ws.sym_d_positions.data() : nullptr);
+  ctx.static_field.Backward(ctx.executor, m, ws.sym_sigma_b.data(), ws.sym_rgb_b.data(),
+                            ws.sym_d_sigma_b.data(), ws.sym_d_rgb_b.data(), &ws.sym_ctx,
+                            warp ? ws.sym_d_positions.data() : nullptr);
   return loss;
 }
 
@@ -291,7 +297,9 @@ class SmoothTerm final : public Loss {
  public:
   std::string_view name() const override { return "smooth"; }
   LossStage stage() const override { return LossStage::kResidual; }
-  double Weight(const LossContext& ctx) const override { return IdentityWeight(ctx, ctx.weights.lambda_smooth); }
+  double Weight(const LossContext& ctx) const override {
+    return IdentityWeight(ctx, ctx.weights.lambda_smooth);
+  }
   double Evaluate(LossContext& ctx, double weight) override;
 };
 
@@ -315,22 +323,24 @@ double SmoothTerm::Evaluate(LossContext& ctx, double weight) {
   for (int64_t j = 0; j < m; ++j) {
     const int64_t i = ws.smooth_index[j * avail / m];  // even stride over the boundary samples
     Rng rng(ctx.seed, StreamId("smooth_direction"), uint64_t(ctx.step), uint64_t(j));
-    Vec3f u(static_cast<float>(rng.Normal()), static_cast<float>(rng.Normal()), static_cast<float>(rng.Normal()));
+    Vec3f u(static_cast<float>(rng.Normal()), static_cast<float>(rng.Normal()),
+            static_cast<float>(rng.Normal()));
     u /= std::max(u.norm(), 1e-6f);
     for (int a = 0; a < 3; ++a) {
       ws.smooth_positions[3 * j + a] = positions[3 * i + a];
       ws.smooth_positions[3 * (m + j) + a] = positions[3 * i + a] + eps * u[a] * half[a];
     }
     std::copy(ws.betas.begin() + i * b, ws.betas.begin() + (i + 1) * b, ws.smooth_betas.begin() + j * b);
-    std::copy(ws.betas.begin() + i * b, ws.betas.begin() + (i + 1) * b, ws.smooth_betas.begin() + (m + j) * b);
+    std::copy(ws.betas.begin() + i * b, ws.betas.begin() + (i + 1) * b,
+              ws.smooth_betas.begin() + (m + j) * b);
     ws.smooth_weight[j] = BoundaryWeight(mask[i]);
   }
   DeformationField& field = *ctx.residual_field;
-  field.Forward(ctx.executor, 2 * m, ws.smooth_positions.data(), ws.smooth_betas.data(), ws.smooth_offsets.data(),
-                &ws.smooth_ctx, true);
+  field.Forward(ctx.executor, 2 * m, ws.smooth_positions.data(), ws.smooth_betas.data(),
+                ws.smooth_offsets.data(), &ws.smooth_ctx, true);
   const float half_arr[3] = {half.x(), half.y(), half.z()};
-  const double loss = SmoothnessLoss<float>(m, ws.smooth_offsets.data(), ws.smooth_weight.data(), half_arr, eps,
-                                            static_cast<float>(weight), ws.smooth_d_offsets.data());
+  const double loss = SmoothnessLoss<float>(m, ws.smooth_offsets.data(), ws.smooth_weight.data(), half_arr,
+                                            eps, static_cast<float>(weight), ws.smooth_d_offsets.data());
   field.Backward(ctx.executor, 2 * m, ws.smooth_d_offsets.data(), &ws.smooth_ctx);
   return loss;
 }

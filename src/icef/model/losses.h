@@ -32,21 +32,22 @@ namespace icef {
 // it where the method or the batch has nothing for it to act on.
 struct LossWeights {
   double lambda_id = 0.0;
-  double lambda_id_prior = 0.0;      // L_id's weight for the methods on the face-model prior (L_id on R_phi)
+  double lambda_id_prior = 0.0;  // L_id's weight for the methods on the face-model prior (L_id on R_phi)
   double lambda_smooth = 0.0;
   double lambda_mask = 0.0;
   double lambda_distortion = 0.0;
   double lambda_occlusion = 0.0;
-  double lambda_occlusion_prior = 0.0;  // L_occ's weight for the methods on the face-model prior
+  double lambda_occlusion_prior = 0.0;      // L_occ's weight for the methods on the face-model prior
   bool occlusion_prior_in_regions = false;  // there, L_occ inside the expression regions only (times M)
   double lambda_symmetry = 0.0;
-  double lambda_depth_prior = 0.0;   // L_depth: rays with a face-model depth (TrainRays::depth_target)
-  double depth_prior_window = 0.0;   // L_depth's window half-width about t*, aabb diagonals (0: none; render/depth_loss.h)
-  double depth_prior_reach = 0.0;    // L_depth's reach behind t*, aabb diagonals (0: none; render/depth_loss.h)
-  double symmetry_colour = 0.0;      // weight of the colour part of L_sym (model/symmetry_loss.h)
-  int symmetry_max_samples = 4096;   // cap on the samples mirrored by L_sym per batch
-  double smooth_epsilon = 0.01;      // finite-difference offset of L_smooth, in half-extent units of the aabb
-  int smooth_max_samples = 4096;     // cap on boundary samples used by L_smooth per batch
+  double lambda_depth_prior = 0.0;  // L_depth: rays with a face-model depth (TrainRays::depth_target)
+  double depth_prior_window =
+      0.0;  // L_depth's window half-width about t*, aabb diagonals (0: none; render/depth_loss.h)
+  double depth_prior_reach = 0.0;  // L_depth's reach behind t*, aabb diagonals (0: none; render/depth_loss.h)
+  double symmetry_colour = 0.0;    // weight of the colour part of L_sym (model/symmetry_loss.h)
+  int symmetry_max_samples = 4096;  // cap on the samples mirrored by L_sym per batch
+  double smooth_epsilon = 0.01;     // finite-difference offset of L_smooth, in half-extent units of the aabb
+  int smooth_max_samples = 4096;    // cap on boundary samples used by L_smooth per batch
 };
 
 // One term's share of a batch's loss.
@@ -73,14 +74,14 @@ struct LossTerms {
 
 // A batch of training rays, each from a training frame with a known expression.
 struct TrainRays {
-  std::vector<Ray> rays;              // [R] world frame
-  std::vector<int32_t> frame;         // [R] training frame index (its expression is setup.training_expressions[k])
-  std::vector<float> target_rgb;      // [R, 3] composited over the background
-  std::vector<float> target_alpha;    // [R] foreground mask, or empty when the images have no alpha
-  std::vector<float> background;      // [R, 3] per-ray background the targets are composited over, or
-                                      // empty for setup.background
-  std::vector<float> depth_target;    // [R] ray parameter t where the fitted face model's surface is
-                                      // hit (train.lambda_depth_prior), NaN where there is none; or empty
+  std::vector<Ray> rays;       // [R] world frame
+  std::vector<int32_t> frame;  // [R] training frame index (its expression is setup.training_expressions[k])
+  std::vector<float> target_rgb;    // [R, 3] composited over the background
+  std::vector<float> target_alpha;  // [R] foreground mask, or empty when the images have no alpha
+  std::vector<float> background;    // [R, 3] per-ray background the targets are composited over, or
+                                    // empty for setup.background
+  std::vector<float> depth_target;  // [R] ray parameter t where the fitted face model's surface is
+                                    // hit (train.lambda_depth_prior), NaN where there is none; or empty
   // Rays [0, photo_rays) are pixels of the training images, with colour (and alpha) targets; the
   // rays after them look at the head from unseen views and carry a depth_target alone
   // (train.depth_prior_views): L_photo and L_mask skip them. -1: every ray is a pixel.

@@ -18,7 +18,8 @@ namespace {
 using testing_model::TinyModelConfig;
 using testing_model::TinySetup;
 
-const std::vector<std::string> kTerms = {"photo", "mask", "distortion", "depth", "occlusion", "symmetry", "id", "smooth"};
+const std::vector<std::string> kTerms = {"photo",     "mask",     "distortion", "depth",
+                                         "occlusion", "symmetry", "id",         "smooth"};
 
 // coarse: a coarse grid, visible opacities and a field with structure (random offsets on every
 // parameter), as the finite-difference checks need (see symmetry_loss_test.cc).

@@ -28,12 +28,12 @@ namespace icef {
 enum class Method { kIcef, kIcefNoId, kIcefNoConf, kIcefUniform, kWarp, kNerface, kIcefPrior, kWarpPrior };
 
 struct MethodTraits {
-  bool deformation = true;       // observation -> canonical warp D_phi
-  bool identity_losses = true;   // L_id and L_smooth active (their lambdas apply)
-  bool confidence = true;        // kappa-weighted blend with the linearised warp at inference
-  bool entangled_beta = false;   // beta fed into the static field (NerFace-style)
-  bool uniform_mask = false;     // L_id with M = 0 everywhere instead of the landmark mask
-  bool prior = false;            // the fitted face model's warp P under the learned residual
+  bool deformation = true;      // observation -> canonical warp D_phi
+  bool identity_losses = true;  // L_id and L_smooth active (their lambdas apply)
+  bool confidence = true;       // kappa-weighted blend with the linearised warp at inference
+  bool entangled_beta = false;  // beta fed into the static field (NerFace-style)
+  bool uniform_mask = false;    // L_id with M = 0 everywhere instead of the landmark mask
+  bool prior = false;           // the fitted face model's warp P under the learned residual
 };
 
 MethodTraits TraitsOf(Method method);
@@ -42,6 +42,8 @@ const char* MethodName(Method method);
 Result<Method> ParseMethod(const std::string& name);
 const std::vector<Method>& AllMethods();
 // True for the methods that need the face-model fit (ModelSetup::face_fit).
-inline bool UsesFacePrior(Method method) { return method == Method::kIcefPrior || method == Method::kWarpPrior; }
+inline bool UsesFacePrior(Method method) {
+  return method == Method::kIcefPrior || method == Method::kWarpPrior;
+}
 
 }  // namespace icef

@@ -111,17 +111,23 @@ void ModelConfig::Bind(ConfigSchema& s) {
   s.Block("region_mask", [this](ConfigSchema& b) { BindRegionMask(b, &region_mask); });
   s.Block("visual_hull", [this](ConfigSchema& b) { BindVisualHull(b, &visual_hull); });
   s.Block("sampler", [this](ConfigSchema& b) {
-    b.Int("num_samples", &sampler.num_samples,
-          "samples per training ray over the ray/aabb interval, one per jittered stratum (fewer, deeper strata smear "
-          "the face's colour along the training rays and blur every other view: 48 did, and 96 still a little; "
-          "docs/results/sampler_samples)");
+    b.Int(
+        "num_samples", &sampler.num_samples,
+        "samples per training ray over the ray/aabb interval, one per jittered stratum (fewer, deeper strata "
+        "smear "
+        "the face's colour along the training rays and blur every other view: 48 did, and 96 still a little; "
+        "docs/results/sampler_samples)");
     b.Int("importance_samples", &importance.num_samples,
-          "training: fine samples per ray placed by the num_samples coarse samples' compositing weights (each coarse "
-          "stratum cut into as many sub-strata as its share of the weight; render/importance_sampler.h); 0 = train on "
-          "the coarse samples themselves. Measured on a validation identity: sharper but grainy, 0.5-1.7 dB below 144 "
+          "training: fine samples per ray placed by the num_samples coarse samples' compositing weights "
+          "(each coarse "
+          "stratum cut into as many sub-strata as its share of the weight; render/importance_sampler.h); 0 = "
+          "train on "
+          "the coarse samples themselves. Measured on a validation identity: sharper but grainy, 0.5-1.7 dB "
+          "below 144 "
           "stratified samples at the same cost; off by default (docs/results/importance_sampling)");
-    b.Float("importance_uniform", &importance.uniform,
-            "share of each ray's importance samples spread over its coarse strata by length rather than weight");
+    b.Float(
+        "importance_uniform", &importance.uniform,
+        "share of each ray's importance samples spread over its coarse strata by length rather than weight");
   });
   s.Block("occupancy", [this](ConfigSchema& b) { BindOccupancy(b, &occupancy); });
   s.Block("compositing", [this](ConfigSchema& b) {
@@ -130,16 +136,21 @@ void ModelConfig::Bind(ConfigSchema& s) {
              "render.transmittance_eps)");
   });
   s.Block("render", [this](ConfigSchema& b) { BindRender(b, &render); });
-  s.Bool("prior_shading", &prior_shading,
-         "icef-prior and warp-prior: scale each sample's colour by the change of light that the expression brings "
-         "to the face model's surface (its normal there against the neutral surface's at the canonical point), "
-         "under a light fitted to the training images' skin before training (field/prior_shading.h, "
-         "model/prior_light.h): the shading a warp of a static field cannot show");
-  s.Bool("prior_style", &prior_style,
-         "icef-prior and warp-prior: fit the subject's expression style (each expression's gain, the jaw hinge, the "
-         "smile's corner and the brows' shift; face/expression_style.h) with its shape to the training frames' "
-         "landmarks, each field with a prior around the face model's generic style; an expression no training frame "
-         "shows keeps the generic style");
+  s.Bool(
+      "prior_shading", &prior_shading,
+      "icef-prior and warp-prior: scale each sample's colour by the change of light that the expression "
+      "brings "
+      "to the face model's surface (its normal there against the neutral surface's at the canonical point), "
+      "under a light fitted to the training images' skin before training (field/prior_shading.h, "
+      "model/prior_light.h): the shading a warp of a static field cannot show");
+  s.Bool(
+      "prior_style", &prior_style,
+      "icef-prior and warp-prior: fit the subject's expression style (each expression's gain, the jaw hinge, "
+      "the "
+      "smile's corner and the brows' shift; face/expression_style.h) with its shape to the training frames' "
+      "landmarks, each field with a prior around the face model's generic style; an expression no training "
+      "frame "
+      "shows keeps the generic style");
   s.Bool("bf16_inference", &bf16_inference,
          "renders, evaluation and occupancy updates multiply in BF16 with FP32 sums on CPUs with AVX512-BF16 "
          "(about "

@@ -13,8 +13,8 @@
 #include "icef/io/config_schema.h"
 #include "icef/model/method.h"
 #include "icef/render/compositing.h"
-#include "icef/render/occupancy_grid.h"
 #include "icef/render/importance_sampler.h"
+#include "icef/render/occupancy_grid.h"
 #include "icef/render/ray_sampler.h"
 
 namespace icef {
@@ -50,7 +50,8 @@ struct VisualHullConfig {
 // Options fields that are not config keys (static_field.condition_dims, bf16_inference and bf16_training,
 // sampler.stratified) are filled in by the accessors below, which every user of the config calls.
 struct ModelConfig {
-  std::string method = "icef-prior";  // icef-prior | warp-prior | icef | icef-no-id | icef-no-conf | icef-uniform | warp | nerface
+  std::string method = "icef-prior";  // icef-prior | warp-prior | icef | icef-no-id | icef-no-conf |
+                                      // icef-uniform | warp | nerface
   StaticFieldOptions static_field;
   DeformationFieldOptions deformation;
   ConfidenceOptions confidence;

@@ -5,7 +5,8 @@
 namespace icef {
 
 Result<ModelSetup> ModelSetup::FromDataset(const Dataset& dataset, const Executor& executor) {
-  if (dataset.train.empty()) return Status::Error(dataset.root.string() + ": the dataset has no training frames");
+  if (dataset.train.empty())
+    return Status::Error(dataset.root.string() + ": the dataset has no training frames");
   ModelSetup s;
   s.aabb = dataset.aabb;
   s.expression_dim = dataset.expression_dim;
@@ -15,7 +16,8 @@ Result<ModelSetup> ModelSetup::FromDataset(const Dataset& dataset, const Executo
     s.training_cameras.push_back(f.camera);
   }
   s.background = dataset.background;
-  ICEF_ASSIGN_OR_RETURN(const RegionMask mask, RegionMask::FromDataset(dataset, RegionMaskOptions{}, executor));
+  ICEF_ASSIGN_OR_RETURN(const RegionMask mask,
+                        RegionMask::FromDataset(dataset, RegionMaskOptions{}, executor));
   s.mask_landmarks = mask.landmarks();
   s.mask_source = mask.source();
   return s;
@@ -36,9 +38,15 @@ Json ModelSetup::ToJson() const {
   for (const Camera& c : training_cameras) {
     const Intrinsics& k = c.intrinsics();
     Json m = Json::array();
-    for (int r = 0; r < 4; ++r) m.push_back({c.world_from_cam()(r, 0), c.world_from_cam()(r, 1), c.world_from_cam()(r, 2),
-                                             c.world_from_cam()(r, 3)});
-    cams.push_back({{"w", k.width}, {"h", k.height}, {"fl_x", k.fl_x}, {"fl_y", k.fl_y}, {"cx", k.cx}, {"cy", k.cy},
+    for (int r = 0; r < 4; ++r)
+      m.push_back({c.world_from_cam()(r, 0), c.world_from_cam()(r, 1), c.world_from_cam()(r, 2),
+                   c.world_from_cam()(r, 3)});
+    cams.push_back({{"w", k.width},
+                    {"h", k.height},
+                    {"fl_x", k.fl_x},
+                    {"fl_y", k.fl_y},
+                    {"cx", k.cx},
+                    {"cy", k.cy},
                     {"transform_matrix", m}});
   }
   j["training_cameras"] = cams;
@@ -55,9 +63,10 @@ Json ModelSetup::ToJson() const {
     for (const auto& [name, value] : f.style.Fields()) style[name] = value;
     j["face_fit"] = {{"shape", shape},
                      {"style", style},
-                     {"head_from_world", {{"scale", sim.scale},
-                                          {"rotation", rot},
-                                          {"translation", {sim.translation.x(), sim.translation.y(), sim.translation.z()}}}},
+                     {"head_from_world",
+                      {{"scale", sim.scale},
+                       {"rotation", rot},
+                       {"translation", {sim.translation.x(), sim.translation.y(), sim.translation.z()}}}},
                      {"rms_iod", f.rms_iod},
                      {"max_iod", f.max_iod},
                      {"landmarks_used", f.landmarks_used},

@@ -19,16 +19,16 @@
 namespace icef {
 
 struct ModelSetup {
-  Aabb aabb;                                          // world frame
+  Aabb aabb;  // world frame
   int expression_dim = 0;
-  std::vector<std::string> expression_names;          // [expression_dim] or empty
+  std::vector<std::string> expression_names;             // [expression_dim] or empty
   std::vector<std::vector<float>> training_expressions;  // [K][expression_dim]
-  std::vector<Vec3f> mask_landmarks;                  // [68] world frame
-  std::string mask_source;                            // where the landmarks came from
+  std::vector<Vec3f> mask_landmarks;                     // [68] world frame
+  std::string mask_source;                               // where the landmarks came from
   Vec3f background = Vec3f::Ones();
-  std::vector<Camera> training_cameras;               // [K] (renders default to their intrinsics and views)
-  std::optional<face::FaceFit> face_fit;              // the fitted face model (model/face_prior.h), if any
-  std::optional<Vec3f> prior_light;                   // the prior shading's light (model/prior_light.h), if fitted
+  std::vector<Camera> training_cameras;   // [K] (renders default to their intrinsics and views)
+  std::optional<face::FaceFit> face_fit;  // the fitted face model (model/face_prior.h), if any
+  std::optional<Vec3f> prior_light;       // the prior shading's light (model/prior_light.h), if fitted
 
   // From a loaded dataset's training split; the landmarks come from RegionMask::FromDataset's
   // rules (mean landmarks_3d, else triangulated landmarks_2d).

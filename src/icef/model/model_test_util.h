@@ -4,7 +4,6 @@
 #include <vector>
 
 #include "icef/core/rng.h"
-
 #include "icef/model/avatar_model.h"
 
 namespace icef::testing_model {
@@ -18,11 +17,13 @@ inline std::vector<Vec3f> FaceLandmarks() {
   }
   for (int i = 0; i < 5; ++i) p[17 + i] = Vec3f(-0.22f + 0.04f * i, 0.17f + 0.01f * (i % 2), 0.25f);  // brows
   for (int i = 0; i < 5; ++i) p[22 + i] = Vec3f(0.06f + 0.04f * i, 0.17f + 0.01f * (i % 2), 0.25f);
-  for (int i = 0; i < 9; ++i) p[27 + i] = Vec3f(0.f + 0.01f * (i - 4) * (i > 3), 0.1f - 0.04f * std::min(i, 4), 0.3f);
+  for (int i = 0; i < 9; ++i)
+    p[27 + i] = Vec3f(0.f + 0.01f * (i - 4) * (i > 3), 0.1f - 0.04f * std::min(i, 4), 0.3f);
   for (int e = 0; e < 2; ++e)  // eyes: 6-point loops
     for (int i = 0; i < 6; ++i) {
       const float a = float(M_PI) * i / 3.f;
-      p[36 + 6 * e + i] = Vec3f((e ? 0.11f : -0.11f) - 0.04f * std::cos(a), 0.1f + 0.015f * std::sin(a), 0.24f);
+      p[36 + 6 * e + i] =
+          Vec3f((e ? 0.11f : -0.11f) - 0.04f * std::cos(a), 0.1f + 0.015f * std::sin(a), 0.24f);
     }
   for (int i = 0; i < 12; ++i) {  // outer lip loop
     const float a = float(M_PI) * i / 6.f;
@@ -80,7 +81,8 @@ inline TrainRays RandomBatch(int rays, uint64_t seed, bool alpha = true, double 
   TrainRays batch;
   Rng rng(seed, StreamId("batch"));
   for (int r = 0; r < rays; ++r) {
-    const Vec3f o(static_cast<float>(rng.Uniform(-0.2, 0.2)), static_cast<float>(rng.Uniform(y_lo, 0.2)), 2.f);
+    const Vec3f o(static_cast<float>(rng.Uniform(-0.2, 0.2)), static_cast<float>(rng.Uniform(y_lo, 0.2)),
+                  2.f);
     batch.rays.push_back(Ray{o, Vec3f(0, 0, -1)});
     batch.frame.push_back(r % 3);
     for (int a = 0; a < 3; ++a) batch.target_rgb.push_back(static_cast<float>(rng.Uniform()));

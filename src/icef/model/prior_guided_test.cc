@@ -26,7 +26,8 @@ using testing_model::TinySetup;
 class TestPrior final : public DeformationPrior {
  public:
   explicit TestPrior(int dims) : dims_(dims) {}
-  void Offsets(const Executor&, int64_t n, const float* x, const float* betas, float* offsets) const override {
+  void Offsets(const Executor&, int64_t n, const float* x, const float* betas,
+               float* offsets) const override {
     for (int64_t i = 0; i < n; ++i) {
       const float* p = x + 3 * i;
       const float b0 = betas[i * dims_], b1 = dims_ > 1 ? betas[i * dims_ + 1] : 0.f;
@@ -35,7 +36,8 @@ class TestPrior final : public DeformationPrior {
       offsets[3 * i + 2] = 0.05f * b0 * p[0];
     }
   }
-  void Cavity(const Executor&, int64_t n, const float* x, const float* betas, uint8_t* inside) const override {
+  void Cavity(const Executor&, int64_t n, const float* x, const float* betas,
+              uint8_t* inside) const override {
     for (int64_t i = 0; i < n; ++i) {
       const Vec3f d = Vec3f(x[3 * i], x[3 * i + 1], x[3 * i + 2]) - Vec3f(0.f, -0.2f, 0.3f);
       inside[i] = d.norm() < 0.1f * betas[i * dims_] ? 1 : 0;
@@ -62,7 +64,8 @@ class TestPrior final : public DeformationPrior {
 
 // A light along +z with strength 1.5: the prior shading scales the colour where beta_0 tilts the
 // observed normal towards it. With shading = false (model.prior_shading off) nothing is shaded.
-std::unique_ptr<AvatarModel> MakePriorModel(const std::string& method, float deform_scale, bool shading = true,
+std::unique_ptr<AvatarModel> MakePriorModel(const std::string& method, float deform_scale,
+                                            bool shading = true,
                                             float density_bias = StaticFieldOptions{}.density_bias) {
   ModelConfig config = TinyModelConfig(method);
   config.deformation.output_init_scale = deform_scale;
@@ -70,7 +73,8 @@ std::unique_ptr<AvatarModel> MakePriorModel(const std::string& method, float def
   config.static_field.density_bias = density_bias;
   ModelSetup setup = TinySetup();
   setup.prior_light = Vec3f(0.f, 0.3f, 1.5f);
-  auto model = AvatarModel::Create(config, setup, Executor(2), std::make_unique<TestPrior>(setup.expression_dim));
+  auto model =
+      AvatarModel::Create(config, setup, Executor(2), std::make_unique<TestPrior>(setup.expression_dim));
   ICEF_CHECK(model.ok(), model.status().message());
   (*model)->Initialize(7);
   return std::move(model).value();
@@ -119,7 +123,8 @@ TEST(PriorGuidedTest, ZeroResidualIsThePriorAndCostsNoIdentityLoss) {
   const std::vector<float> x = RandomPoints(n, 3);
   const ModelSetup& setup = model->setup();
   TestPrior prior(setup.expression_dim);
-  for (const std::vector<float>& beta : {std::vector<float>{0.5f, 0.f, 0.f}, std::vector<float>{2.f, 1.f, 0.5f}}) {
+  for (const std::vector<float>& beta :
+       {std::vector<float>{0.5f, 0.f, 0.f}, std::vector<float>{2.f, 1.f, 0.5f}}) {
     std::vector<float> got(3 * n), want(3 * n), betas;
     model->Offsets(Executor(1), n, x.data(), beta, got.data());
     BroadcastExpression(beta, n, &betas);
@@ -208,7 +213,8 @@ TEST(PriorGuidedTest, ConfidenceBlendsOnlyTheResidual) {
   const std::vector<float> x = RandomPoints(n, 4);
   TestPrior prior(3);
   for (const std::vector<float>& beta :
-       {std::vector<float>{0.5f, 0.f, 0.f}, std::vector<float>{0.7f, 0.1f, 0.f}, std::vector<float>{2.f, 1.5f, 1.f}}) {
+       {std::vector<float>{0.5f, 0.f, 0.f}, std::vector<float>{0.7f, 0.1f, 0.f},
+        std::vector<float>{2.f, 1.5f, 1.f}}) {
     const double kappa = with_prior->Nearest(beta).kappa;
     std::vector<float> fin(3 * n), res(3 * n), p(3 * n), phi(3 * n), lin(3 * n), betas;
     with_prior->Offsets(Executor(1), n, x.data(), beta, fin.data());
@@ -248,8 +254,8 @@ TEST(PriorGuidedTest, MouthCavityColourIsLearned) {
   const float want[3] = {0.5f, 0.2f, 0.1f};
   for (int a = 0; a < 3; ++a) store.params(block)[a] = std::log(want[a] / (1.f - want[a]));
   RenderOutput open;
-  model->Render(std::vector<Ray>{Ray{Vec3f(0.f, -0.2f, 2.f), Vec3f(0, 0, -1)}}, std::vector<float>{1.5f, 0.f, 0.f},
-                Vec3f::Ones(), Executor(1), &open);
+  model->Render(std::vector<Ray>{Ray{Vec3f(0.f, -0.2f, 2.f), Vec3f(0, 0, -1)}},
+                std::vector<float>{1.5f, 0.f, 0.f}, Vec3f::Ones(), Executor(1), &open);
   ASSERT_GT(open.opacity[0], 0.99f);
   for (int a = 0; a < 3; ++a) EXPECT_NEAR(open.color[a], want[a], 0.03f) << a;
 
@@ -286,7 +292,8 @@ TEST(PriorGuidedTest, PriorShadingScalesTheColourByTheLightOnTheTurnedSurface) {
   auto plain = MakePriorModel("icef-prior", 0.01f, false, -1.f);
   ASSERT_TRUE(shaded->prior_light().has_value());
   EXPECT_FALSE(plain->prior_light().has_value());
-  const std::vector<Ray> rays = {Ray{Vec3f(0.1f, 0.05f, 2.f), Vec3f(0, 0, -1)}, Ray{Vec3f(-0.2f, 0.1f, 2.f), Vec3f(0, 0, -1)}};
+  const std::vector<Ray> rays = {Ray{Vec3f(0.1f, 0.05f, 2.f), Vec3f(0, 0, -1)},
+                                 Ray{Vec3f(-0.2f, 0.1f, 2.f), Vec3f(0, 0, -1)}};
   for (float b0 : {0.f, 0.6f}) {
     const std::vector<float> beta = {b0, 0.f, 0.f};
     RenderOutput a, b;
@@ -565,10 +572,13 @@ TEST_P(FittedPriorTest, MatchesTheGeneratingHeadsWarp) {
   for (int k = 0; k < 5; ++k) {
     face::FitFrame f;
     f.expression.assign(face::kNumExpressions, 0.f);
-    for (float& v : f.expression) v = rng.UniformDouble() < 0.4 ? static_cast<float>(rng.Uniform(0.0, 0.9)) : 0.f;
+    for (float& v : f.expression)
+      v = rng.UniformDouble() < 0.4 ? static_cast<float>(rng.Uniform(0.0, 0.9)) : 0.f;
     std::vector<Vec3f> world;
     for (const Vec3f& p : truth.Landmarks(truth.Prepare(f.expression)))
-      world.push_back(s.ApplyInverse(p.cast<double>() + 0.002 * Vec3d(rng.Normal(), rng.Normal(), rng.Normal())).cast<float>());
+      world.push_back(
+          s.ApplyInverse(p.cast<double>() + 0.002 * Vec3d(rng.Normal(), rng.Normal(), rng.Normal()))
+              .cast<float>());
     f.landmarks_3d = world;
     frames.push_back(std::move(f));
   }
@@ -613,7 +623,8 @@ TEST_P(FittedPriorTest, MatchesTheGeneratingHeadsWarp) {
     double worst = 0, motion = 0;
     for (int64_t i = 0; i < n; ++i) {
       const Vec3d xw(x[3 * i], x[3 * i + 1], x[3 * i + 2]);
-      const Vec3d want = s.ApplyInverse(truth.PriorWarp(s.Apply(xw).cast<float>(), state).cast<double>()) - xw;
+      const Vec3d want =
+          s.ApplyInverse(truth.PriorWarp(s.Apply(xw).cast<float>(), state).cast<double>()) - xw;
       const Vec3d have(got[3 * i], got[3 * i + 1], got[3 * i + 2]);
       worst = std::max(worst, (have - want).norm() / iod_world);
       motion = std::max(motion, want.norm() / iod_world);
@@ -642,7 +653,8 @@ TEST(FacePriorTest, ShadingNormalsAreTheNeutralNormalCarriedThroughTheWarp) {
   face::FaceFit fit;
   fit.shape = shape;
   fit.head_from_world.scale = 1.3;
-  fit.head_from_world.rotation = Eigen::AngleAxisd(0.5, Vec3d(0.2, 1.0, -0.3).normalized()).toRotationMatrix();
+  fit.head_from_world.rotation =
+      Eigen::AngleAxisd(0.5, Vec3d(0.2, 1.0, -0.3).normalized()).toRotationMatrix();
   fit.head_from_world.translation = Vec3d(0.05, -0.1, 0.2);
   setup.face_fit = fit;
   Result<std::unique_ptr<DeformationPrior>> made = MakeFacePrior(setup);
@@ -686,13 +698,14 @@ TEST(FacePriorTest, ShadingNormalsAreTheNeutralNormalCarriedThroughTheWarp) {
     turned = std::max<double>(turned, angle_deg(observed[i], canonical[i]));
   }
   EXPECT_LT(worst, 2.0);   // the expressed model's own normal (measured 0.6 degrees; 21 with J for J^T)
-  EXPECT_GT(turned, 5.0);   // and the expression does turn the surface (10 degrees)
+  EXPECT_GT(turned, 5.0);  // and the expression does turn the surface (10 degrees)
 
   // Where the expression moves nothing (the crown, the back of the head: jaw and mouth only), and at
   // neutral everywhere, the two normals agree.
   std::vector<float> mouth_only(face::kNumExpressions, 0.f);
   mouth_only[face::kJawOpen] = 1.f, mouth_only[face::kLipPucker] = 0.8f;
-  const std::vector<Vec3f> far_away = {Vec3f(0.f, 0.388f, 0.f), Vec3f(0.1f, 0.3f, -0.2f), Vec3f(-0.2f, 0.2f, -0.25f)};
+  const std::vector<Vec3f> far_away = {Vec3f(0.f, 0.388f, 0.f), Vec3f(0.1f, 0.3f, -0.2f),
+                                       Vec3f(-0.2f, 0.2f, -0.25f)};
   normals(far_away, mouth_only, &observed, &canonical);
   for (size_t i = 0; i < far_away.size(); ++i) EXPECT_LT(angle_deg(observed[i], canonical[i]), 0.05) << i;
   normals(points, std::vector<float>(face::kNumExpressions, 0.f), &observed, &canonical);
@@ -706,7 +719,8 @@ TEST(FacePriorTest, AnotherExpressionSpacePointsToTheTracker) {
   const Status s = CheckFaceModelExpressions({"e0", "e1"}, "data/nerface");
   ASSERT_FALSE(s.ok());
   EXPECT_EQ(s.message().find('\n'), std::string::npos);
-  for (const char* want : {"data/nerface", "[e0, e1]", "icef track DATASET --keep-cameras --out NEW", "icef, warp"})
+  for (const char* want :
+       {"data/nerface", "[e0, e1]", "icef track DATASET --keep-cameras --out NEW", "icef, warp"})
     EXPECT_NE(s.message().find(want), std::string::npos) << want << " in " << s.message();
 }
 
@@ -717,7 +731,8 @@ TEST(FacePriorTest, SetupJsonKeepsTheFit) {
   fit.head_from_world.scale = 1.5;
   fit.head_from_world.rotation = Eigen::AngleAxisd(0.4, Vec3d::UnitY()).toRotationMatrix();
   fit.head_from_world.translation = Vec3d(0.1, 0.2, 0.3);
-  fit.rms_iod = 0.01, fit.max_iod = 0.03, fit.landmarks_used = 300, fit.landmarks_total = 340, fit.iterations = 7;
+  fit.rms_iod = 0.01, fit.max_iod = 0.03, fit.landmarks_used = 300, fit.landmarks_total = 340,
+  fit.iterations = 7;
   fit.style.jaw_gain = 0.75f, fit.style.smile_gain[1] = 1.2f, fit.style.jaw_hinge_dz = -0.02f;
   setup.face_fit = fit;
   setup.prior_light = Vec3f(-0.5f, 0.75f, 1.25f);

@@ -34,7 +34,8 @@ struct ShadingResidual {
 
 // The skin pixels of one frame (every `stride`-th pixel in each direction).
 std::vector<SkinPixel> SkinPixels(const Frame& frame, const Image& image, const face::FaceModel& model,
-                                  const face::Similarity& head_from_world, int stride, const Executor& executor) {
+                                  const face::Similarity& head_from_world, int stride,
+                                  const Executor& executor) {
   const Camera& camera = frame.camera;
   std::vector<float> beta(frame.expression);
   for (float& b : beta) b = std::isfinite(b) ? std::max(b, 0.f) : 0.f;
@@ -77,7 +78,8 @@ std::vector<SkinPixel> SkinPixels(const Frame& frame, const Image& image, const 
             c.z() < face_lo.z())
           continue;
         const Vec3f n_head = model.Normal(p, state);
-        if (-n_head.dot(ray.direction) < 0.3f) continue;  // grazing: the silhouette, where the fit is least sure
+        if (-n_head.dot(ray.direction) < 0.3f)
+          continue;  // grazing: the silhouette, where the fit is least sure
         SkinPixel s;
         s.normal = rot.transpose() * n_head;
         for (int a = 0; a < 3; ++a) s.color[a] = image.At(x, y, a);
@@ -101,8 +103,10 @@ std::string PriorLightFit::BriefReport() const {
   return os.str();
 }
 
-Result<PriorLightFit> FitPriorLight(const Dataset& dataset, const face::FaceFit& fit, const Executor& executor) {
-  if (dataset.train.empty()) return Status::Error(dataset.root.string() + ": no training frames to fit the light to");
+Result<PriorLightFit> FitPriorLight(const Dataset& dataset, const face::FaceFit& fit,
+                                    const Executor& executor) {
+  if (dataset.train.empty())
+    return Status::Error(dataset.root.string() + ": no training frames to fit the light to");
   const face::FaceModel model(fit.shape, fit.style);
   std::vector<SkinPixel> pixels;
   for (const Frame& frame : dataset.train) {
@@ -133,8 +137,9 @@ Result<PriorLightFit> FitPriorLight(const Dataset& dataset, const face::FaceFit&
     std::array<double, 3> v{start.x(), start.y(), start.z()};
     ceres::Problem problem;
     for (const SkinPixel& p : pixels)
-      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<ShadingResidual, 3, 3, 3>(new ShadingResidual{p}),
-                               new ceres::HuberLoss(0.05), rho.data(), v.data());
+      problem.AddResidualBlock(
+          new ceres::AutoDiffCostFunction<ShadingResidual, 3, 3, 3>(new ShadingResidual{p}),
+          new ceres::HuberLoss(0.05), rho.data(), v.data());
     ceres::Solver::Options options;
     options.max_num_iterations = 50;
     options.num_threads = 1;  // the same result for any thread count

@@ -21,15 +21,16 @@
 namespace icef {
 
 struct PriorLightFit {
-  Vec3f light = Vec3f::Zero();    // v, world frame
-  Vec3f albedo = Vec3f::Zero();   // rho
-  int pixels = 0;                 // skin pixels used
-  double rms = 0;                 // RMS colour residual (per RGB value)
+  Vec3f light = Vec3f::Zero();   // v, world frame
+  Vec3f albedo = Vec3f::Zero();  // rho
+  int pixels = 0;                // skin pixels used
+  double rms = 0;                // RMS colour residual (per RGB value)
   std::string BriefReport() const;
 };
 
 // Errors: no training frame, an unreadable image, fewer than 100 face-skin pixels (icef train then
 // trains without the prior shading and says so).
-Result<PriorLightFit> FitPriorLight(const Dataset& dataset, const face::FaceFit& fit, const Executor& executor);
+Result<PriorLightFit> FitPriorLight(const Dataset& dataset, const face::FaceFit& fit,
+                                    const Executor& executor);
 
 }  // namespace icef

@@ -3,12 +3,11 @@
 #include "icef/model/prior_light.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-
-#include <unistd.h>
 
 #include "icef/model/face_prior.h"
 #include "icef/synth/synthesize.h"
@@ -21,7 +20,8 @@ namespace fs = std::filesystem;
 // A K = 4 dataset at 64 px lit by `light` (head frame = world frame in the classic scene), its face
 // fit and light fit.
 Result<PriorLightFit> FitSynthetic(const Vec3f& light, uint64_t seed, const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("icef_prior_light_test_" + name + "_" + std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("icef_prior_light_test_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   synth::SynthOptions o;
   o.out_dir = dir;
@@ -48,7 +48,8 @@ TEST(PriorLightTest, RecoversTheKeyLightOfSyntheticHeads) {
     const Vec3f want = strength * dir.normalized();
     const Result<PriorLightFit> fit = FitSynthetic(dir, 3, dir.x() < 0 ? "left" : "right");
     ASSERT_TRUE(fit.ok()) << fit.status().message();
-    const double angle = std::acos(std::clamp(double(fit->light.normalized().dot(want.normalized())), -1.0, 1.0));
+    const double angle =
+        std::acos(std::clamp(double(fit->light.normalized().dot(want.normalized())), -1.0, 1.0));
     EXPECT_LT(angle * 180 / M_PI, 15.0) << fit->BriefReport();
     EXPECT_GT(fit->light.norm(), 0.7 * strength) << fit->BriefReport();
     EXPECT_LT(fit->light.norm(), 1.4 * strength) << fit->BriefReport();

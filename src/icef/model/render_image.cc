@@ -7,7 +7,8 @@
 namespace icef {
 
 RenderedImage RenderImage(const AvatarModel& model, const Camera& camera, std::span<const float> beta,
-                          const Vec3f& background, const Executor& executor, RenderOccupancyMode occupancy_mode) {
+                          const Vec3f& background, const Executor& executor,
+                          RenderOccupancyMode occupancy_mode) {
   std::optional<OccupancyGrid> occupancy;
   if (occupancy_mode == RenderOccupancyMode::kExpression) occupancy = model.RenderOccupancy(beta, executor);
   const int w = camera.width(), h = camera.height();
@@ -32,7 +33,8 @@ RenderedImage RenderImage(const AvatarModel& model, const Camera& camera, std::s
     for (int j = j0; j < j1; ++j)
       for (int i = 0; i < w; ++i)
         for (int q = 0; q < s2; ++q)
-          rays[(size_t(j - j0) * w + i) * s2 + q] = camera.RayThrough(i + (q % s + 0.5) / s, j + (q / s + 0.5) / s);
+          rays[(size_t(j - j0) * w + i) * s2 + q] =
+              camera.RayThrough(i + (q % s + 0.5) / s, j + (q / s + 0.5) / s);
     model.Render(rays, beta, background, executor, &out, occupancy ? &*occupancy : nullptr);
     img.samples_evaluated += out.samples_evaluated;
     const size_t first = size_t(j0) * w, pixels = size_t(j1 - j0) * w;
@@ -61,9 +63,11 @@ Image ColorizeScalar(const Image& scalar, float lo, float hi) {
     if (!(hi > lo)) hi = lo + 1.f;
   }
   // Five control points of viridis.
-  static const float kMap[5][3] = {
-      {0.267f, 0.005f, 0.329f}, {0.230f, 0.322f, 0.546f}, {0.128f, 0.567f, 0.551f}, {0.369f, 0.789f, 0.383f},
-      {0.993f, 0.906f, 0.144f}};
+  static const float kMap[5][3] = {{0.267f, 0.005f, 0.329f},
+                                   {0.230f, 0.322f, 0.546f},
+                                   {0.128f, 0.567f, 0.551f},
+                                   {0.369f, 0.789f, 0.383f},
+                                   {0.993f, 0.906f, 0.144f}};
   Image out(scalar.width, scalar.height, 3);
   for (size_t p = 0; p < scalar.pixels.size(); ++p) {
     const float t = std::clamp((scalar.pixels[p] - lo) / (hi - lo), 0.f, 1.f) * 4.f;

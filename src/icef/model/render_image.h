@@ -11,12 +11,12 @@
 namespace icef {
 
 struct RenderedImage {
-  Image color;        // RGB over the background
-  Image depth;        // 1 channel, expected depth (world units; 0 where nothing is hit)
-  Image opacity;      // 1 channel
-  Image mask;         // 1 channel: expected region mask M along each ray
-  Image deformation;  // 1 channel: expected ||D_final(x) - x|| (world units)
-  NearestExpression nearest;  // beta_n, delta, kappa of the expression
+  Image color;                    // RGB over the background
+  Image depth;                    // 1 channel, expected depth (world units; 0 where nothing is hit)
+  Image opacity;                  // 1 channel
+  Image mask;                     // 1 channel: expected region mask M along each ray
+  Image deformation;              // 1 channel: expected ||D_final(x) - x|| (world units)
+  NearestExpression nearest;      // beta_n, delta, kappa of the expression
   int64_t samples_evaluated = 0;  // field evaluations (all sub-pixel rays)
 };
 

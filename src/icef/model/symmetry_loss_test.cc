@@ -57,11 +57,12 @@ TEST(SymmetryLossTest, GradientsMatchFiniteDifferences) {
   for (uint64_t seed = 2; seed < 5; ++seed) {
     const Inputs in = RandomInputs(m, seed);
     std::vector<double> ds_a(m), dc_a(3 * m), ds_b(m), dc_b(3 * m);
-    SymmetryLoss<double>(m, in.sigma_a.data(), in.rgb_a.data(), in.sigma_b.data(), in.rgb_b.data(), in.dt.data(),
-                         colour, scale, ds_a.data(), dc_a.data(), ds_b.data(), dc_b.data());
+    SymmetryLoss<double>(m, in.sigma_a.data(), in.rgb_a.data(), in.sigma_b.data(), in.rgb_b.data(),
+                         in.dt.data(), colour, scale, ds_a.data(), dc_a.data(), ds_b.data(), dc_b.data());
     // The colour weight alpha_a alpha_b is held constant: differentiate the colour part with it frozen
     // by perturbing rgb only, and the opacity part with colour = 0 for the densities.
-    auto check = [&](std::vector<double> Inputs::*field, const std::vector<double>& grad, double c, const char* name) {
+    auto check = [&](std::vector<double> Inputs::*field, const std::vector<double>& grad, double c,
+                     const char* name) {
       for (size_t i = 0; i < grad.size(); ++i) {
         Inputs p = in, q = in;
         (p.*field)[i] += h;
@@ -74,15 +75,16 @@ TEST(SymmetryLossTest, GradientsMatchFiniteDifferences) {
     check(&Inputs::rgb_b, dc_b, colour, "rgb_b");
     // Densities: the opacity part only (the colour part's weight is a stop-gradient).
     std::vector<double> ds_a0(m), dc0(3 * m), ds_b0(m);
-    SymmetryLoss<double>(m, in.sigma_a.data(), in.rgb_a.data(), in.sigma_b.data(), in.rgb_b.data(), in.dt.data(),
-                         colour, scale, ds_a0.data(), dc0.data(), ds_b0.data(), dc0.data());
+    SymmetryLoss<double>(m, in.sigma_a.data(), in.rgb_a.data(), in.sigma_b.data(), in.rgb_b.data(),
+                         in.dt.data(), colour, scale, ds_a0.data(), dc0.data(), ds_b0.data(), dc0.data());
     check(&Inputs::sigma_a, ds_a0, 0.0, "sigma_a");
     check(&Inputs::sigma_b, ds_b0, 0.0, "sigma_b");
   }
 }
 
 TEST(SymmetryLossTest, ModelFindsThePlaneOfAFrontalFace) {
-  auto model = AvatarModel::Create(testing_model::TinyModelConfig("icef"), testing_model::TinySetup(), Executor(1));
+  auto model =
+      AvatarModel::Create(testing_model::TinyModelConfig("icef"), testing_model::TinySetup(), Executor(1));
   ASSERT_TRUE(model.ok());
   ASSERT_TRUE((*model)->symmetry_plane().has_value());
   const SymmetryPlane& plane = *(*model)->symmetry_plane();
@@ -114,7 +116,8 @@ TEST(SymmetryLossTest, ModelGradientMatchesFiniteDifferences) {
     TrainRays batch;
     Rng rng(6, StreamId("batch"));
     for (int r = 0; r < 16; ++r) {
-      const Vec3f o(static_cast<float>(rng.Uniform(-0.3, 0.3)), static_cast<float>(rng.Uniform(-0.3, 0.3)), 2.f);
+      const Vec3f o(static_cast<float>(rng.Uniform(-0.3, 0.3)), static_cast<float>(rng.Uniform(-0.3, 0.3)),
+                    2.f);
       batch.rays.push_back(Ray{o, Vec3f(0.1f, 0.f, -1.f).normalized()});
       batch.frame.push_back(r % 3);
       for (int a = 0; a < 3; ++a) batch.target_rgb.push_back(rng.Uniform());
@@ -146,9 +149,8 @@ TEST(SymmetryLossTest, ModelGradientMatchesFiniteDifferences) {
     check.abs_tol_frac = 0;
     check.abs_tol = 1e-6;
     check.min_checked = 10;
-    const auto report = check.Run(store.params(), g, [&] {
-      return model.TrainForwardBackward(batch, on, 3, 0, ex).Get("symmetry");
-    });
+    const auto report = check.Run(
+        store.params(), g, [&] { return model.TrainForwardBackward(batch, on, 3, 0, ex).Get("symmetry"); });
     EXPECT_TRUE(report.ok()) << method << ":\n" << report.failures;
     store.ZeroGrads();
   }

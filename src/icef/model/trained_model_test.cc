@@ -47,7 +47,8 @@ fs::path WriteCheckpoint(const fs::path& dir, const AvatarModel& model, int64_t 
   w.Add("occupancy", std::string(reinterpret_cast<const char*>(occ.data()), occ.size() * sizeof(float)));
   const std::vector<uint8_t>& allowed = model.occupancy().allowed();
   w.Add("occupancy_allowed", std::string(allowed.begin(), allowed.end()));
-  w.Add("trainer", Json{{"step", step}, {"elapsed_seconds", 1.0}, {"config_hash", Fnv1a64(config_text)}}.dump());
+  w.Add("trainer",
+        Json{{"step", step}, {"elapsed_seconds", 1.0}, {"config_hash", Fnv1a64(config_text)}}.dump());
   const fs::path path = dir / kCheckpointFile;
   ICEF_CHECK(w.WriteAtomic(path).ok());
   return path;
@@ -135,7 +136,8 @@ TEST(TrainedModel, OtherFormatVersionIsRefusedNamingIt) {
 }
 
 TEST(TrainedModel, MissingSectionIsRefusedNamingFileAndSection) {
-  for (const std::string section : {"config", "trainer", "setup", "params", "occupancy", "occupancy_allowed"}) {
+  for (const std::string section :
+       {"config", "trainer", "setup", "params", "occupancy", "occupancy_allowed"}) {
     const fs::path path = WriteTinyCheckpoint("trained_model_section");
     DropSection(path, section);
     ExpectErrorNaming(LoadTrainedModel(path, Executor(1)).status(), path, "no section '" + section + "'");
@@ -152,9 +154,12 @@ TEST(TrainedModel, BadModelBlockAndTrainerFieldsNameTheField) {
   bad["model"]["grid_levelz"] = 4;
   CheckpointWriter w;
   for (const std::string& n : ckpt.SectionNames()) {
-    if (n == "config") w.Add(n, bad.dump());
-    else if (n == "trainer") w.Add(n, Json{{"step", 3}, {"config_hash", Fnv1a64(bad.dump())}}.dump());
-    else w.Add(n, ckpt.Section(n).value());
+    if (n == "config")
+      w.Add(n, bad.dump());
+    else if (n == "trainer")
+      w.Add(n, Json{{"step", 3}, {"config_hash", Fnv1a64(bad.dump())}}.dump());
+    else
+      w.Add(n, ckpt.Section(n).value());
   }
   ASSERT_TRUE(w.WriteAtomic(path).ok());
   ExpectErrorNaming(LoadTrainedModel(path, Executor(1)).status(), path, "model.grid_levelz: unknown key");
@@ -163,16 +168,16 @@ TEST(TrainedModel, BadModelBlockAndTrainerFieldsNameTheField) {
   for (const std::string& n : ckpt.SectionNames())
     w2.Add(n, n == "config" ? bad.dump() : ckpt.Section(n).value());
   ASSERT_TRUE(w2.WriteAtomic(path).ok());
-  ExpectErrorNaming(LoadTrainedModel(path, Executor(1)).status(), path, "trainer.config_hash: does not match");
+  ExpectErrorNaming(LoadTrainedModel(path, Executor(1)).status(), path,
+                    "trainer.config_hash: does not match");
 }
 
 TEST(TrainedModel, InferenceOverridesChangeTheLoadedConfig) {
   const fs::path path = WriteTinyCheckpoint("trained_model_override");
-  Result<TrainedModel> loaded =
-      LoadTrainedModel(path, Executor(1),
-                       {"model.render.supersample=3", "model.render.transmittance_eps=0.001",
-                        "model.bf16_inference=false", "model.sampler.num_samples=24",
-                        "model.render.sample_factor=1"});
+  Result<TrainedModel> loaded = LoadTrainedModel(
+      path, Executor(1),
+      {"model.render.supersample=3", "model.render.transmittance_eps=0.001", "model.bf16_inference=false",
+       "model.sampler.num_samples=24", "model.render.sample_factor=1"});
   ASSERT_TRUE(loaded.ok()) << loaded.status().message();
   EXPECT_EQ(loaded->config.render.supersample, 3);
   EXPECT_EQ(loaded->config.render.transmittance_eps, 0.001);
@@ -193,7 +198,8 @@ TEST(TrainedModel, ArchitectureKeysAreRefusedNamingTheKey) {
     const Status s = ApplyInferenceOverride(key, &config);
     ASSERT_FALSE(s.ok()) << key << " was accepted";
     const std::string name = key.substr(0, key.find('='));
-    EXPECT_NE(s.message().find(name + " cannot be changed on a trained model"), std::string::npos) << s.message();
+    EXPECT_NE(s.message().find(name + " cannot be changed on a trained model"), std::string::npos)
+        << s.message();
     EXPECT_NE(s.message().find("model.render.supersample"), std::string::npos) << s.message();
     EXPECT_EQ(s.message().find('\n'), std::string::npos) << "one line: " << s.message();
   }

@@ -1,22 +1,23 @@
 #include "icef/nn/activation.h"
 
+#include "icef/core/enum_table.h"
+
 namespace icef::nn {
 
-std::string ActivationName(Activation a) {
-  switch (a) {
-    case Activation::kNone: return "none";
-    case Activation::kRelu: return "relu";
-    case Activation::kSigmoid: return "sigmoid";
-    case Activation::kExp: return "exp";
-  }
-  return "?";
-}
+namespace {
+
+constexpr std::array<EnumEntry<Activation>, 4> kActivationNames = {{{Activation::kNone, "none"},
+                                                                    {Activation::kRelu, "relu"},
+                                                                    {Activation::kSigmoid, "sigmoid"},
+                                                                    {Activation::kExp, "exp"}}};
+
+}  // namespace
+
+std::string ActivationName(Activation a) { return EnumName(kActivationNames, a); }
 
 Result<Activation> ParseActivation(const std::string& name) {
-  for (Activation a : {Activation::kNone, Activation::kRelu, Activation::kSigmoid, Activation::kExp}) {
-    if (ActivationName(a) == name) return a;
-  }
-  return Status::Error("unknown activation '" + name + "' (valid: none, relu, sigmoid, exp)");
+  if (const std::optional<Activation> a = ParseEnum(kActivationNames, name)) return *a;
+  return Status::Error("unknown activation '" + name + "' (valid: " + EnumNames(kActivationNames) + ")");
 }
 
 }  // namespace icef::nn

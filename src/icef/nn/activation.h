@@ -20,10 +20,14 @@ Result<Activation> ParseActivation(const std::string& name);
 template <typename T>
 inline T ApplyActivation(Activation a, T x) {
   switch (a) {
-    case Activation::kNone: return x;
-    case Activation::kRelu: return x > T(0) ? x : T(0);
-    case Activation::kSigmoid: return T(1) / (T(1) + std::exp(-x));
-    case Activation::kExp: return std::exp(x);
+    case Activation::kNone:
+      return x;
+    case Activation::kRelu:
+      return x > T(0) ? x : T(0);
+    case Activation::kSigmoid:
+      return T(1) / (T(1) + std::exp(-x));
+    case Activation::kExp:
+      return std::exp(x);
   }
   return x;
 }
@@ -32,10 +36,14 @@ inline T ApplyActivation(Activation a, T x) {
 template <typename T>
 inline T ActivationDerivativeFromOutput(Activation a, T y) {
   switch (a) {
-    case Activation::kNone: return T(1);
-    case Activation::kRelu: return y > T(0) ? T(1) : T(0);
-    case Activation::kSigmoid: return y * (T(1) - y);
-    case Activation::kExp: return y;
+    case Activation::kNone:
+      return T(1);
+    case Activation::kRelu:
+      return y > T(0) ? T(1) : T(0);
+    case Activation::kSigmoid:
+      return y * (T(1) - y);
+    case Activation::kExp:
+      return y;
   }
   return T(1);
 }

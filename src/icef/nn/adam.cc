@@ -40,7 +40,8 @@ void UpdateRange(float* __restrict p, float* __restrict g, float* __restrict m, 
 }  // namespace
 
 Status AdamGroup::Validate() const {
-  if (!(learning_rate >= 0.0) || !std::isfinite(learning_rate)) return Status::Error("adam.learning_rate: must be finite and >= 0");
+  if (!(learning_rate >= 0.0) || !std::isfinite(learning_rate))
+    return Status::Error("adam.learning_rate: must be finite and >= 0");
   if (!(beta1 >= 0.0 && beta1 < 1.0)) return Status::Error("adam.beta1: must be in [0, 1)");
   if (!(beta2 >= 0.0 && beta2 < 1.0)) return Status::Error("adam.beta2: must be in [0, 1)");
   if (!(epsilon >= 0.0)) return Status::Error("adam.epsilon: must be >= 0");
@@ -69,7 +70,9 @@ Status AdamOptions::Validate() const {
 std::string AdamOptions::ToString() const {
   std::ostringstream s;
   s << "AdamOptions(schedule="
-    << (schedule == LrSchedule::kConstant ? "constant" : schedule == LrSchedule::kStep ? "step" : "exponential")
+    << (schedule == LrSchedule::kConstant ? "constant"
+        : schedule == LrSchedule::kStep   ? "step"
+                                          : "exponential")
     << ", decay_rate=" << decay_rate << ", decay_steps=" << decay_steps;
   for (const AdamGroup& g : groups) s << ", " << g.ToString();
   s << ")";
@@ -90,10 +93,13 @@ void Adam::set_options(const AdamOptions& options) {
 
 double Adam::ScheduleFactor(int64_t t) const {
   switch (options_.schedule) {
-    case LrSchedule::kConstant: return 1.0;
-    case LrSchedule::kStep: return std::pow(options_.decay_rate, static_cast<double>(t / options_.decay_steps));
+    case LrSchedule::kConstant:
+      return 1.0;
+    case LrSchedule::kStep:
+      return std::pow(options_.decay_rate, static_cast<double>(t / options_.decay_steps));
     case LrSchedule::kExponential:
-      return std::pow(options_.decay_rate, static_cast<double>(t) / static_cast<double>(options_.decay_steps));
+      return std::pow(options_.decay_rate,
+                      static_cast<double>(t) / static_cast<double>(options_.decay_steps));
   }
   return 1.0;
 }
@@ -121,9 +127,11 @@ void Adam::Step(const Executor& executor) {
     const Executor& ex = b.size >= 2 * kAdamChunk ? executor : serial;
     ParallelForChunks(ex, b.size, kAdamChunk, [&](int64_t begin, int64_t end) {
       if (g.sparse) {
-        UpdateRange<true>(p + begin, gr + begin, m + begin, v + begin, end - begin, lr, b1, b2, c1, c2, eps, wd);
+        UpdateRange<true>(p + begin, gr + begin, m + begin, v + begin, end - begin, lr, b1, b2, c1, c2, eps,
+                          wd);
       } else {
-        UpdateRange<false>(p + begin, gr + begin, m + begin, v + begin, end - begin, lr, b1, b2, c1, c2, eps, wd);
+        UpdateRange<false>(p + begin, gr + begin, m + begin, v + begin, end - begin, lr, b1, b2, c1, c2, eps,
+                           wd);
       }
     });
   }

@@ -42,7 +42,7 @@ TEST(AdamTest, MatchesReferenceUpdateAndSkipsZeroGradientsInSparseGroups) {
       EXPECT_EQ(store.grads(dense)[i], 0.0f);  // consumed
     }
   }
-  EXPECT_EQ(store.params(sparse)[1], 2.0f);  // never had a gradient: untouched
+  EXPECT_EQ(store.params(sparse)[1], 2.0f);                    // never had a gradient: untouched
   EXPECT_NEAR(store.params(sparse)[0], 1.0 - 3 * 1e-2, 1e-5);  // constant gradient: ~lr per step
   EXPECT_EQ(adam.step(), 3);
 }

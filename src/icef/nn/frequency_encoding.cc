@@ -49,20 +49,19 @@ void FrequencyEncoding::Forward(const Executor& executor, int64_t n, const float
   });
 }
 
-void FrequencyEncoding::Backward(const Executor& executor, int64_t n, const float* x,
-                                 const float* dy, float* dx) const {
+void FrequencyEncoding::Backward(const Executor& executor, int64_t n, const float* x, const float* dy,
+                                 float* dx) const {
   const int d = input_dims(), out = output_dims();
   ParallelFor(executor, n, [&](int64_t b, int64_t e, int) {
     FrequencyBackward<float>(options_, weights_.data(), e - b, x + b * d, dy + b * out, dx + b * d);
   });
 }
 
-void FrequencyEncoding::Jvp(const Executor& executor, int64_t n, const float* x, const float* v,
-                            float* y, float* jy) const {
+void FrequencyEncoding::Jvp(const Executor& executor, int64_t n, const float* x, const float* v, float* y,
+                            float* jy) const {
   const int d = input_dims(), out = output_dims();
   ParallelFor(executor, n, [&](int64_t b, int64_t e, int) {
-    FrequencyJvp<float>(options_, weights_.data(), e - b, x + b * d, v + b * d, y + b * out,
-                        jy + b * out);
+    FrequencyJvp<float>(options_, weights_.data(), e - b, x + b * d, v + b * d, y + b * out, jy + b * out);
   });
 }
 

@@ -36,8 +36,7 @@ double AnnealingWeight(double alpha, int k);
 
 // weights: [N] annealing weights. x [n, d] -> y [n, D].
 template <typename T>
-void FrequencyForward(const FrequencyEncodingOptions& o, const T* weights, int64_t n, const T* x,
-                      T* y) {
+void FrequencyForward(const FrequencyEncodingOptions& o, const T* weights, int64_t n, const T* x, T* y) {
   const int d = o.input_dims, nf = o.num_frequencies, out = o.output_dims();
   const T pi = T(3.14159265358979323846);
   for (int64_t s = 0; s < n; ++s) {
@@ -89,8 +88,8 @@ void FrequencyBackward(const FrequencyEncodingOptions& o, const T* weights, int6
 
 // y = enc(x) and jy = J_enc(x) · v, v [n, d] -> y, jy [n, D].
 template <typename T>
-void FrequencyJvp(const FrequencyEncodingOptions& o, const T* weights, int64_t n, const T* x,
-                  const T* v, T* y, T* jy) {
+void FrequencyJvp(const FrequencyEncodingOptions& o, const T* weights, int64_t n, const T* x, const T* v,
+                  T* y, T* jy) {
   const int d = o.input_dims, nf = o.num_frequencies, out = o.output_dims();
   const T pi = T(3.14159265358979323846);
   for (int64_t s = 0; s < n; ++s) {
@@ -141,8 +140,7 @@ class FrequencyEncoding {
   // dx [n, d] (overwritten) from dy [n, D].
   void Backward(const Executor& executor, int64_t n, const float* x, const float* dy, float* dx) const;
   // y [n, D], jy [n, D] from x, v [n, d].
-  void Jvp(const Executor& executor, int64_t n, const float* x, const float* v, float* y,
-           float* jy) const;
+  void Jvp(const Executor& executor, int64_t n, const float* x, const float* v, float* y, float* jy) const;
 
   std::string ToString() const;
 

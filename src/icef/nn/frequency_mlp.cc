@@ -25,12 +25,12 @@ MlpOptions FrequencyMlpOptions::ToMlpOptions() const {
 }
 
 std::string FrequencyMlpOptions::ToString() const {
-  return "FrequencyMlpOptions(" + encoding.ToString() + ", condition_dims=" +
-         std::to_string(condition_dims) + ", " + ToMlpOptions().ToString() + ")";
+  return "FrequencyMlpOptions(" + encoding.ToString() + ", condition_dims=" + std::to_string(condition_dims) +
+         ", " + ToMlpOptions().ToString() + ")";
 }
 
-FrequencyMlp::FrequencyMlp(const FrequencyMlpOptions& options, ParameterStore* store,
-                           const std::string& name, int group)
+FrequencyMlp::FrequencyMlp(const FrequencyMlpOptions& options, ParameterStore* store, const std::string& name,
+                           int group)
     : options_(options), encoding_(options.encoding), mlp_(options.ToMlpOptions(), store, name, group) {}
 
 namespace {
@@ -39,13 +39,14 @@ int64_t PerThread(const MlpShape& s) {
 }
 }  // namespace
 
-void FrequencyMlp::Forward(const Executor& executor, int64_t n, const float* x, const float* c,
-                           float* y, FrequencyMlpContext* ctx, bool keep_for_backward) const {
+void FrequencyMlp::Forward(const Executor& executor, int64_t n, const float* x, const float* c, float* y,
+                           FrequencyMlpContext* ctx, bool keep_for_backward) const {
   const MlpShape& s = mlp_.shape();
   const int threads = std::min(executor.num_threads(), 64);
   SlotAllocator slots(threads);
   const int64_t per_thread = PerThread(s);
-  if (ctx->scratch.size() < static_cast<size_t>(per_thread * threads)) ctx->scratch.resize(per_thread * threads);
+  if (ctx->scratch.size() < static_cast<size_t>(per_thread * threads))
+    ctx->scratch.resize(per_thread * threads);
   const int w0 = s.input_dims(), hps = s.hidden_per_sample(), out = s.output_dims();
   const int d = options_.encoding.input_dims, dc = options_.condition_dims;
   if (keep_for_backward) {
@@ -84,7 +85,8 @@ void FrequencyMlp::Backward(const Executor& executor, int64_t n, const float* x,
   const int threads = std::min(executor.num_threads(), 64);
   SlotAllocator slots(threads);
   const int64_t per_thread = PerThread(s);
-  if (ctx->scratch.size() < static_cast<size_t>(per_thread * threads)) ctx->scratch.resize(per_thread * threads);
+  if (ctx->scratch.size() < static_cast<size_t>(per_thread * threads))
+    ctx->scratch.resize(per_thread * threads);
   const int64_t np = s.num_params();
   const int64_t chunk = MlpChunkSize(n), chunks = (n + chunk - 1) / chunk;
   MlpContext& mc = ctx->mlp;
@@ -122,14 +124,14 @@ void FrequencyMlp::Backward(const Executor& executor, int64_t n, const float* x,
   }
 }
 
-void FrequencyMlp::Jvp(const Executor& executor, int64_t n, const float* x, const float* c,
-                       const float* vx, const float* vc, float* y, float* jy,
-                       FrequencyMlpContext* ctx) const {
+void FrequencyMlp::Jvp(const Executor& executor, int64_t n, const float* x, const float* c, const float* vx,
+                       const float* vc, float* y, float* jy, FrequencyMlpContext* ctx) const {
   const MlpShape& s = mlp_.shape();
   const int threads = std::min(executor.num_threads(), 64);
   SlotAllocator slots(threads);
   const int64_t per_thread = PerThread(s);
-  if (ctx->scratch.size() < static_cast<size_t>(per_thread * threads)) ctx->scratch.resize(per_thread * threads);
+  if (ctx->scratch.size() < static_cast<size_t>(per_thread * threads))
+    ctx->scratch.resize(per_thread * threads);
   const int out = s.output_dims();
   const int d = options_.encoding.input_dims, dc = options_.condition_dims;
   const float* w = mlp_.weights();
@@ -145,9 +147,8 @@ void FrequencyMlp::Jvp(const Executor& executor, int64_t n, const float* x, cons
     float* scratch = ctx->scratch.data() + per_thread * t;
     for (int64_t r = begin; r < end; r += kMlpTile) {
       const int64_t m = std::min(kMlpTile, end - r);
-      FrequencyMlpJvp<float>(options_.encoding, fw, s, w, m, x + r * d, c + r * dc,
-                             vx ? vx + r * d : nullptr, vc ? vc + r * dc : nullptr, y + r * out,
-                             jy + r * out, scratch, bf);
+      FrequencyMlpJvp<float>(options_.encoding, fw, s, w, m, x + r * d, c + r * dc, vx ? vx + r * d : nullptr,
+                             vc ? vc + r * dc : nullptr, y + r * out, jy + r * out, scratch, bf);
     }
   });
 }

@@ -37,8 +37,8 @@ void FrequencyMlpInput(const FrequencyEncodingOptions& fo, const T* freq_weights
 // in MlpForward, y [n, out].
 template <typename T>
 void FrequencyMlpForward(const FrequencyEncodingOptions& fo, const T* freq_weights, const MlpShape& s,
-                         const T* w, int64_t n, const T* x, const T* c, T* in, T* hidden, T* y,
-                         T* scratch, const MlpBf16Weights* bf = nullptr) {
+                         const T* w, int64_t n, const T* x, const T* c, T* in, T* hidden, T* y, T* scratch,
+                         const MlpBf16Weights* bf = nullptr) {
   const int dc = s.input_dims() - fo.output_dims();
   FrequencyMlpInput(fo, freq_weights, dc, n, x, c, in, scratch);
   MlpForward<T>(s, w, n, in, hidden, y, bf);
@@ -52,8 +52,8 @@ void FrequencyMlpBackward(const FrequencyEncodingOptions& fo, const T* freq_weig
                           const MlpBf16Weights* bf_t = nullptr) {
   const int D = fo.output_dims(), w0 = s.input_dims(), dc = w0 - D;
   const bool need_input = dx != nullptr || dc_out != nullptr;
-  T* d_in = scratch;                 // [n, w0]
-  T* d_enc = scratch + n * w0;       // [n, D]
+  T* d_in = scratch;            // [n, w0]
+  T* d_enc = scratch + n * w0;  // [n, D]
   T* mlp_scratch = scratch + 2 * n * w0;
   MlpBackward<T>(s, w_transposed, n, in, hidden, y, dy, dw, need_input ? d_in : nullptr, mlp_scratch, bf_t);
   if (!need_input) return;
@@ -66,12 +66,12 @@ void FrequencyMlpBackward(const FrequencyEncodingOptions& fo, const T* freq_weig
 
 // Tile JVP: y = f(x, c), jy = J_x f vx + J_c f vc; vx [n, d] or vc [n, dc] may be null (zero).
 template <typename T>
-void FrequencyMlpJvp(const FrequencyEncodingOptions& fo, const T* freq_weights, const MlpShape& s,
-                     const T* w, int64_t n, const T* x, const T* c, const T* vx, const T* vc, T* y,
-                     T* jy, T* scratch, const MlpBf16Weights* bf = nullptr) {
+void FrequencyMlpJvp(const FrequencyEncodingOptions& fo, const T* freq_weights, const MlpShape& s, const T* w,
+                     int64_t n, const T* x, const T* c, const T* vx, const T* vc, T* y, T* jy, T* scratch,
+                     const MlpBf16Weights* bf = nullptr) {
   const int D = fo.output_dims(), w0 = s.input_dims(), dc = w0 - D;
-  T* in = scratch;               // [n, w0]
-  T* tin = scratch + n * w0;     // [n, w0]
+  T* in = scratch;            // [n, w0]
+  T* tin = scratch + n * w0;  // [n, w0]
   T* mlp_scratch = scratch + 2 * n * w0;
   // Encoding and its tangent go through mlp_scratch first (it is free until MlpJvp).
   T* enc = mlp_scratch;
@@ -125,9 +125,9 @@ struct FrequencyMlpOptions {
 struct FrequencyMlpContext {
   int64_t n = 0;
   int num_threads = 0;
-  AlignedVector<float> input;   // [n, D + dc]
-  AlignedVector<float> scratch; // per thread
-  MlpContext mlp;               // hidden, per-thread gradients, transposed weights
+  AlignedVector<float> input;    // [n, D + dc]
+  AlignedVector<float> scratch;  // per thread
+  MlpContext mlp;                // hidden, per-thread gradients, transposed weights
 };
 
 class FrequencyMlp {
@@ -146,8 +146,8 @@ class FrequencyMlp {
   void Forward(const Executor& executor, int64_t n, const float* x, const float* c, float* y,
                FrequencyMlpContext* ctx, bool keep_for_backward = true) const;
   // Accumulates parameter gradients; writes dx [n, d], dc [n, dc] unless null.
-  void Backward(const Executor& executor, int64_t n, const float* x, const float* y,
-                const float* dy, FrequencyMlpContext* ctx, float* dx, float* dc);
+  void Backward(const Executor& executor, int64_t n, const float* x, const float* y, const float* dy,
+                FrequencyMlpContext* ctx, float* dx, float* dc);
   // y [n, out], jy = J_x y vx + J_c y vc [n, out]; vx or vc may be null.
   void Jvp(const Executor& executor, int64_t n, const float* x, const float* c, const float* vx,
            const float* vc, float* y, float* jy, FrequencyMlpContext* ctx) const;

@@ -2,8 +2,8 @@
 
 #include <gtest/gtest.h>
 
-#include "icef/testing/gradient_check.h"
 #include "icef/nn/hash_grid.h"
+#include "icef/testing/gradient_check.h"
 
 namespace icef::nn {
 namespace {
@@ -31,10 +31,12 @@ struct Composite {
     c = RandomVector(n * dc, 8, 3, -1, 1);
     r = RandomVector(n * 3, 8, 4, -1, 1);
   }
-  std::vector<double> Forward(std::vector<double>* in = nullptr, std::vector<double>* hidden = nullptr) const {
+  std::vector<double> Forward(std::vector<double>* in = nullptr,
+                              std::vector<double>* hidden = nullptr) const {
     std::vector<double> i(n * shape.input_dims()), h(n * shape.hidden_per_sample()), y(n * 3);
     std::vector<double> scratch(FrequencyMlpScratch(shape, n));
-    FrequencyMlpForward<double>(fo, fw.data(), shape, w.data(), n, x.data(), c.data(), i.data(), h.data(), y.data(), scratch.data());
+    FrequencyMlpForward<double>(fo, fw.data(), shape, w.data(), n, x.data(), c.data(), i.data(), h.data(),
+                                y.data(), scratch.data());
     if (in) *in = i;
     if (hidden) *hidden = h;
     return y;
@@ -49,7 +51,8 @@ TEST(FrequencyMlpTest, GradientsMatchFiniteDifferences) {
   std::vector<double> scratch(FrequencyMlpScratch(m.shape, m.n));
   MlpTransposeWeights<double>(m.shape, m.w.data(), wt.data());
   FrequencyMlpBackward<double>(m.fo, m.fw.data(), m.shape, wt.data(), m.n, m.x.data(), in.data(),
-                               hidden.data(), y.data(), m.r.data(), dw.data(), dx.data(), dc.data(), scratch.data());
+                               hidden.data(), y.data(), m.r.data(), dw.data(), dx.data(), dc.data(),
+                               scratch.data());
   auto loss = [&] { return Dot(m.Forward(), m.r); };
   EXPECT_LT(MaxRelativeError(&m.w, dw, loss), 1e-6);
   EXPECT_LT(MaxRelativeError(&m.x, dx, loss), 1e-6);
@@ -58,12 +61,14 @@ TEST(FrequencyMlpTest, GradientsMatchFiniteDifferences) {
 
 TEST(FrequencyMlpTest, JvpMatchesFiniteDifferencesOnEachSlice) {
   Composite m;
-  const std::vector<double> vx = RandomVector(m.n * 3, 9, 1, -1, 1), vc = RandomVector(m.n * m.dc, 9, 2, -1, 1);
+  const std::vector<double> vx = RandomVector(m.n * 3, 9, 1, -1, 1),
+                            vc = RandomVector(m.n * m.dc, 9, 2, -1, 1);
   for (int mode = 0; mode < 3; ++mode) {  // x only, c only, both
     const bool use_x = mode != 1, use_c = mode != 0;
     std::vector<double> y(m.n * 3), jy(m.n * 3), scratch(FrequencyMlpScratch(m.shape, m.n));
     FrequencyMlpJvp<double>(m.fo, m.fw.data(), m.shape, m.w.data(), m.n, m.x.data(), m.c.data(),
-                            use_x ? vx.data() : nullptr, use_c ? vc.data() : nullptr, y.data(), jy.data(), scratch.data());
+                            use_x ? vx.data() : nullptr, use_c ? vc.data() : nullptr, y.data(), jy.data(),
+                            scratch.data());
     const double h = 1e-6;
     Composite p = m, q = m;
     for (size_t i = 0; use_x && i < vx.size(); ++i) {
@@ -92,7 +97,8 @@ TEST(FrequencyMlpTest, FloatModuleMatchesDoubleKernels) {
   const int64_t n = 260;
   const std::vector<double> xd = RandomVector(n * 3, 4, 1, -1, 1), cd = RandomVector(n * 16, 4, 2, -1, 1);
   const std::vector<double> dyd = RandomVector(n * 3, 4, 3, -1, 1), vcd = RandomVector(n * 16, 4, 4, -1, 1);
-  std::vector<float> x(xd.begin(), xd.end()), c(cd.begin(), cd.end()), dy(dyd.begin(), dyd.end()), vc(vcd.begin(), vcd.end());
+  std::vector<float> x(xd.begin(), xd.end()), c(cd.begin(), cd.end()), dy(dyd.begin(), dyd.end()),
+      vc(vcd.begin(), vcd.end());
   std::vector<float> y(n * 3), dx(n * 3), dc(n * 16), y2(n * 3), jy(n * 3);
   Executor ex(2);
   FrequencyMlpContext ctx;
@@ -102,13 +108,18 @@ TEST(FrequencyMlpTest, FloatModuleMatchesDoubleKernels) {
 
   const MlpShape& s = net.mlp().shape();
   const std::vector<double> fw = net.encoding().weights_double();
-  std::vector<double> w(net.mlp().weights(), net.mlp().weights() + s.num_params()), wt(w.size()), dw(w.size(), 0.0);
-  std::vector<double> in(n * 55), h(n * s.hidden_per_sample()), yd(n * 3), dxd(n * 3), dcd(n * 16), jyd(n * 3), yj(n * 3);
+  std::vector<double> w(net.mlp().weights(), net.mlp().weights() + s.num_params()), wt(w.size()),
+      dw(w.size(), 0.0);
+  std::vector<double> in(n * 55), h(n * s.hidden_per_sample()), yd(n * 3), dxd(n * 3), dcd(n * 16),
+      jyd(n * 3), yj(n * 3);
   std::vector<double> scratch(FrequencyMlpScratch(s, n));
-  FrequencyMlpForward<double>(o.encoding, fw.data(), s, w.data(), n, xd.data(), cd.data(), in.data(), h.data(), yd.data(), scratch.data());
+  FrequencyMlpForward<double>(o.encoding, fw.data(), s, w.data(), n, xd.data(), cd.data(), in.data(),
+                              h.data(), yd.data(), scratch.data());
   MlpTransposeWeights<double>(s, w.data(), wt.data());
-  FrequencyMlpBackward<double>(o.encoding, fw.data(), s, wt.data(), n, xd.data(), in.data(), h.data(), yd.data(), dyd.data(), dw.data(), dxd.data(), dcd.data(), scratch.data());
-  FrequencyMlpJvp<double>(o.encoding, fw.data(), s, w.data(), n, xd.data(), cd.data(), nullptr, vcd.data(), yj.data(), jyd.data(), scratch.data());
+  FrequencyMlpBackward<double>(o.encoding, fw.data(), s, wt.data(), n, xd.data(), in.data(), h.data(),
+                               yd.data(), dyd.data(), dw.data(), dxd.data(), dcd.data(), scratch.data());
+  FrequencyMlpJvp<double>(o.encoding, fw.data(), s, w.data(), n, xd.data(), cd.data(), nullptr, vcd.data(),
+                          yj.data(), jyd.data(), scratch.data());
   for (int64_t i = 0; i < n * 3; ++i) {
     ASSERT_NEAR(y[i], yd[i], 1e-4 * (1 + std::abs(yd[i])));
     ASSERT_NEAR(y2[i], yd[i], 1e-4 * (1 + std::abs(yd[i])));
@@ -149,7 +160,8 @@ TEST(ComposedTest, HashGridThenMlpGradientsMatchFiniteDifferences) {
   std::vector<double> wt(w.size()), dw(w.size(), 0.0), df(f.size()), dtable(table.size(), 0.0), dpos(n * 3);
   std::vector<double> scratch(MlpBackwardScratch(s, n));
   MlpTransposeWeights<double>(s, w.data(), wt.data());
-  MlpBackward<double>(s, wt.data(), n, f.data(), h.data(), y.data(), r.data(), dw.data(), df.data(), scratch.data());
+  MlpBackward<double>(s, wt.data(), n, f.data(), h.data(), y.data(), r.data(), dw.data(), df.data(),
+                      scratch.data());
   HashGridBackwardParams<double>(g, n, pos.data(), df.data(), dtable.data(), 0, g.num_levels);
   HashGridBackwardInput<double>(g, n, jac.data(), df.data(), dpos.data());
   EXPECT_LT(MaxRelativeError(&w, dw, loss), 1e-6);

@@ -102,11 +102,17 @@ void ConvertRows(int64_t rows, int k, int kp, const float* a, uint16_t* out) {
     for (int p = 0; p < kp; p += 32) {
       // Masked loads read zeros past k; the masked store writes up to kp.
       const int left = k - p;
-      const __mmask16 lo = left >= 16 ? __mmask16(0xffff) : left > 0 ? __mmask16((1u << left) - 1u) : __mmask16(0);
-      const __mmask16 hi = left >= 32 ? __mmask16(0xffff) : left > 16 ? __mmask16((1u << (left - 16)) - 1u) : __mmask16(0);
-      const __m512bh v = _mm512_cvtne2ps_pbh(_mm512_maskz_loadu_ps(hi, src + p + 16), _mm512_maskz_loadu_ps(lo, src + p));
+      const __mmask16 lo = left >= 16 ? __mmask16(0xffff)
+                           : left > 0 ? __mmask16((1u << left) - 1u)
+                                      : __mmask16(0);
+      const __mmask16 hi = left >= 32  ? __mmask16(0xffff)
+                           : left > 16 ? __mmask16((1u << (left - 16)) - 1u)
+                                       : __mmask16(0);
+      const __m512bh v =
+          _mm512_cvtne2ps_pbh(_mm512_maskz_loadu_ps(hi, src + p + 16), _mm512_maskz_loadu_ps(lo, src + p));
       const int out = std::min(32, kp - p);
-      _mm512_mask_storeu_epi16(dst + p, out >= 32 ? __mmask32(0xffffffffu) : __mmask32((1u << out) - 1u), (__m512i)v);
+      _mm512_mask_storeu_epi16(dst + p, out >= 32 ? __mmask32(0xffffffffu) : __mmask32((1u << out) - 1u),
+                               (__m512i)v);
     }
   }
 }
@@ -124,7 +130,8 @@ void Bf16Panel(int64_t n, int k, int m, const float* a, const uint16_t* packed, 
       int64_t s = 0;
       for (; s + R <= rows; s += R)
         Bf16Block<R, MV>(kp, m, a_bf.data() + s * kp, packed + 2 * j0, c + (s0 + s) * m + j0);
-      for (; s < rows; ++s) Bf16Block<1, MV>(kp, m, a_bf.data() + s * kp, packed + 2 * j0, c + (s0 + s) * m + j0);
+      for (; s < rows; ++s)
+        Bf16Block<1, MV>(kp, m, a_bf.data() + s * kp, packed + 2 * j0, c + (s0 + s) * m + j0);
     }
   }
 }

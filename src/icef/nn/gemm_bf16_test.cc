@@ -31,7 +31,8 @@ TEST(Bf16Test, RoundsToNearestEven) {
   EXPECT_EQ(FloatToBf16(1.f + 1.5f * std::ldexp(1.f, -8)), 0x3f81);  // above the tie: up
   EXPECT_TRUE(std::isnan(Bf16ToFloat(FloatToBf16(std::numeric_limits<float>::quiet_NaN()))));
   EXPECT_TRUE(std::isinf(Bf16ToFloat(FloatToBf16(std::numeric_limits<float>::infinity()))));
-  for (float x : Random(1000, 1)) EXPECT_NEAR(Bf16ToFloat(FloatToBf16(x)), x, std::abs(x) * std::ldexp(1.f, -8));
+  for (float x : Random(1000, 1))
+    EXPECT_NEAR(Bf16ToFloat(FloatToBf16(x)), x, std::abs(x) * std::ldexp(1.f, -8));
 }
 
 TEST(Bf16Test, PacksPairsOfRowsPerColumn) {
@@ -119,7 +120,8 @@ TEST(Bf16Test, MlpInferenceIsCloseToFp32AndTrainingIsUnchanged) {
   fp32.Forward(ex, n, x.data(), y32.data(), &c32, false);
   bf16.Forward(ex, n, x.data(), y16.data(), &c16, false);
   double err = 0, scale = 0;
-  for (int64_t i = 0; i < n * 3; ++i) err = std::max(err, double(std::abs(y16[i] - y32[i]))), scale = std::max(scale, double(std::abs(y32[i])));
+  for (int64_t i = 0; i < n * 3; ++i)
+    err = std::max(err, double(std::abs(y16[i] - y32[i]))), scale = std::max(scale, double(std::abs(y32[i])));
   EXPECT_LT(err, 0.02 * scale);
   if (Bf16Supported()) {
     EXPECT_GT(err, 0.0);  // the BF16 path really ran

@@ -26,9 +26,9 @@ Status HashGridOptions::Validate() const {
 
 std::string HashGridOptions::ToString() const {
   std::ostringstream s;
-  s << "HashGridOptions(L=" << num_levels << ", F=" << features_per_level << ", log2_T="
-    << log2_table_size << ", base=" << base_resolution << ", finest=" << finest_resolution
-    << ", init_scale=" << init_scale << ")";
+  s << "HashGridOptions(L=" << num_levels << ", F=" << features_per_level << ", log2_T=" << log2_table_size
+    << ", base=" << base_resolution << ", finest=" << finest_resolution << ", init_scale=" << init_scale
+    << ")";
   return s.str();
 }
 
@@ -37,8 +37,9 @@ HashGridLayout MakeHashGridLayout(const HashGridOptions& o) {
   g.num_levels = o.num_levels;
   g.features = o.features_per_level;
   g.table_size = 1u << o.log2_table_size;
-  const double growth =
-      o.num_levels > 1 ? std::exp(std::log(o.finest_resolution / o.base_resolution) / (o.num_levels - 1)) : 1.0;
+  const double growth = o.num_levels > 1
+                            ? std::exp(std::log(o.finest_resolution / o.base_resolution) / (o.num_levels - 1))
+                            : 1.0;
   int64_t offset = 0;
   for (int l = 0; l < o.num_levels; ++l) {
     HashGridLevel lv;
@@ -81,8 +82,8 @@ void HashGridEncoding::ForwardTile(int64_t n, const float* positions, float* fea
   }
 }
 
-void HashGridEncoding::BackwardParamsLevel(int level, int64_t n, const float* positions,
-                                           const float* d_level, int64_t d_stride) {
+void HashGridEncoding::BackwardParamsLevel(int level, int64_t n, const float* positions, const float* d_level,
+                                           int64_t d_stride) {
   ICEF_CHECK(level >= 0 && level < layout_.num_levels, "hash grid level out of range");
   if (layout_.features == 2) {
     HashGridScatterLevelF2(layout_, level, n, positions, d_level, d_stride, table_grads());
@@ -103,16 +104,15 @@ void HashGridEncoding::BackwardParamsLevel(int level, int64_t n, const float* po
   }
 }
 
-void HashGridEncoding::BackwardParamsLevels(int64_t n, const float* positions,
-                                            const float* d_features, int level_begin,
-                                            int level_end) {
+void HashGridEncoding::BackwardParamsLevels(int64_t n, const float* positions, const float* d_features,
+                                            int level_begin, int level_end) {
   for (int l = level_begin; l < level_end; ++l) {
     BackwardParamsLevel(l, n, positions, d_features + l * layout_.features, output_dims());
   }
 }
 
-void HashGridEncoding::Forward(const Executor& executor, int64_t n, const float* positions,
-                               float* features, float* d_features_d_positions) const {
+void HashGridEncoding::Forward(const Executor& executor, int64_t n, const float* positions, float* features,
+                               float* d_features_d_positions) const {
   const int out = output_dims();
   ParallelForChunks(executor, n, BalancedChunk(n, 64, 4096), [&](int64_t begin, int64_t end) {
     ForwardTile(end - begin, positions + 3 * begin, features + begin * out,
@@ -132,9 +132,8 @@ void HashGridEncoding::BackwardParams(const Executor& executor, int64_t n, const
   });
 }
 
-void HashGridEncoding::BackwardInput(const Executor& executor, int64_t n,
-                                     const float* d_features_d_positions, const float* d_features,
-                                     float* d_positions) const {
+void HashGridEncoding::BackwardInput(const Executor& executor, int64_t n, const float* d_features_d_positions,
+                                     const float* d_features, float* d_positions) const {
   const int out = output_dims();
   ParallelForChunks(executor, n, BalancedChunk(n, 64, 4096), [&](int64_t begin, int64_t end) {
     HashGridBackwardInput<float>(layout_, end - begin, d_features_d_positions + begin * out * 3,

@@ -37,7 +37,7 @@ struct HashGridOptions {
 };
 
 // docs/design.md §7's reference configuration (instant-ngp's: T = 2^19, finest resolution 1024), which
-// the reference model and the engine benchmarks use; the avatar's default grid is smaller.
+// the engine's kernel benchmarks use; the avatar's default grid is smaller.
 inline HashGridOptions ReferenceHashGridOptions() {
   HashGridOptions o;
   o.log2_table_size = 19;
@@ -74,18 +74,16 @@ class HashGridEncoding {
   // ACCUMULATES d loss / d table into the store's gradient block from d_features [n, L*F].
   // Levels are handed to threads one at a time and each level sees the samples in index order,
   // so the result is bit-identical for ANY thread count and scheduling.
-  void BackwardParams(const Executor& executor, int64_t n, const float* positions,
-                      const float* d_features);
+  void BackwardParams(const Executor& executor, int64_t n, const float* positions, const float* d_features);
 
   // d_positions [n, 3] (overwritten) from d_features [n, L*F] and the forward Jacobian.
   void BackwardInput(const Executor& executor, int64_t n, const float* d_features_d_positions,
                      const float* d_features, float* d_positions) const;
 
   // Single-thread tile versions for fused pipelines (same contracts as above).
-  void ForwardTile(int64_t n, const float* positions, float* features,
-                   float* d_features_d_positions) const;
-  void BackwardParamsLevels(int64_t n, const float* positions, const float* d_features,
-                            int level_begin, int level_end);
+  void ForwardTile(int64_t n, const float* positions, float* features, float* d_features_d_positions) const;
+  void BackwardParamsLevels(int64_t n, const float* positions, const float* d_features, int level_begin,
+                            int level_end);
   // One level's table gradient from that level's feature gradients d_level (row s at
   // d_level + s * d_stride, F values): d_stride = L*F with d_level = d_features + l*F reads a
   // sample-major matrix; d_stride = F reads a level-major buffer [n, F] (cheaper to stream).

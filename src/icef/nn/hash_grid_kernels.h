@@ -41,8 +41,8 @@ inline constexpr uint32_t kHashPrime2 = 805459861u;
 // Level-local entry indices of the 8 cell corners (corner c: bit 0 = +x, bit 1 = +y, bit 2 = +z),
 // the cell fractions, and per axis whether p was inside [0,1] (else clamped: zero derivative).
 template <typename T>
-inline void HashGridCell(const HashGridLevel& lv, uint32_t table_size, const T* p, uint32_t idx[8],
-                         T frac[3], bool inside[3]) {
+inline void HashGridCell(const HashGridLevel& lv, uint32_t table_size, const T* p, uint32_t idx[8], T frac[3],
+                         bool inside[3]) {
   const int r = lv.resolution;
   int cell[3];
   for (int a = 0; a < 3; ++a) {
@@ -85,8 +85,8 @@ inline void TrilinearWeights(const T frac[3], T w[8]) {
 // positions [n, 3] -> features [n, L*F]. When d_features_d_positions is not null it also writes
 // the Jacobian [n, L*F, 3] (d feature / d position), for a cheap BackwardInput later.
 template <typename T>
-void HashGridForward(const HashGridLayout& g, const T* table, int64_t n, const T* positions,
-                     T* features, T* d_features_d_positions) {
+void HashGridForward(const HashGridLayout& g, const T* table, int64_t n, const T* positions, T* features,
+                     T* d_features_d_positions) {
   const int F = g.features;
   const int out = g.output_dims();
   for (int64_t s = 0; s < n; ++s) {
@@ -134,8 +134,8 @@ void HashGridForward(const HashGridLayout& g, const T* table, int64_t n, const T
 
 // ACCUMULATES d loss / d table for levels [level_begin, level_end), samples in index order.
 template <typename T>
-void HashGridBackwardParams(const HashGridLayout& g, int64_t n, const T* positions,
-                            const T* d_features, T* d_table, int level_begin, int level_end) {
+void HashGridBackwardParams(const HashGridLayout& g, int64_t n, const T* positions, const T* d_features,
+                            T* d_table, int level_begin, int level_end) {
   const int F = g.features;
   const int out = g.output_dims();
   for (int64_t s = 0; s < n; ++s) {

@@ -119,7 +119,9 @@ TEST(HashGridTest, ThreadedBackwardIsIdenticalForAnyThreadCount) {
     for (int64_t i = 0; i < n * 16; ++i) ASSERT_NEAR(f[i], fd[i], 1e-7);
     for (int64_t i = 0; i < n * 48; ++i) ASSERT_NEAR(jac[i], jd[i], 1e-5 * (1 + std::abs(jd[i])));
     for (int64_t i = 0; i < n * 3; ++i) ASSERT_NEAR(dpos[i], dpd[i], 1e-4 * (1 + std::abs(dpd[i])));
-    for (size_t i = 0; i < table.size(); ++i) ASSERT_NEAR(store.grads()[i], dd_table[i], 1e-4 * (1 + std::abs(dd_table[i])));  // float sums of ~1e3 terms
+    for (size_t i = 0; i < table.size(); ++i)
+      ASSERT_NEAR(store.grads()[i], dd_table[i],
+                  1e-4 * (1 + std::abs(dd_table[i])));  // float sums of ~1e3 terms
   }
   EXPECT_EQ(0, std::memcmp(grads[0].data(), grads[1].data(), grads[0].size() * sizeof(float)));
   EXPECT_EQ(0, std::memcmp(grads[0].data(), grads[2].data(), grads[0].size() * sizeof(float)));

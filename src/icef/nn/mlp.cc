@@ -1,12 +1,11 @@
 #include "icef/nn/mlp.h"
 
 #include <algorithm>
-
-#include "icef/nn/scratch_pool.h"
 #include <cmath>
 #include <sstream>
 
 #include "icef/core/rng.h"
+#include "icef/nn/scratch_pool.h"
 
 namespace icef::nn {
 
@@ -61,8 +60,8 @@ void Mlp::Initialize(uint64_t seed) {
   for (int l = 0; l < shape_.num_layers(); ++l) {
     const int in = shape_.widths()[l], out = shape_.widths()[l + 1];
     const bool last = l == shape_.num_layers() - 1;
-    const double bound = last ? std::sqrt(6.0 / (in + out)) * options_.output_init_scale
-                              : std::sqrt(6.0 / in);
+    const double bound =
+        last ? std::sqrt(6.0 / (in + out)) * options_.output_init_scale : std::sqrt(6.0 / in);
     float* wl = w + shape_.WeightOffset(l);
     for (int64_t i = 0; i < int64_t{in} * out; ++i) wl[i] = static_cast<float>(rng.Uniform(-bound, bound));
   }
@@ -71,8 +70,8 @@ void Mlp::Initialize(uint64_t seed) {
 namespace {
 // Per-thread tile scratch, large enough for backward and JVP.
 int64_t ScratchPerThread(const MlpShape& s) {
-  return std::max({MlpBackwardScratch(s, kMlpTile), MlpJvpScratch(s, kMlpTile),
-                   kMlpTile * s.hidden_per_sample()});
+  return std::max(
+      {MlpBackwardScratch(s, kMlpTile), MlpJvpScratch(s, kMlpTile), kMlpTile * s.hidden_per_sample()});
 }
 template <typename V>
 void GrowTo(V* v, size_t n) {
@@ -112,8 +111,8 @@ void Mlp::Forward(const Executor& executor, int64_t n, const float* x, float* y,
   });
 }
 
-void Mlp::Backward(const Executor& executor, int64_t n, const float* x, const float* y,
-                   const float* dy, MlpContext* ctx, float* dx) {
+void Mlp::Backward(const Executor& executor, int64_t n, const float* x, const float* y, const float* dy,
+                   MlpContext* ctx, float* dx) {
   ICEF_CHECK(ctx != nullptr && ctx->n == n,
              "Mlp::Backward must follow Forward(keep_for_backward) on the same batch");
   const int threads = std::min(executor.num_threads(), 64);
@@ -170,8 +169,8 @@ void Mlp::Jvp(const Executor& executor, int64_t n, const float* x, int slice_beg
     float* scratch = ctx->scratch.data() + per_thread * t;
     for (int64_t s = begin; s < end; s += kMlpTile) {
       const int64_t m = std::min(kMlpTile, end - s);
-      MlpJvp<float>(shape_, w, m, x + s * in_w, slice_begin, slice_dims, v + s * slice_dims,
-                    y + s * out_w, jy + s * out_w, scratch);
+      MlpJvp<float>(shape_, w, m, x + s * in_w, slice_begin, slice_dims, v + s * slice_dims, y + s * out_w,
+                    jy + s * out_w, scratch);
     }
   });
 }

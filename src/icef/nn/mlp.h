@@ -58,14 +58,14 @@ struct MlpOptions {
 // Per-batch state: hidden activations kept for Backward, per-thread scratch and gradients.
 // Reuse one context across batches; it grows to the largest batch and never shrinks.
 struct MlpContext {
-  int64_t n = 0;                     // samples of the last Forward with keep_for_backward
-  int num_threads = 0;               // thread count of that Forward (informational)
-  AlignedVector<float> hidden;       // [n * hidden_per_sample], tile-major (see Mlp::Forward)
-  AlignedVector<float> scratch;      // per thread: tile-sized work buffers
-  AlignedVector<float> weight_grads; // per chunk: [num_params] gradient accumulators
-  AlignedVector<float> w_transposed; // untransposed weights for the backward pass
-  MlpBf16Weights bf16;               // the weights packed for BF16 products
-  MlpBf16Weights bf16_transposed;    // w_transposed packed for BF16 backward products
+  int64_t n = 0;                      // samples of the last Forward with keep_for_backward
+  int num_threads = 0;                // thread count of that Forward (informational)
+  AlignedVector<float> hidden;        // [n * hidden_per_sample], tile-major (see Mlp::Forward)
+  AlignedVector<float> scratch;       // per thread: tile-sized work buffers
+  AlignedVector<float> weight_grads;  // per chunk: [num_params] gradient accumulators
+  AlignedVector<float> w_transposed;  // untransposed weights for the backward pass
+  MlpBf16Weights bf16;                // the weights packed for BF16 products
+  MlpBf16Weights bf16_transposed;     // w_transposed packed for BF16 backward products
 };
 
 class Mlp {
@@ -95,8 +95,8 @@ class Mlp {
   // After Forward(keep_for_backward) on the same n and x: dy [n, output_dims] ->
   // accumulates d loss / d weights into the store's gradient; writes dx [n, input_dims] unless
   // dx is null.
-  void Backward(const Executor& executor, int64_t n, const float* x, const float* y,
-                const float* dy, MlpContext* ctx, float* dx);
+  void Backward(const Executor& executor, int64_t n, const float* x, const float* y, const float* dy,
+                MlpContext* ctx, float* dx);
 
   // y = f(x) and jy = J_f(x) · v with v [n, slice_dims] on input columns
   // [slice_begin, slice_begin + slice_dims); y, jy [n, output_dims].

@@ -63,10 +63,12 @@ struct MlpBf16Weights {
     offsets.assign(s.num_layers(), -1);
     int64_t size = 0;
     for (int l = 0; l < s.num_layers(); ++l)
-      if (s.widths()[l + 1] % 16 == 0) offsets[l] = size, size += Bf16PackedSize(s.widths()[l], s.widths()[l + 1]);
+      if (s.widths()[l + 1] % 16 == 0)
+        offsets[l] = size, size += Bf16PackedSize(s.widths()[l], s.widths()[l + 1]);
     packed.resize(size);
     for (int l = 0; l < s.num_layers(); ++l)
-      if (offsets[l] >= 0) PackBf16Pairs(s.widths()[l], s.widths()[l + 1], w + s.WeightOffset(l), packed.data() + offsets[l]);
+      if (offsets[l] >= 0)
+        PackBf16Pairs(s.widths()[l], s.widths()[l + 1], w + s.WeightOffset(l), packed.data() + offsets[l]);
   }
   // The untransposed layers W_l [w_{l+1}, w_l] (MlpTransposeWeights) for the backward pass's data
   // products; layers whose INPUT width is not a multiple of 16 stay FP32.
@@ -87,7 +89,8 @@ struct MlpBf16Weights {
 
 // Layer l's product: BF16 when bf packs the layer (float only), else GemmNN.
 template <typename T>
-inline void LayerProduct(const MlpShape& s, int l, const T* w, const MlpBf16Weights* bf, int64_t n, const T* in, T* out) {
+inline void LayerProduct(const MlpShape& s, int l, const T* w, const MlpBf16Weights* bf, int64_t n,
+                         const T* in, T* out) {
   const int in_w = s.widths()[l], out_w = s.widths()[l + 1];
   if constexpr (std::is_same_v<T, float>) {
     if (bf && bf->layer(l)) return GemmNNBf16(n, in_w, out_w, in, bf->layer(l), out);
@@ -200,8 +203,8 @@ inline int64_t MlpJvpScratch(const MlpShape& s, int64_t n) { return 4 * n * s.ma
 // Forward-mode derivative: y = f(x) [n, w_L] and jy = J_f(x) · v [n, w_L], where the tangent v
 // [n, slice_dims] is non-zero only on input columns [slice_begin, slice_begin + slice_dims).
 template <typename T>
-void MlpJvp(const MlpShape& s, const T* w, int64_t n, const T* x, int slice_begin, int slice_dims,
-            const T* v, T* y, T* jy, T* scratch, const MlpBf16Weights* bf = nullptr) {
+void MlpJvp(const MlpShape& s, const T* w, int64_t n, const T* x, int slice_begin, int slice_dims, const T* v,
+            T* y, T* jy, T* scratch, const MlpBf16Weights* bf = nullptr) {
   const int layers = s.num_layers();
   const int64_t stride = n * s.max_width();
   T* h[2] = {scratch, scratch + stride};

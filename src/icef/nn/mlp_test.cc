@@ -48,14 +48,14 @@ TEST_P(MlpGradientTest, ParamAndInputGradientsMatchFiniteDifferences) {
   std::vector<double> wt(m.w.size()), dw(m.w.size(), 0.0), dx(m.x.size());
   std::vector<double> scratch(MlpBackwardScratch(m.shape, m.n));
   MlpTransposeWeights<double>(m.shape, m.w.data(), wt.data());
-  MlpBackward<double>(m.shape, wt.data(), m.n, m.x.data(), hidden.data(), y.data(), m.r.data(),
-                      dw.data(), dx.data(), scratch.data());
+  MlpBackward<double>(m.shape, wt.data(), m.n, m.x.data(), hidden.data(), y.data(), m.r.data(), dw.data(),
+                      dx.data(), scratch.data());
   EXPECT_LT(MaxRelativeError(&m.w, dw, [&] { return m.Loss(); }), kTol);
   EXPECT_LT(MaxRelativeError(&m.x, dx, [&] { return m.Loss(); }), kTol);
   // Gradients accumulate: a second backward doubles dw.
   std::vector<double> dw2 = dw;
-  MlpBackward<double>(m.shape, wt.data(), m.n, m.x.data(), hidden.data(), y.data(), m.r.data(),
-                      dw2.data(), nullptr, scratch.data());
+  MlpBackward<double>(m.shape, wt.data(), m.n, m.x.data(), hidden.data(), y.data(), m.r.data(), dw2.data(),
+                      nullptr, scratch.data());
   for (size_t i = 0; i < dw.size(); ++i) EXPECT_NEAR(dw2[i], 2.0 * dw[i], 1e-12 * (1 + std::abs(dw[i])));
 }
 
@@ -64,8 +64,8 @@ TEST_P(MlpGradientTest, JvpMatchesFiniteDifferencesOfForward) {
   const int slice_begin = 4, slice_dims = 5;
   const std::vector<double> v = RandomVector(m.n * slice_dims, 12, 4, -1.0, 1.0);
   std::vector<double> y(m.n * 3), jy(m.n * 3), scratch(MlpJvpScratch(m.shape, m.n));
-  MlpJvp<double>(m.shape, m.w.data(), m.n, m.x.data(), slice_begin, slice_dims, v.data(), y.data(),
-                 jy.data(), scratch.data());
+  MlpJvp<double>(m.shape, m.w.data(), m.n, m.x.data(), slice_begin, slice_dims, v.data(), y.data(), jy.data(),
+                 scratch.data());
   EXPECT_EQ(y, m.Forward());
   const double h = 1e-6;
   DoubleMlp plus = m, minus = m;
@@ -83,8 +83,8 @@ TEST_P(MlpGradientTest, JvpMatchesFiniteDifferencesOfForward) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Activations, MlpGradientTest,
-                         ::testing::Values(Activation::kNone, Activation::kRelu,
-                                           Activation::kSigmoid, Activation::kExp),
+                         ::testing::Values(Activation::kNone, Activation::kRelu, Activation::kSigmoid,
+                                           Activation::kExp),
                          [](const auto& info) { return ActivationName(info.param); });
 
 TEST(GemmTest, FloatKernelsMatchGenericForReferenceShapes) {
@@ -129,7 +129,8 @@ TEST(MlpTest, ThreadedFloatMatchesDoubleKernels) {
   std::vector<double> h(n * s.hidden_per_sample()), yd(n * 3), dxd(n * 32), scratch(MlpBackwardScratch(s, n));
   MlpForward<double>(s, w.data(), n, xd.data(), h.data(), yd.data());
   MlpTransposeWeights<double>(s, w.data(), wt.data());
-  MlpBackward<double>(s, wt.data(), n, xd.data(), h.data(), yd.data(), dyd.data(), dw.data(), dxd.data(), scratch.data());
+  MlpBackward<double>(s, wt.data(), n, xd.data(), h.data(), yd.data(), dyd.data(), dw.data(), dxd.data(),
+                      scratch.data());
   for (int64_t i = 0; i < n * 3; ++i) ASSERT_NEAR(y[i], yd[i], 1e-5);
   for (int64_t i = 0; i < n * 32; ++i) ASSERT_NEAR(dx[i], dxd[i], 1e-4 * (1 + std::abs(dxd[i])));
   const float* g = mlp.weight_grads();

@@ -25,8 +25,7 @@ bool Get(std::istream& in, T* v) {
 
 std::string ParamBlock::ToString() const {
   std::ostringstream s;
-  s << "ParamBlock(" << name << ", offset=" << offset << ", size=" << size << ", group=" << group
-    << ")";
+  s << "ParamBlock(" << name << ", offset=" << offset << ", size=" << size << ", group=" << group << ")";
   return s.str();
 }
 
@@ -97,11 +96,12 @@ Status ParameterStore::Read(std::istream& in) {
   uint32_t version = 0, count = 0;
   if (!Get(in, &version)) return Status::Error("parameters: truncated header (version)");
   if (version != kVersion) {
-    return Status::Error("parameters: unsupported version " + std::to_string(version) +
-                         " (expected " + std::to_string(kVersion) + ")");
+    return Status::Error("parameters: unsupported version " + std::to_string(version) + " (expected " +
+                         std::to_string(kVersion) + ")");
   }
   if (!Get(in, &count)) return Status::Error("parameters: truncated header (block count)");
-  if (count > (1u << 16)) return Status::Error("parameters: implausible block count " + std::to_string(count));
+  if (count > (1u << 16))
+    return Status::Error("parameters: implausible block count " + std::to_string(count));
   // The file's block headers first, so that a mismatch names the block that differs.
   struct FileBlock {
     std::string name;
@@ -119,13 +119,18 @@ Status ParameterStore::Read(std::istream& in) {
     }
   }
   const std::string counts = " (the file has " + std::to_string(count) + " blocks, the model " +
-                             std::to_string(blocks_.size()) + ": written by another version or for another method?)";
+                             std::to_string(blocks_.size()) +
+                             ": written by another version or for another method?)";
   for (size_t k = 0; k < std::max<size_t>(file.size(), blocks_.size()); ++k) {
-    if (k >= file.size()) return Status::Error("parameters: the model's block '" + blocks_[k].name + "' is not in the file" + counts);
-    if (k >= blocks_.size()) return Status::Error("parameters: block '" + file[k].name + "' in file is not in the model" + counts);
+    if (k >= file.size())
+      return Status::Error("parameters: the model's block '" + blocks_[k].name + "' is not in the file" +
+                           counts);
+    if (k >= blocks_.size())
+      return Status::Error("parameters: block '" + file[k].name + "' in file is not in the model" + counts);
     const ParamBlock& b = blocks_[k];
     if (file[k].name != b.name) {
-      return Status::Error("parameters: block '" + file[k].name + "' in file where model expects '" + b.name + "'");
+      return Status::Error("parameters: block '" + file[k].name + "' in file where model expects '" + b.name +
+                           "'");
     }
     if (file[k].size != b.size) {
       return Status::Error("parameters: block '" + b.name + "' has " + std::to_string(file[k].size) +

@@ -78,7 +78,8 @@ class SlotAllocator {
       uint64_t used = used_.load(std::memory_order_relaxed);
       for (int i = 0; i < num_slots_; ++i) {
         const uint64_t bit = uint64_t{1} << i;
-        if (!(used & bit) && used_.compare_exchange_weak(used, used | bit, std::memory_order_acquire)) return i;
+        if (!(used & bit) && used_.compare_exchange_weak(used, used | bit, std::memory_order_acquire))
+          return i;
       }
     }
   }

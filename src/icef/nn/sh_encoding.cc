@@ -12,16 +12,15 @@ ShEncoding::ShEncoding(const ShEncodingOptions& options) : options_(options) {
   ICEF_CHECK(st.ok(), st.message());
 }
 
-void ShEncoding::Forward(const Executor& executor, int64_t n, const float* directions,
-                         float* y) const {
+void ShEncoding::Forward(const Executor& executor, int64_t n, const float* directions, float* y) const {
   const int out = output_dims();
   ParallelFor(executor, n, [&](int64_t b, int64_t e, int) {
     ShForward<float>(options_.degree, e - b, directions + 3 * b, y + b * out);
   });
 }
 
-void ShEncoding::Backward(const Executor& executor, int64_t n, const float* directions,
-                          const float* dy, float* d_directions) const {
+void ShEncoding::Backward(const Executor& executor, int64_t n, const float* directions, const float* dy,
+                          float* d_directions) const {
   const int out = output_dims();
   ParallelFor(executor, n, [&](int64_t b, int64_t e, int) {
     ShBackward<float>(options_.degree, e - b, directions + 3 * b, dy + b * out, d_directions + 3 * b);

@@ -19,7 +19,8 @@ TEST(ShEncodingTest, BasisIsOrthonormalOnTheSphere) {
     const double theta = (i + 0.5) * M_PI / nt;
     for (int j = 0; j < np; ++j) {
       const double phi = (j + 0.5) * 2 * M_PI / np;
-      const double x = std::sin(theta) * std::cos(phi), y = std::sin(theta) * std::sin(phi), z = std::cos(theta);
+      const double x = std::sin(theta) * std::cos(phi), y = std::sin(theta) * std::sin(phi),
+                   z = std::cos(theta);
       double b[16];
       ShBasis<double>(4, x, y, z, b);
       const double dA = std::sin(theta) * (M_PI / nt) * (2 * M_PI / np);

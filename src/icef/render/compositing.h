@@ -127,22 +127,22 @@ void CompositeRayBackward(int n, int num_used, const T* sigma, const T* rgb, con
 // Batched inputs: samples of all rays in RaySamples layout.
 template <typename T>
 struct CompositeInputs {
-  std::span<const T> sigma;              // [n]
-  std::span<const T> rgb;                // [n, 3]
-  std::span<const T> t;                  // [n]
-  std::span<const T> dt;                 // [n]
-  std::span<const int32_t> ray_offset;   // [num_rays]
-  std::span<const int32_t> ray_count;    // [num_rays]
-  std::span<const T> background;         // [3] shared by all rays, or [num_rays, 3] per ray
+  std::span<const T> sigma;             // [n]
+  std::span<const T> rgb;               // [n, 3]
+  std::span<const T> t;                 // [n]
+  std::span<const T> dt;                // [n]
+  std::span<const int32_t> ray_offset;  // [num_rays]
+  std::span<const int32_t> ray_count;   // [num_rays]
+  std::span<const T> background;        // [3] shared by all rays, or [num_rays, 3] per ray
 };
 
 template <typename T>
 struct CompositeOutputs {
-  std::vector<T> color;          // [num_rays, 3]
-  std::vector<T> opacity;        // [num_rays]
-  std::vector<T> depth;          // [num_rays]
-  std::vector<T> weights;        // [n]
-  std::vector<int32_t> num_used; // [num_rays] samples used before early termination
+  std::vector<T> color;           // [num_rays, 3]
+  std::vector<T> opacity;         // [num_rays]
+  std::vector<T> depth;           // [num_rays]
+  std::vector<T> weights;         // [n]
+  std::vector<int32_t> num_used;  // [num_rays] samples used before early termination
 };
 
 // Incoming gradients; empty spans mean zero.
@@ -161,7 +161,7 @@ void CompositeForward(const CompositeInputs<T>& in, const CompositeOptions& opti
 // Needs the forward's num_used. Resizes and overwrites d_sigma [n], d_rgb [n, 3].
 template <typename T>
 void CompositeBackward(const CompositeInputs<T>& in, const CompositeOutputs<T>& forward,
-                       const CompositeOutputGradients<T>& grads, const Executor& executor, std::vector<T>* d_sigma,
-                       std::vector<T>* d_rgb);
+                       const CompositeOutputGradients<T>& grads, const Executor& executor,
+                       std::vector<T>* d_sigma, std::vector<T>* d_rgb);
 
 }  // namespace icef

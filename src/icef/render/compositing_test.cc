@@ -41,8 +41,8 @@ struct LossWeights {
 double Loss(const RayData& r, double eps, const LossWeights& g, int* used = nullptr) {
   double c[3], op, d;
   std::vector<double> w(r.n);
-  const int m = CompositeRayForward<double>(r.n, r.sigma.data(), r.rgb.data(), r.t.data(), r.dt.data(), r.bg.data(),
-                                            eps, c, &op, &d, w.data());
+  const int m = CompositeRayForward<double>(r.n, r.sigma.data(), r.rgb.data(), r.t.data(), r.dt.data(),
+                                            r.bg.data(), eps, c, &op, &d, w.data());
   if (used) *used = m;
   double loss = g.dc[0] * c[0] + g.dc[1] * c[1] + g.dc[2] * c[2] + g.dop * op + g.dd * d;
   for (int i = 0; i < r.n && !g.dw.empty(); ++i) loss += g.dw[i] * w[i];
@@ -53,8 +53,8 @@ TEST(CompositingTest, MatchesNaiveReference) {
   const RayData r = RandomRay(20, 1, 10.0);
   double c[3], op, d;
   std::vector<double> w(r.n);
-  CompositeRayForward<double>(r.n, r.sigma.data(), r.rgb.data(), r.t.data(), r.dt.data(), r.bg.data(), 0.0, c, &op,
-                              &d, w.data());
+  CompositeRayForward<double>(r.n, r.sigma.data(), r.rgb.data(), r.t.data(), r.dt.data(), r.bg.data(), 0.0, c,
+                              &op, &d, w.data());
   double ref_c[3] = {0, 0, 0}, ref_d = 0, sum_w = 0;
   for (int i = 0; i < r.n; ++i) {
     double trans = 1;
@@ -82,8 +82,8 @@ void CheckGradient(const RayData& base, double eps, bool with_dw, uint64_t seed)
   Loss(base, eps, g, &m);
   std::vector<double> d_sigma(base.n), d_rgb(3 * base.n);
   CompositeRayBackward<double>(base.n, m, base.sigma.data(), base.rgb.data(), base.t.data(), base.dt.data(),
-                               base.bg.data(), g.dc, g.dop, g.dd, with_dw ? g.dw.data() : nullptr, d_sigma.data(),
-                               d_rgb.data());
+                               base.bg.data(), g.dc, g.dop, g.dd, with_dw ? g.dw.data() : nullptr,
+                               d_sigma.data(), d_rgb.data());
   const double h = 1e-6;
   for (int i = 0; i < base.n; ++i) {
     RayData p = base, q = base;
@@ -124,8 +124,8 @@ TEST(CompositingTest, EarlyTerminationStopsAndItsBackwardIsConsistent) {
   // Samples past the termination point get zero gradient; the others match central differences.
   CheckGradient(r, eps, true, 4);
   std::vector<double> d_sigma(r.n), d_rgb(3 * r.n);
-  CompositeRayBackward<double>(r.n, m_term, r.sigma.data(), r.rgb.data(), r.t.data(), r.dt.data(), r.bg.data(), g.dc,
-                               g.dop, g.dd, nullptr, d_sigma.data(), d_rgb.data());
+  CompositeRayBackward<double>(r.n, m_term, r.sigma.data(), r.rgb.data(), r.t.data(), r.dt.data(),
+                               r.bg.data(), g.dc, g.dop, g.dd, nullptr, d_sigma.data(), d_rgb.data());
   for (int i = m_term; i < r.n; ++i) EXPECT_EQ(d_sigma[i], 0.0);
 }
 
@@ -179,22 +179,23 @@ TEST(CompositingTest, BatchedMatchesPerRayAndFloatMatchesDouble) {
   CompositeBackward<double>(in, out, {d_color, {}, {}, {}}, Executor(2), &d_sigma, &d_rgb);
   ASSERT_EQ(d_sigma.size(), sigma.size());
   std::vector<double> ref_sigma(11), ref_rgb(33);
-  CompositeRayBackward<double>(11, out.num_used[2], rays[2].sigma.data(), rays[2].rgb.data(), rays[2].t.data(),
-                               rays[2].dt.data(), rays[2].bg.data(), d_color.data(), 0.0, 0.0, nullptr,
-                               ref_sigma.data(), ref_rgb.data());
+  CompositeRayBackward<double>(11, out.num_used[2], rays[2].sigma.data(), rays[2].rgb.data(),
+                               rays[2].t.data(), rays[2].dt.data(), rays[2].bg.data(), d_color.data(), 0.0,
+                               0.0, nullptr, ref_sigma.data(), ref_rgb.data());
   for (int i = 0; i < 11; ++i) EXPECT_DOUBLE_EQ(d_sigma[7 + i], ref_sigma[i]);
   // Float path agrees with double to float precision.
   std::vector<float> fs(sigma.begin(), sigma.end()), frgb(rgb.begin(), rgb.end()), ft(t.begin(), t.end()),
       fdt(dt.begin(), dt.end()), fbg(bg.begin(), bg.end());
   CompositeOutputs<float> fout;
-  CompositeForward(CompositeInputs<float>{fs, frgb, ft, fdt, offset, count, fbg}, options, Executor(1), &fout);
+  CompositeForward(CompositeInputs<float>{fs, frgb, ft, fdt, offset, count, fbg}, options, Executor(1),
+                   &fout);
   for (size_t k = 0; k < out.color.size(); ++k) EXPECT_NEAR(fout.color[k], out.color[k], 1e-5);
 }
 
 TEST(CompositingTest, OpaqueSurfaceGivesItsColourAndDepth) {
   // One very dense sample: colour = its rgb, opacity = 1, depth = its t.
-  const double sigma[2] = {1e4, 1.0}, rgb[6] = {0.2, 0.4, 0.6, 1, 1, 1}, t[2] = {1.5, 1.7}, dt[2] = {0.1, 0.1},
-               bg[3] = {1, 1, 1};
+  const double sigma[2] = {1e4, 1.0}, rgb[6] = {0.2, 0.4, 0.6, 1, 1, 1}, t[2] = {1.5, 1.7},
+               dt[2] = {0.1, 0.1}, bg[3] = {1, 1, 1};
   double c[3], op, d;
   const int m = CompositeRayForward<double>(2, sigma, rgb, t, dt, bg, 1e-4, c, &op, &d, nullptr);
   EXPECT_EQ(m, 1);

@@ -33,10 +33,11 @@ T DistortionLoss(std::span<const T> weights, std::span<const T> t, std::span<con
 }
 
 template float DistortionLoss<float>(std::span<const float>, std::span<const float>, std::span<const float>,
-                                     std::span<const int32_t>, std::span<const int32_t>, float, const Executor&,
-                                     std::vector<float>*);
-template double DistortionLoss<double>(std::span<const double>, std::span<const double>, std::span<const double>,
-                                       std::span<const int32_t>, std::span<const int32_t>, double,
-                                       const Executor&, std::vector<double>*);
+                                     std::span<const int32_t>, std::span<const int32_t>, float,
+                                     const Executor&, std::vector<float>*);
+template double DistortionLoss<double>(std::span<const double>, std::span<const double>,
+                                       std::span<const double>, std::span<const int32_t>,
+                                       std::span<const int32_t>, double, const Executor&,
+                                       std::vector<double>*);
 
 }  // namespace icef

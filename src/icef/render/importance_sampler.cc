@@ -2,15 +2,16 @@
 
 #include <algorithm>
 #include <cmath>
-#include <vector>
 #include <sstream>
+#include <vector>
 
 #include "icef/core/rng.h"
 
 namespace icef {
 
 Status ImportanceOptions::Validate() const {
-  if (num_samples < 0 || num_samples > 65536) return Status::Error("importance_samples must be in [0, 65536]");
+  if (num_samples < 0 || num_samples > 65536)
+    return Status::Error("importance_samples must be in [0, 65536]");
   if (!(uniform >= 0.f && uniform <= 1.f)) return Status::Error("importance_uniform must be in [0, 1]");
   return Status::Ok();
 }
@@ -24,7 +25,8 @@ std::string ImportanceOptions::ToString() const {
 namespace {
 
 // The fine sample count of each coarse interval of one ray (counts[0..m)), summing to n.
-void Allocate(const float* sigma, const float* dt, int64_t m, int n, float uniform, float jitter, int32_t* counts) {
+void Allocate(const float* sigma, const float* dt, int64_t m, int n, float uniform, float jitter,
+              int32_t* counts) {
   double transmittance = 1.0, weight_sum = 0.0, length = 0.0;
   // Two passes over the ray: the weights' sum first, then the cumulative allocation (the weights are
   // recomputed rather than stored).

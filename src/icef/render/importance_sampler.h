@@ -28,8 +28,8 @@
 namespace icef {
 
 struct ImportanceOptions {
-  int num_samples = 0;    // fine samples per ray; 0 = off (the coarse samples are the training samples)
-  float uniform = 0.1f;   // share of each ray's fine samples spread over its coarse intervals by length
+  int num_samples = 0;   // fine samples per ray; 0 = off (the coarse samples are the training samples)
+  float uniform = 0.1f;  // share of each ray's fine samples spread over its coarse intervals by length
 
   bool enabled() const { return num_samples > 0; }
   bool operator==(const ImportanceOptions&) const = default;

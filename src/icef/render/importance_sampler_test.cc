@@ -57,10 +57,13 @@ TEST(ImportanceSamplerTest, FineSamplesTileTheCoarseIntervalsInOrder) {
       int inside = 0;
       for (int64_t i = c0; i < c0 + m; ++i) {
         const float lo = coarse.t[i] - 0.5f * coarse.dt[i], hi = coarse.t[i] + 0.5f * coarse.dt[i];
-        if (fine.t[k] - 0.5f * fine.dt[k] >= lo - 1e-5f && fine.t[k] + 0.5f * fine.dt[k] <= hi + 1e-5f) ++inside;
+        if (fine.t[k] - 0.5f * fine.dt[k] >= lo - 1e-5f && fine.t[k] + 0.5f * fine.dt[k] <= hi + 1e-5f)
+          ++inside;
       }
       EXPECT_EQ(inside, 1) << "ray " << r << " sample " << k - o;
-      if (k > o) EXPECT_GE(fine.t[k] - 0.5f * fine.dt[k], fine.t[k - 1] + 0.5f * fine.dt[k - 1] - 1e-5f);  // no overlap
+      if (k > o)
+        EXPECT_GE(fine.t[k] - 0.5f * fine.dt[k],
+                  fine.t[k - 1] + 0.5f * fine.dt[k - 1] - 1e-5f);  // no overlap
     }
     double length = 0;
     for (int64_t i = c0; i < c0 + m; ++i) length += coarse.dt[i];
@@ -85,7 +88,8 @@ TEST(ImportanceSamplerTest, SamplesGatherWhereTheWeightIs) {
     for (int64_t i = c0; i < c0 + m && front < 0; ++i)
       if (sigma[i] > 0) front = i;
     ASSERT_GE(front, 0);
-    const float lo = coarse.t[front] - 0.5f * coarse.dt[front], hi = coarse.t[front] + 0.5f * coarse.dt[front];
+    const float lo = coarse.t[front] - 0.5f * coarse.dt[front],
+                hi = coarse.t[front] + 0.5f * coarse.dt[front];
     int there = 0;
     for (int64_t k = fine.ray_offset[r]; k < fine.ray_offset[r] + 40; ++k)
       if (fine.t[k] > lo && fine.t[k] < hi) ++there;

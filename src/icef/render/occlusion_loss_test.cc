@@ -77,18 +77,21 @@ TEST(OcclusionLossTest, MaskSelectsTheSamplesItActsOn) {
   std::vector<double> ones(n, 1.0), half(n, 1.0);
   for (int i = n / 2; i < n; ++i) half[i] = 0.0;
   std::vector<double> g_plain(n, 0.0), g_ones(n, 0.0), g_half(n, 0.0);
-  const double plain = OcclusionLossRay<double>(n, r.w.data(), r.sigma.data(), r.dt.data(), 1.0, g_plain.data());
-  const double all = OcclusionLossRay<double>(n, r.w.data(), r.sigma.data(), r.dt.data(), 1.0, g_ones.data(),
-                                              ones.data());
-  const double front = OcclusionLossRay<double>(n, r.w.data(), r.sigma.data(), r.dt.data(), 1.0, g_half.data(),
-                                                half.data());
+  const double plain =
+      OcclusionLossRay<double>(n, r.w.data(), r.sigma.data(), r.dt.data(), 1.0, g_plain.data());
+  const double all =
+      OcclusionLossRay<double>(n, r.w.data(), r.sigma.data(), r.dt.data(), 1.0, g_ones.data(), ones.data());
+  const double front =
+      OcclusionLossRay<double>(n, r.w.data(), r.sigma.data(), r.dt.data(), 1.0, g_half.data(), half.data());
   EXPECT_DOUBLE_EQ(all, plain);
   EXPECT_GT(front, 0.0);
   EXPECT_LT(front, plain);
   for (int i = 0; i < n; ++i) {
     EXPECT_DOUBLE_EQ(g_ones[i], g_plain[i]) << i;
-    if (i < n / 2) EXPECT_DOUBLE_EQ(g_half[i], g_plain[i]) << i;
-    else EXPECT_EQ(g_half[i], 0.0) << i;
+    if (i < n / 2)
+      EXPECT_DOUBLE_EQ(g_half[i], g_plain[i]) << i;
+    else
+      EXPECT_EQ(g_half[i], 0.0) << i;
   }
 }
 
@@ -106,10 +109,10 @@ TEST(OcclusionLossTest, OnlyDensityBehindAbsorbedLightCosts) {
   }
   std::vector<double> grad(4, 0.0);
   const double loss = OcclusionLossRay<double>(4, w.data(), sigma.data(), dt.data(), 1.0, grad.data());
-  EXPECT_EQ(grad[0], 0.0);              // nothing absorbed before the first sample
-  EXPECT_LT(grad[1], 0.2 * grad[3]);    // in front of the surface: little absorbed yet
-  EXPECT_GT(grad[3], 0.05);             // behind the surface: pushed down
-  EXPECT_NEAR(grad[2], 0.0, 1e-12);     // the surface itself is saturated
+  EXPECT_EQ(grad[0], 0.0);            // nothing absorbed before the first sample
+  EXPECT_LT(grad[1], 0.2 * grad[3]);  // in front of the surface: little absorbed yet
+  EXPECT_GT(grad[3], 0.05);           // behind the surface: pushed down
+  EXPECT_NEAR(grad[2], 0.0, 1e-12);   // the surface itself is saturated
   // Removing the haze behind the surface lowers the loss.
   sigma[3] = 0.0;
   EXPECT_LT(OcclusionLossRay<double>(4, w.data(), sigma.data(), dt.data(), 1.0, nullptr), loss);

@@ -11,7 +11,8 @@ namespace icef {
 Status OccupancyGridOptions::Validate() const {
   if (resolution < 1 || resolution > 1024) return Status::Error("occupancy.resolution must be in [1, 1024]");
   if (!(decay >= 0.f && decay <= 1.f)) return Status::Error("occupancy.decay must be in [0, 1]");
-  if (!(threshold >= 0.f) || !std::isfinite(threshold)) return Status::Error("occupancy.threshold must be >= 0");
+  if (!(threshold >= 0.f) || !std::isfinite(threshold))
+    return Status::Error("occupancy.threshold must be >= 0");
   if (dilation < 0 || dilation > 16) return Status::Error("occupancy.dilation must be in [0, 16]");
   if (query_batch < 1) return Status::Error("occupancy.query_batch must be >= 1");
   if (!(update_fraction > 0.f && update_fraction <= 1.f))
@@ -69,14 +70,17 @@ void OccupancyGrid::Update(const DensityQuery& query, uint64_t seed, int64_t ste
   for (float& d : density_) d *= options_.decay;
   // The cells to re-query this step, in index order.
   std::vector<int64_t> selected;
-  selected.reserve(options_.update_fraction >= 1.f ? cells : int64_t(cells * options_.update_fraction * 1.1f) + 16);
+  selected.reserve(options_.update_fraction >= 1.f ? cells
+                                                   : int64_t(cells * options_.update_fraction * 1.1f) + 16);
   for (int64_t c = 0; c < cells; ++c) {
     if (!queried_.empty() && !queried_[c]) continue;
     if (options_.update_fraction >= 1.f ||
-        Rng(seed, StreamId("occupancy_subset"), uint64_t(step), uint64_t(c)).Uniform() < options_.update_fraction)
+        Rng(seed, StreamId("occupancy_subset"), uint64_t(step), uint64_t(c)).Uniform() <
+            options_.update_fraction)
       selected.push_back(c);
   }
-  const int64_t batch = std::max<int64_t>(1, std::min<int64_t>(options_.query_batch, int64_t(selected.size())));
+  const int64_t batch =
+      std::max<int64_t>(1, std::min<int64_t>(options_.query_batch, int64_t(selected.size())));
   std::vector<float> positions(batch * 3);
   std::vector<float> sigma(batch);
   for (int64_t begin = 0; begin < int64_t(selected.size()); begin += batch) {
@@ -85,7 +89,8 @@ void OccupancyGrid::Update(const DensityQuery& query, uint64_t seed, int64_t ste
       const int64_t c = selected[begin + i];
       const int idx[3] = {int(c % r), int((c / r) % r), int(c / (int64_t(r) * r))};
       Rng rng(seed, StreamId("occupancy"), uint64_t(step), uint64_t(c));
-      for (int a = 0; a < 3; ++a) positions[3 * i + a] = aabb_.min[a] + (float(idx[a]) + rng.Uniform()) * cell_size[a];
+      for (int a = 0; a < 3; ++a)
+        positions[3 * i + a] = aabb_.min[a] + (float(idx[a]) + rng.Uniform()) * cell_size[a];
     }
     query(positions.data(), n, sigma.data());
     for (int64_t i = 0; i < n; ++i) {

@@ -5,7 +5,6 @@
 #pragma once
 
 #include <algorithm>
-
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -18,10 +17,10 @@
 namespace icef {
 
 struct OccupancyGridOptions {
-  int resolution = 64;       // cells per axis (resolution^3 cells over the aabb)
-  float decay = 0.9f;        // EMA: stored density <- max(decay * stored, new density) per update
-  float threshold = 0.5f;    // a cell is occupied when its stored density (sigma, 1/world units) exceeds this
-  int dilation = 1;          // occupied cells are dilated by this many cells (Chebyshev distance)
+  int resolution = 64;     // cells per axis (resolution^3 cells over the aabb)
+  float decay = 0.9f;      // EMA: stored density <- max(decay * stored, new density) per update
+  float threshold = 0.5f;  // a cell is occupied when its stored density (sigma, 1/world units) exceeds this
+  int dilation = 1;        // occupied cells are dilated by this many cells (Chebyshev distance)
   int64_t query_batch = 65536;  // positions per density-query call
   float update_fraction = 1.f;  // fraction of cells re-queried per Update (a random subset; all cells decay)
 
@@ -73,7 +72,9 @@ class OccupancyGrid {
   int resolution() const { return options_.resolution; }
   const Aabb& aabb() const { return aabb_; }
   const OccupancyGridOptions& options() const { return options_; }
-  int64_t num_cells() const { return int64_t(options_.resolution) * options_.resolution * options_.resolution; }
+  int64_t num_cells() const {
+    return int64_t(options_.resolution) * options_.resolution * options_.resolution;
+  }
   int64_t NumOccupied() const;
   double OccupiedFraction() const { return double(NumOccupied()) / double(num_cells()); }
   // Stored densities [resolution^3], index (z * R + y) * R + x; for checkpoints.
@@ -91,7 +92,9 @@ class OccupancyGrid {
     }
     return CellIndex(c[0], c[1], c[2]);
   }
-  int64_t CellIndex(int x, int y, int z) const { return (int64_t(z) * options_.resolution + y) * options_.resolution + x; }
+  int64_t CellIndex(int x, int y, int z) const {
+    return (int64_t(z) * options_.resolution + y) * options_.resolution + x;
+  }
 
   std::string ToString() const;
 
@@ -103,9 +106,9 @@ class OccupancyGrid {
   Aabb aabb_;
   OccupancyGridOptions options_;
   Vec3f inv_cell_size_;
-  std::vector<float> density_;   // [R^3]
-  std::vector<uint8_t> bits_;    // [R^3] 1 = occupied (after dilation)
-  std::vector<uint8_t> allowed_; // [R^3] or empty: 0 = never occupied
+  std::vector<float> density_;    // [R^3]
+  std::vector<uint8_t> bits_;     // [R^3] 1 = occupied (after dilation)
+  std::vector<uint8_t> allowed_;  // [R^3] or empty: 0 = never occupied
   // [R^3] or empty (query every cell): the cells Update queries, the allowed set dilated as the
   // bits are. A cell beyond it cannot make an allowed cell occupied, so its density is not asked
   // for: with a visual hull that carves most of the box, most of the cost of an update.

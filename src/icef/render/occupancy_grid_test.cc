@@ -84,11 +84,13 @@ TEST(OccupancyGridTest, PartialUpdatesQueryAboutThatFractionOfCells) {
   o.update_fraction = 0.25f;
   OccupancyGrid grid(Aabb(), o);
   int64_t queried = 0;
-  grid.Update([&](const float*, int64_t n, float* sigma) {
-    queried += n;
-    for (int64_t i = 0; i < n; ++i) sigma[i] = 1.f;
-  }, 3, 0);
-  EXPECT_GT(queried, 900);   // 0.25 * 4096 = 1024
+  grid.Update(
+      [&](const float*, int64_t n, float* sigma) {
+        queried += n;
+        for (int64_t i = 0; i < n; ++i) sigma[i] = 1.f;
+      },
+      3, 0);
+  EXPECT_GT(queried, 900);  // 0.25 * 4096 = 1024
   EXPECT_LT(queried, 1150);
   int64_t high = 0;
   for (float d : grid.densities()) high += d == 1.f ? 1 : 0;
@@ -198,7 +200,9 @@ TEST(OccupancyGridTest, QueriedCellsAddCellsOutsideTheAllowedSet) {
   auto one_cell = [&](const float* p, int64_t n, float* sigma) {
     queried += n;
     for (int64_t i = 0; i < n; ++i)
-      sigma[i] = (Vec3f(p[3 * i], p[3 * i + 1], p[3 * i + 2]) - Vec3f(0.375f, 0.375f, 0.375f)).norm() < 0.01f ? 1.f : 0.f;
+      sigma[i] = (Vec3f(p[3 * i], p[3 * i + 1], p[3 * i + 2]) - Vec3f(0.375f, 0.375f, 0.375f)).norm() < 0.01f
+                     ? 1.f
+                     : 0.f;
   };
   const OccupancyGrid render = grid.WithQueriedCells(one_cell);
   EXPECT_EQ(queried, grid.num_cells());
@@ -211,7 +215,8 @@ TEST(OccupancyGridTest, QueriedCellsAddCellsOutsideTheAllowedSet) {
   o.dilation = 1;
   OccupancyGrid dilated(Aabb{}, o);
   dilated.Fill(false);
-  EXPECT_EQ(dilated.WithQueriedCells([](const float*, int64_t n, float* s) { std::fill(s, s + n, 0.f); }).NumOccupied(),
+  EXPECT_EQ(dilated.WithQueriedCells([](const float*, int64_t n, float* s) { std::fill(s, s + n, 0.f); })
+                .NumOccupied(),
             0);
   EXPECT_EQ(dilated.WithQueriedCells(one_cell).NumOccupied(), 27);
   const OccupancyGrid half = dilated.WithQueriedCells([&](const float* p, int64_t n, float* sigma) {
@@ -222,11 +227,15 @@ TEST(OccupancyGridTest, QueriedCellsAddCellsOutsideTheAllowedSet) {
   EXPECT_EQ(half.NumOccupied(), 18);  // x in {4, 5} of the 3 x 3 x 3 block
   // Stride 2: one query per 2 x 2 x 2 block; a dense block occupies its 8 cells (dilated: 4^3).
   queried = 0;
-  const OccupancyGrid coarse = dilated.WithQueriedCells([&](const float* p, int64_t n, float* sigma) {
-    queried += n;
-    for (int64_t i = 0; i < n; ++i)  // block (2, 2, 2): cells 4..5, centre (0.25, 0.25, 0.25)
-      sigma[i] = (Vec3f(p[3 * i], p[3 * i + 1], p[3 * i + 2]) - Vec3f(0.25f, 0.25f, 0.25f)).norm() < 0.01f ? 1.f : 0.f;
-  }, 2);
+  const OccupancyGrid coarse = dilated.WithQueriedCells(
+      [&](const float* p, int64_t n, float* sigma) {
+        queried += n;
+        for (int64_t i = 0; i < n; ++i)  // block (2, 2, 2): cells 4..5, centre (0.25, 0.25, 0.25)
+          sigma[i] = (Vec3f(p[3 * i], p[3 * i + 1], p[3 * i + 2]) - Vec3f(0.25f, 0.25f, 0.25f)).norm() < 0.01f
+                         ? 1.f
+                         : 0.f;
+      },
+      2);
   EXPECT_EQ(queried, 4 * 4 * 4);
   EXPECT_EQ(coarse.NumOccupied(), 4 * 4 * 4);
   EXPECT_TRUE(coarse.IsCellOccupied(3, 3, 3));

@@ -26,8 +26,8 @@ bool RayMarch::NextRound(const RaySamples& samples, int64_t target_rows, int min
     return done_[r] || next_[r] >= samples.ray_offset[r] + samples.ray_count[r];
   });
   if (active_.empty()) return false;
-  const int64_t per_ray =
-      std::clamp<int64_t>(target_rows / int64_t(active_.size()), min_per_ray, std::max(min_per_ray, max_per_ray));
+  const int64_t per_ray = std::clamp<int64_t>(target_rows / int64_t(active_.size()), min_per_ray,
+                                              std::max(min_per_ray, max_per_ray));
   row_begin_.resize(active_.size() + 1);
   row_begin_[0] = 0;
   for (size_t k = 0; k < active_.size(); ++k) {

@@ -63,13 +63,13 @@ class RayMarch {
  private:
   int num_extras_ = 0;
   int stride_ = 4;
-  std::vector<int32_t> active_;    // rays still marching
-  std::vector<int32_t> next_;      // [rays] first sample not yet composited
-  std::vector<int64_t> row_begin_; // [active + 1] this round's rows per active ray
+  std::vector<int32_t> active_;     // rays still marching
+  std::vector<int32_t> next_;       // [rays] first sample not yet composited
+  std::vector<int64_t> row_begin_;  // [active + 1] this round's rows per active ray
   int64_t round_rows_ = 0;
-  std::vector<float> trans_;       // [rays] transmittance so far
-  std::vector<uint8_t> done_;      // [rays] terminated
-  std::vector<float> acc_;         // [rays, 4 + num_extras] colour, depth, extras
+  std::vector<float> trans_;   // [rays] transmittance so far
+  std::vector<uint8_t> done_;  // [rays] terminated
+  std::vector<float> acc_;     // [rays, 4 + num_extras] colour, depth, extras
 };
 
 }  // namespace icef

@@ -82,7 +82,12 @@ TEST(RayMarchTest, MatchesCompositingEverySampleAndSkipsSamplesBehindOpaqueSurfa
   const Batch b = RandomBatch(300, 40, 1);
   const float bg[3] = {0.2f, 0.5f, 0.9f};
   for (const float eps : {1e-4f, 1e-2f, 0.f}) {
-    CompositeInputs<float> in{b.sigma, b.rgb, b.samples.t, b.samples.dt, b.samples.ray_offset, b.samples.ray_count,
+    CompositeInputs<float> in{b.sigma,
+                              b.rgb,
+                              b.samples.t,
+                              b.samples.dt,
+                              b.samples.ray_offset,
+                              b.samples.ray_count,
                               std::span<const float>(bg, 3)};
     CompositeOptions options;
     options.transmittance_eps = eps;
@@ -95,7 +100,8 @@ TEST(RayMarchTest, MatchesCompositingEverySampleAndSkipsSamplesBehindOpaqueSurfa
       for (int64_t r = 0; r < b.samples.num_rays(); ++r) {
         // Same operations in the same order; only the compiler's fusing of multiply-adds (which
         // differs between optimisation levels) may move the last bit.
-        for (int a = 0; a < 3; ++a) ASSERT_NEAR(m.color[3 * r + a], ref.color[3 * r + a], 1e-6) << "ray " << r;
+        for (int a = 0; a < 3; ++a)
+          ASSERT_NEAR(m.color[3 * r + a], ref.color[3 * r + a], 1e-6) << "ray " << r;
         ASSERT_NEAR(m.opacity[r], ref.opacity[r], 1e-6) << "ray " << r;
         ASSERT_NEAR(m.depth[r], ref.depth[r], 1e-6) << "ray " << r;
         for (int e = 0; e < 2; ++e) {

@@ -9,10 +9,14 @@
 namespace icef {
 
 Status RaySamplerOptions::Validate() const {
-  if (num_samples < 1 || num_samples > 65536) return Status::Error("sampler.num_samples must be in [1, 65536]");
-  if (!(step_size >= 0.f) || !std::isfinite(step_size)) return Status::Error("sampler.step_size must be >= 0");
-  if (!(cone_angle >= 0.f) || !std::isfinite(cone_angle)) return Status::Error("sampler.cone_angle must be >= 0");
-  if (max_samples < 1 || max_samples > 65536) return Status::Error("sampler.max_samples must be in [1, 65536]");
+  if (num_samples < 1 || num_samples > 65536)
+    return Status::Error("sampler.num_samples must be in [1, 65536]");
+  if (!(step_size >= 0.f) || !std::isfinite(step_size))
+    return Status::Error("sampler.step_size must be >= 0");
+  if (!(cone_angle >= 0.f) || !std::isfinite(cone_angle))
+    return Status::Error("sampler.cone_angle must be >= 0");
+  if (max_samples < 1 || max_samples > 65536)
+    return Status::Error("sampler.max_samples must be in [1, 65536]");
   return Status::Ok();
 }
 

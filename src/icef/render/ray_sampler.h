@@ -35,10 +35,12 @@ struct RaySamplerOptions {
   // expr_gain (+0.035 on average) at an unchanged PSNR for 1.5x the training time of 96
   // (docs/results/sampler_samples).
   int num_samples = 144;
-  float step_size = 0.f;     // marching mode: minimum step (world units); 0 = fixed-count mode unless cone_angle > 0
-  float cone_angle = 0.f;    // marching mode: step grows as cone_angle * t (instant-ngp: 1/256); 0 = constant step
-  int max_samples = 1024;    // marching mode: cap on samples per ray
-  bool stratified = true;    // jitter sample positions per ray (training); false = deterministic midpoints
+  float step_size =
+      0.f;  // marching mode: minimum step (world units); 0 = fixed-count mode unless cone_angle > 0
+  float cone_angle =
+      0.f;  // marching mode: step grows as cone_angle * t (instant-ngp: 1/256); 0 = constant step
+  int max_samples = 1024;  // marching mode: cap on samples per ray
+  bool stratified = true;  // jitter sample positions per ray (training); false = deterministic midpoints
 
   bool Marching() const { return step_size > 0.f || cone_angle > 0.f; }
   bool operator==(const RaySamplerOptions&) const = default;
@@ -47,9 +49,9 @@ struct RaySamplerOptions {
 };
 
 struct RaySamples {
-  std::vector<float> t;          // [n] distance along the ray of each sample (interval midpoint)
-  std::vector<float> dt;         // [n] interval length
-  std::vector<float> positions;  // [n, 3] world frame, origin + t * direction
+  std::vector<float> t;             // [n] distance along the ray of each sample (interval midpoint)
+  std::vector<float> dt;            // [n] interval length
+  std::vector<float> positions;     // [n, 3] world frame, origin + t * direction
   std::vector<int32_t> ray_offset;  // [num_rays] first sample of each ray
   std::vector<int32_t> ray_count;   // [num_rays] samples of each ray (0 when the ray misses the aabb)
 

@@ -103,9 +103,11 @@ TEST(RaySamplerTest, OccupancyGridSkipsEmptyCells) {
   OccupancyGrid grid(Aabb(), grid_options);
   grid.Fill(false);  // forget the all-occupied start
   // Density only where z > 0.
-  grid.Update([](const float* p, int64_t n, float* sigma) {
-    for (int64_t i = 0; i < n; ++i) sigma[i] = p[3 * i + 2] > 0.f ? 10.f : 0.f;
-  }, 1, 0);
+  grid.Update(
+      [](const float* p, int64_t n, float* sigma) {
+        for (int64_t i = 0; i < n; ++i) sigma[i] = p[3 * i + 2] > 0.f ? 10.f : 0.f;
+      },
+      1, 0);
   const std::vector<Ray> rays = RandomRays(40, 3);
   RaySamples full, skipped;
   SampleRays(rays, Aabb(), RaySamplerOptions(), nullptr, 5, 0, Executor(2), &full);

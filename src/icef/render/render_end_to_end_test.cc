@@ -33,7 +33,8 @@ FieldEval EvalField(const std::vector<double>& theta, const std::vector<float>& 
       r2 += d * d;
     }
     f.sigma[i] = theta[0] * std::exp(-r2 / (2 * theta[4] * theta[4]));
-    for (int j = 0; j < 3; ++j) f.rgb[3 * i + j] = 1 / (1 + std::exp(-(theta[5 + j] + theta[8] * positions[3 * i + j])));
+    for (int j = 0; j < 3; ++j)
+      f.rgb[3 * i + j] = 1 / (1 + std::exp(-(theta[5 + j] + theta[8] * positions[3 * i + j])));
   }
   return f;
 }
@@ -52,9 +53,9 @@ struct Pipeline {
     const Executor executor(2);
     CompositeForward(in, options, executor, &out);
     std::vector<double> d_weights;
-    double loss = distortion_weight * DistortionLoss<double>(out.weights, t, dt, samples.ray_offset,
-                                                             samples.ray_count, distortion_weight, executor,
-                                                             grad ? &d_weights : nullptr);
+    double loss =
+        distortion_weight * DistortionLoss<double>(out.weights, t, dt, samples.ray_offset, samples.ray_count,
+                                                   distortion_weight, executor, grad ? &d_weights : nullptr);
     for (size_t r = 0; r < out.opacity.size(); ++r) {
       for (int k = 0; k < 3; ++k) loss += g_color[3 * r + k] * out.color[3 * r + k];
       loss += g_opacity[r] * out.opacity[r] + g_depth[r] * out.depth[r];
@@ -71,7 +72,8 @@ struct Pipeline {
       for (int j = 0; j < 3; ++j) r2 += (x[j] - theta[1 + j]) * (x[j] - theta[1 + j]);
       const double e = std::exp(-r2 / (2 * s * s));
       (*grad)[0] += d_sigma[i] * e;
-      for (int j = 0; j < 3; ++j) (*grad)[1 + j] += d_sigma[i] * theta[0] * e * (x[j] - theta[1 + j]) / (s * s);
+      for (int j = 0; j < 3; ++j)
+        (*grad)[1 + j] += d_sigma[i] * theta[0] * e * (x[j] - theta[1 + j]) / (s * s);
       (*grad)[4] += d_sigma[i] * theta[0] * e * r2 / (s * s * s);
       for (int j = 0; j < 3; ++j) {
         const double c = f.rgb[3 * i + j];

@@ -1,4 +1,4 @@
-#include "icef/eval/bench_protocol.h"
+#include "icef/study/bench_protocol.h"
 
 #include <algorithm>
 #include <chrono>
@@ -69,7 +69,8 @@ void BenchOptions::ApplyValidation() {
 std::string BenchOptions::IdentityRole() const {
   return validation ? "validation identities: for tuning and prior experiments, never reported as results"
                     : "test identities: never used to choose a default or a hyperparameter; tuning uses the "
-                      "validation seeds " + std::to_string(kFirstValidationSeed) + " and up (`icef bench --validation`)";
+                      "validation seeds " +
+                          std::to_string(kFirstValidationSeed) + " and up (`icef bench --validation`)";
 }
 
 Status BenchOptions::Validate() const {
@@ -77,8 +78,9 @@ Status BenchOptions::Validate() const {
   if (identities < 1) return Status::Error("bench: --identities must be >= 1");
   const uint64_t last_seed = first_identity_seed + uint64_t(identities) - 1;
   if (validation && first_identity_seed < kFirstValidationSeed)
-    return Status::Error("bench: --validation uses validation seeds (" + std::to_string(kFirstValidationSeed) +
-                         " and up), got --first-seed " + std::to_string(first_identity_seed));
+    return Status::Error("bench: --validation uses validation seeds (" +
+                         std::to_string(kFirstValidationSeed) + " and up), got --first-seed " +
+                         std::to_string(first_identity_seed));
   if (!validation && last_seed >= kFirstValidationSeed)
     return Status::Error("bench: seeds " + std::to_string(kFirstValidationSeed) +
                          " and up are validation identities; a test bench uses seeds below it (got seeds " +
@@ -89,7 +91,8 @@ Status BenchOptions::Validate() const {
   for (int k : ks)
     if (k < 1) return Status::Error("bench: --k values must be >= 1, got " + std::to_string(k));
   if (methods.empty()) return Status::Error("bench: --methods needs at least one method");
-  for (const std::string& m : methods) ICEF_RETURN_IF_ERROR(ParseMethod(m).status().WithContext("bench: --methods"));
+  for (const std::string& m : methods)
+    ICEF_RETURN_IF_ERROR(ParseMethod(m).status().WithContext("bench: --methods"));
   if (resolution < 16) return Status::Error("bench: --res must be >= 16");
   if (test_views < 1) return Status::Error("bench: test_views must be >= 1");
   if (novel_per_tier < 1) return Status::Error("bench: novel_per_tier must be >= 1");
@@ -108,8 +111,9 @@ Json BenchOptions::ToJson() const {
   j["ks"] = ks;
   j["replicates"] = replicates;
   j["methods"] = methods;
-  j["resolution"] = draw_resolution ? Json("drawn per identity, 128-" + std::to_string(kMaxValidationResolution))
-                                    : Json(resolution);
+  j["resolution"] = draw_resolution
+                        ? Json("drawn per identity, 128-" + std::to_string(kMaxValidationResolution))
+                        : Json(resolution);
   if (diverse) {
     synth::SceneAxes axes = synth::SceneAxes::All();
     axes.resolution = draw_resolution;
@@ -127,7 +131,9 @@ Json BenchOptions::ToJson() const {
   return j;
 }
 
-std::string BenchOptions::ToString() const { return "BenchOptions(out=" + out_dir.string() + ", " + ToJson().dump() + ")"; }
+std::string BenchOptions::ToString() const {
+  return "BenchOptions(out=" + out_dir.string() + ", " + ToJson().dump() + ")";
+}
 
 Status ParseShard(const std::string& text, int* index, int* count) {
   int i = 0, n = 0;
@@ -164,13 +170,15 @@ std::vector<RunId> PlanRuns(const BenchOptions& o) {
   for (int i = 0; i < o.identities; ++i)
     for (int k : o.ks)
       for (const std::string& m : o.methods)
-        for (int r = 0; r < o.replicates; ++r) runs.push_back(RunId{o.first_identity_seed + uint64_t(i), k, m, r});
+        for (int r = 0; r < o.replicates; ++r)
+          runs.push_back(RunId{o.first_identity_seed + uint64_t(i), k, m, r});
   return runs;
 }
 
 std::vector<RunId> ShardRuns(const std::vector<RunId>& runs, int index, int count) {
   std::vector<RunId> out;
-  for (size_t i = static_cast<size_t>(index); i < runs.size(); i += static_cast<size_t>(count)) out.push_back(runs[i]);
+  for (size_t i = static_cast<size_t>(index); i < runs.size(); i += static_cast<size_t>(count))
+    out.push_back(runs[i]);
   return out;
 }
 
@@ -182,8 +190,8 @@ double Seconds(std::chrono::steady_clock::time_point since) {
 
 // The dataset of (identity, K), synthesised on first use and cached in out/data/ (re-synthesised
 // when the options written beside it differ).
-Result<Dataset> EnsureDataset(const BenchOptions& o, uint64_t seed, int k, const Executor& executor, std::ostream& log,
-                              bool interactive) {
+Result<Dataset> EnsureDataset(const BenchOptions& o, uint64_t seed, int k, const Executor& executor,
+                              std::ostream& log, bool interactive) {
   synth::SynthOptions so;
   so.out_dir = o.out_dir / "data" / ("id" + std::to_string(seed) + "_k" + std::to_string(k));
   so.identity_seed = seed;
@@ -218,7 +226,8 @@ Result<RunConfig> MakeRunConfig(const BenchOptions& o, const RunId& id) {
   }
   config.train.checkpoint_every = 0;  // one checkpoint at the end (models are usually deleted)
   config.train.eval_every = 0;
-  for (const std::string& a : o.overrides) ICEF_RETURN_IF_ERROR(config.ApplyOverride(a).WithContext("bench: --set"));
+  for (const std::string& a : o.overrides)
+    ICEF_RETURN_IF_ERROR(config.ApplyOverride(a).WithContext("bench: --set"));
   config.model.method = id.method;
   config.train.steps = o.steps;
   config.train.time_budget_seconds = o.time_budget_seconds;
@@ -258,8 +267,9 @@ Result<BenchNetworks> LoadNetworks(const BenchOptions& o, std::ostream& log) {
 }
 
 // One run: train, evaluate, write runs/<name>/metrics.json.
-Result<RunRecord> RunOne(const BenchOptions& o, const RunId& id, const Dataset& dataset, BenchNetworks& networks,
-                         const Executor& executor, std::ostream& log, bool interactive) {
+Result<RunRecord> RunOne(const BenchOptions& o, const RunId& id, const Dataset& dataset,
+                         BenchNetworks& networks, const Executor& executor, std::ostream& log,
+                         bool interactive) {
   const fs::path run_dir = o.out_dir / "runs" / id.Name();
   const fs::path model_dir = run_dir / "model";
   std::error_code ec;
@@ -270,15 +280,15 @@ Result<RunRecord> RunOne(const BenchOptions& o, const RunId& id, const Dataset& 
   const auto train_start = std::chrono::steady_clock::now();
   ICEF_ASSIGN_OR_RETURN(std::unique_ptr<Trainer> trainer, Trainer::Create(dataset, model_dir, config));
   ProgressBar train_bar("train " + id.Name(), config.train.steps, log, interactive);
-  ICEF_ASSIGN_OR_RETURN(
-      const TrainSummary summary, trainer->Run(
-                                      [&](const TrainProgress& p) {
-                                        char status[96];
-                                        std::snprintf(status, sizeof status, "loss %.4f psnr %.2f", p.terms.total,
-                                                      p.terms.psnr());
-                                        train_bar.Update(p.step, status);
-                                      },
-                                      nullptr));
+  ICEF_ASSIGN_OR_RETURN(const TrainSummary summary, trainer->Run(
+                                                        [&](const TrainProgress& p) {
+                                                          char status[96];
+                                                          std::snprintf(status, sizeof status,
+                                                                        "loss %.4f psnr %.2f", p.terms.total,
+                                                                        p.terms.psnr());
+                                                          train_bar.Update(p.step, status);
+                                                        },
+                                                        nullptr));
   char done[128];
   std::snprintf(done, sizeof done, "%lld steps, batch psnr %.2f (%s)", static_cast<long long>(summary.steps),
                 summary.final_batch_psnr, summary.stop_reason.c_str());
@@ -316,11 +326,13 @@ Status RunBench(const BenchOptions& o, std::ostream& log, bool interactive) {
     if (!fs::exists(o.out_dir / "runs" / id.Name() / "metrics.json", ec)) todo.push_back(id);
   log << "bench: " << runs.size() << " runs in shard " << o.shard_index << "/" << o.shard_count << " ("
       << runs.size() - todo.size() << " already done), "
-      << (o.draw_resolution ? "resolution drawn per identity (128-" + std::to_string(kMaxValidationResolution) + ")"
-                            : std::to_string(o.resolution) + "x" + std::to_string(o.resolution))
+      << (o.draw_resolution
+              ? "resolution drawn per identity (128-" + std::to_string(kMaxValidationResolution) + ")"
+              : std::to_string(o.resolution) + "x" + std::to_string(o.resolution))
       << (o.diverse ? ", diverse scenes" : "") << ", "
-      << (o.time_budget_seconds > 0 ? "time budget " + ProgressBar::FormatDuration(o.time_budget_seconds) + ", up to "
-                                    : std::string())
+      << (o.time_budget_seconds > 0
+              ? "time budget " + ProgressBar::FormatDuration(o.time_budget_seconds) + ", up to "
+              : std::string())
       << o.steps << " steps per run\n";
   const Executor executor(o.threads);
   BenchNetworks networks;
@@ -342,7 +354,8 @@ Status RunBench(const BenchOptions& o, std::ostream& log, bool interactive) {
       ICEF_ASSIGN_OR_RETURN(Dataset d, EnsureDataset(o, id.identity_seed, id.k, executor, log, interactive));
       it = datasets.emplace(std::make_pair(id.identity_seed, id.k), std::move(d)).first;
     }
-    ICEF_ASSIGN_OR_RETURN(const RunRecord record, RunOne(o, id, it->second, networks, executor, log, interactive));
+    ICEF_ASSIGN_OR_RETURN(const RunRecord record,
+                          RunOne(o, id, it->second, networks, executor, log, interactive));
     const TierMetrics& far = record.metrics.tiers[TierIndex(Tier::kFar)];
     char line[256];
     std::snprintf(line, sizeof line, "bench: %s far tier: psnr %s id_distance %s (train %s, eval %s)\n",
@@ -368,8 +381,8 @@ Status RunBench(const BenchOptions& o, std::ostream& log, bool interactive) {
     context.notes.push_back("Shard " + std::to_string(o.shard_index) + "/" + std::to_string(o.shard_count) +
                             " only; merge the shards with `icef bench merge`.");
   if (records.size() < PlanRuns(o).size())
-    context.notes.push_back("Partial: " + std::to_string(records.size()) + " of " + std::to_string(PlanRuns(o).size()) +
-                            " planned runs are in this directory.");
+    context.notes.push_back("Partial: " + std::to_string(records.size()) + " of " +
+                            std::to_string(PlanRuns(o).size()) + " planned runs are in this directory.");
   ICEF_RETURN_IF_ERROR(WriteReport(o.out_dir, records, context));
   log << "bench: " << todo.size() << " runs in " << ProgressBar::FormatDuration(wall)
       << "; report: " << (o.out_dir / "report.md").string() << " (LaTeX tables: report.tex)\n";
@@ -377,82 +390,105 @@ Status RunBench(const BenchOptions& o, std::ostream& log, bool interactive) {
   return Status::Ok();
 }
 
+namespace {
+
+// What the inputs of a merge share: their settings (bench.json less what varies between shards),
+// every K and method any of them ran, and each run's metrics.json (run name -> text, source).
+struct MergeInputs {
+  std::optional<Json> settings;
+  Json union_parts = Json::object();  // "ks", "methods": every value any input ran, in first-seen order
+  std::map<std::string, std::pair<std::string, fs::path>> runs;
+};
+
+// One input's bench.json into `m`: which shard, which identities, which methods and Ks or how many
+// training replicates a directory ran does not make it another bench: benches of the same protocol
+// over other identity seeds, methods or frame counts merge like shards; the merged bench.json lists
+// every method and K of its inputs.
+Status MergeSettings(const fs::path& in, const fs::path& first, MergeInputs* m) {
+  ICEF_ASSIGN_OR_RETURN(Json s, ReadJsonFile(in / "bench.json"));
+  Json parts = Json::object();
+  if (s.is_object()) {
+    for (const char* key : {"ks", "methods"})
+      if (s.contains(key)) parts[key] = s[key];
+    for (const char* key : {"shard", "identities", "first_identity_seed", "replicates", "ks", "methods"})
+      s.erase(key);
+  }
+  if (!m->settings) {
+    m->settings = s;
+  } else if (*m->settings != s) {
+    return Status::Error((in / "bench.json").string() + ": settings differ from " +
+                         (first / "bench.json").string() + " (shards of different benches?)");
+  }
+  for (const auto& [key, values] : parts.items()) {
+    if (!values.is_array()) continue;
+    Json& all = m->union_parts[key];
+    if (!all.is_array()) all = Json::array();
+    for (const Json& v : values)
+      if (std::find(all.begin(), all.end(), v) == all.end()) all.push_back(v);
+  }
+  return Status::Ok();
+}
+
+// One input's runs into `m`. The same run in two inputs is fine when its metrics agree (training
+// and evaluation are deterministic for a step budget; only the timings differ), else the first is kept.
+Status MergeRuns(const fs::path& in, MergeInputs* m, std::ostream& log) {
+  ICEF_ASSIGN_OR_RETURN(const std::vector<RunRecord> records, ReadRunRecords(in));
+  for (const RunRecord& r : records) {
+    const fs::path src = in / "runs" / r.id.Name() / "metrics.json";
+    ICEF_ASSIGN_OR_RETURN(const std::string text, ReadFile(src));
+    const auto [it, inserted] = m->runs.emplace(r.id.Name(), std::make_pair(text, src));
+    if (inserted) continue;
+    ICEF_ASSIGN_OR_RETURN(const RunRecord first, ReadRunRecord(it->second.second));
+    if (first.metrics.ToJson() != r.metrics.ToJson())
+      log << "bench merge: warning: " << src.string() << " differs from " << it->second.second.string()
+          << " (a time budget makes runs differ); keeping the first\n";
+  }
+  log << "bench merge: " << records.size() << " runs from " << in.string() << "\n";
+  return Status::Ok();
+}
+
+// The merged report's context; writes the merged bench.json when the inputs had settings.
+Result<ReportContext> MergedContext(MergeInputs& m, size_t num_inputs, const fs::path& out_dir) {
+  ReportContext context;
+  for (const auto& [name, entry] : m.runs) context.run_dirs[name] = entry.second.parent_path();
+  if (m.settings) {
+    for (const auto& [key, values] : m.union_parts.items()) (*m.settings)[key] = values;
+    context.settings = *m.settings;
+    ICEF_RETURN_IF_ERROR(WriteFileAtomic(out_dir / "bench.json", FormatJson(*m.settings)));
+    BenchOptions role;
+    role.validation = m.settings->value("validation", false);
+    context.identity_role = role.IdentityRole();
+    context.per_identity = role.validation;
+  }
+  const synth::SynthOptions defaults;
+  context.tier_thresholds = std::array<double, 2>{defaults.near_threshold, defaults.far_threshold};
+  context.notes.push_back(
+      "Merged from " + std::to_string(num_inputs) +
+      " bench directories (renders stay there; the worst identities' training views are drawn "
+      "from them).");
+  return context;
+}
+
+}  // namespace
+
 Status MergeBench(const std::vector<fs::path>& inputs, const fs::path& out_dir, std::ostream& log) {
   if (inputs.empty()) return Status::Error("bench merge: no input directories");
   std::error_code ec;
   fs::create_directories(out_dir / "runs", ec);
   if (ec) return Status::Error((out_dir / "runs").string() + ": cannot create directory: " + ec.message());
-  std::optional<Json> settings;
-  Json union_parts = Json::object();  // "ks", "methods": every value any input ran, in first-seen order
-  std::map<std::string, std::pair<std::string, fs::path>> merged;  // run name -> (metrics.json text, source)
+  MergeInputs m;
   for (const fs::path& in : inputs) {
-    if (!fs::is_directory(in / "runs", ec)) return Status::Error(in.string() + ": not a bench directory (no runs/)");
-    if (fs::exists(in / "bench.json", ec)) {
-      ICEF_ASSIGN_OR_RETURN(Json s, ReadJsonFile(in / "bench.json"));
-      // Which shard, which identities, which methods and Ks or how many training replicates a
-      // directory ran does not make it another bench: benches of the same protocol over other
-      // identity seeds, methods or frame counts merge like shards; the merged bench.json lists
-      // every method and K of its inputs.
-      Json parts = Json::object();
-      if (s.is_object()) {
-        for (const char* key : {"ks", "methods"})
-          if (s.contains(key)) parts[key] = s[key];
-        for (const char* key : {"shard", "identities", "first_identity_seed", "replicates", "ks", "methods"})
-          s.erase(key);
-      }
-      if (!settings) {
-        settings = s;
-      } else if (*settings != s) {
-        return Status::Error((in / "bench.json").string() + ": settings differ from " +
-                             (inputs.front() / "bench.json").string() + " (shards of different benches?)");
-      }
-      for (const auto& [key, values] : parts.items()) {
-        if (!values.is_array()) continue;
-        Json& all = union_parts[key];
-        if (!all.is_array()) all = Json::array();
-        for (const Json& v : values)
-          if (std::find(all.begin(), all.end(), v) == all.end()) all.push_back(v);
-      }
-    }
-    ICEF_ASSIGN_OR_RETURN(const std::vector<RunRecord> records, ReadRunRecords(in));
-    for (const RunRecord& r : records) {
-      const fs::path src = in / "runs" / r.id.Name() / "metrics.json";
-      ICEF_ASSIGN_OR_RETURN(const std::string text, ReadFile(src));
-      const auto [it, inserted] = merged.emplace(r.id.Name(), std::make_pair(text, src));
-      if (inserted) continue;
-      // The same run in two inputs: fine when its metrics agree (training and evaluation are
-      // deterministic for a step budget; only the timings differ), else the first one is kept.
-      ICEF_ASSIGN_OR_RETURN(const RunRecord first, ReadRunRecord(it->second.second));
-      if (first.metrics.ToJson() != r.metrics.ToJson())
-        log << "bench merge: warning: " << src.string() << " differs from " << it->second.second.string()
-            << " (a time budget makes runs differ); keeping the first\n";
-    }
-    log << "bench merge: " << records.size() << " runs from " << in.string() << "\n";
+    if (!fs::is_directory(in / "runs", ec))
+      return Status::Error(in.string() + ": not a bench directory (no runs/)");
+    if (fs::exists(in / "bench.json", ec)) ICEF_RETURN_IF_ERROR(MergeSettings(in, inputs.front(), &m));
+    ICEF_RETURN_IF_ERROR(MergeRuns(in, &m, log));
   }
-  for (const auto& [name, entry] : merged) {
+  for (const auto& [name, entry] : m.runs) {
     fs::create_directories(out_dir / "runs" / name, ec);
     ICEF_RETURN_IF_ERROR(WriteFileAtomic(out_dir / "runs" / name / "metrics.json", entry.first));
   }
   ICEF_ASSIGN_OR_RETURN(const std::vector<RunRecord> records, ReadRunRecords(out_dir));
-  ReportContext context;
-  for (const auto& [name, entry] : merged) context.run_dirs[name] = entry.second.parent_path();
-  if (settings) {
-    for (const auto& [key, values] : union_parts.items()) (*settings)[key] = values;
-    context.settings = *settings;
-    ICEF_RETURN_IF_ERROR(WriteFileAtomic(out_dir / "bench.json", FormatJson(*settings)));
-    BenchOptions role;
-    role.validation = settings->value("validation", false);
-    context.identity_role = role.IdentityRole();
-    context.per_identity = role.validation;
-  }
-  {
-    const synth::SynthOptions defaults;
-    context.tier_thresholds = std::array<double, 2>{defaults.near_threshold, defaults.far_threshold};
-  }
-  context.notes.push_back(
-      "Merged from " + std::to_string(inputs.size()) +
-      " bench directories (renders stay there; the worst identities' training views are drawn "
-      "from them).");
+  ICEF_ASSIGN_OR_RETURN(const ReportContext context, MergedContext(m, inputs.size(), out_dir));
   ICEF_RETURN_IF_ERROR(WriteReport(out_dir, records, context));
   log << "bench merge: " << records.size() << " runs; report: " << (out_dir / "report.md").string()
       << " (LaTeX tables: report.tex)\n";

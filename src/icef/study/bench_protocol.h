@@ -1,7 +1,7 @@
 // The whole benchmark of docs/design.md §6 (`icef bench`): for each identity seed x K x method,
 // synthesise the dataset (once per identity x K, cached in OUT/data/), train with the same budget,
 // evaluate (eval/evaluate.h) and write OUT/runs/<id>_k<K>_<method>/metrics.json; then aggregate
-// into OUT/report.md + report.json + plots (eval/report.h). Resumable: a run whose metrics.json
+// into OUT/report.md + report.json + plots (study/report.h). Resumable: a run whose metrics.json
 // exists is skipped. Runs are ordered stably (identity, K, method); --shard i/n takes runs i,
 // i + n, i + 2n, ... so several machines can share a bench, and MergeBench builds one report from
 // their output directories.
@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "icef/core/status.h"
-#include "icef/eval/report.h"
 #include "icef/io/json_util.h"
+#include "icef/study/report.h"
 
 namespace icef::eval {
 
@@ -45,7 +45,8 @@ struct BenchOptions {
   std::vector<int> ks = {3, 5, 10};
   // Methods (names of model/method.h).
   // (icef-no-id is left out: it trains the same model as warp, see model/method.h.)
-  std::vector<std::string> methods = {"icef-prior", "warp-prior", "icef", "icef-no-conf", "icef-uniform", "warp", "nerface"};
+  std::vector<std::string> methods = {"icef-prior",   "warp-prior", "icef",   "icef-no-conf",
+                                      "icef-uniform", "warp",       "nerface"};
   // Image width = height in pixels.
   int resolution = 128;
   // Held-out test views per dataset.

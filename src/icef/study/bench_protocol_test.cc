@@ -1,4 +1,4 @@
-#include "icef/eval/bench_protocol.h"
+#include "icef/study/bench_protocol.h"
 
 #include <gtest/gtest.h>
 
@@ -14,7 +14,8 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path TempDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("icef_bench_test_" + name + "_" + std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("icef_bench_test_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
@@ -78,7 +79,8 @@ TEST(BenchProtocolTest, ParsesShardAndLists) {
   ASSERT_TRUE(ParseShard("2/5", &i, &n).ok());
   EXPECT_EQ(i, 2);
   EXPECT_EQ(n, 5);
-  for (const char* bad : {"5/5", "-1/3", "1/0", "1", "1/2x", "a/b"}) EXPECT_FALSE(ParseShard(bad, &i, &n).ok()) << bad;
+  for (const char* bad : {"5/5", "-1/3", "1/0", "1", "1/2x", "a/b"})
+    EXPECT_FALSE(ParseShard(bad, &i, &n).ok()) << bad;
   const Result<std::vector<int>> ks = ParseIntList("3,5,10", "--k");
   ASSERT_TRUE(ks.ok());
   EXPECT_EQ(*ks, std::vector<int>({3, 5, 10}));
@@ -154,7 +156,8 @@ TEST(BenchProtocolTest, MergesShardDirectories) {
     r.metrics.frames = {f};
     r.metrics.tiers = AggregateTiers(r.metrics.frames);
     fs::create_directories(bench / "runs" / id.Name());
-    ASSERT_TRUE(WriteFileAtomic(bench / "runs" / id.Name() / "metrics.json", FormatJson(RunRecordJson(r))).ok());
+    ASSERT_TRUE(
+        WriteFileAtomic(bench / "runs" / id.Name() / "metrics.json", FormatJson(RunRecordJson(r))).ok());
   };
   write_run(dir / "a", RunId{1, 3, "icef"}, 20);
   write_run(dir / "a", RunId{1, 3, "warp"}, 19);
@@ -191,11 +194,16 @@ TEST(BenchProtocolTest, MergesShardDirectories) {
   ASSERT_TRUE(WriteFileAtomic(dir / "b" / "bench.json", R"({"steps": 10, "shard": "1/2"})").ok());
   EXPECT_TRUE(MergeBench({dir / "a", dir / "b"}, dir / "merged4", log).ok());
   // Other identity seeds of the same protocol merge too.
-  ASSERT_TRUE(WriteFileAtomic(dir / "b" / "bench.json", R"({"steps": 10, "identities": 3, "first_identity_seed": 104})").ok());
+  ASSERT_TRUE(WriteFileAtomic(dir / "b" / "bench.json",
+                              R"({"steps": 10, "identities": 3, "first_identity_seed": 104})")
+                  .ok());
   EXPECT_TRUE(MergeBench({dir / "a", dir / "b"}, dir / "merged6", log).ok());
   // So do parts of one bench run by method or by K; the merged bench.json lists all of them.
-  ASSERT_TRUE(WriteFileAtomic(dir / "a" / "bench.json", R"({"steps": 10, "ks": [3, 5], "methods": ["icef"]})").ok());
-  ASSERT_TRUE(WriteFileAtomic(dir / "b" / "bench.json", R"({"steps": 10, "ks": [5], "methods": ["warp", "icef"]})").ok());
+  ASSERT_TRUE(
+      WriteFileAtomic(dir / "a" / "bench.json", R"({"steps": 10, "ks": [3, 5], "methods": ["icef"]})").ok());
+  ASSERT_TRUE(
+      WriteFileAtomic(dir / "b" / "bench.json", R"({"steps": 10, "ks": [5], "methods": ["warp", "icef"]})")
+          .ok());
   ASSERT_TRUE(MergeBench({dir / "a", dir / "b"}, dir / "merged7", log).ok()) << log.str();
   const Result<Json> parts = ReadJsonFile(dir / "merged7" / "bench.json");
   ASSERT_TRUE(parts.ok());

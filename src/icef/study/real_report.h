@@ -17,14 +17,14 @@ namespace icef::eval {
 
 // One real-media run: a source, K training frames, a method.
 struct RealRunRecord {
-  std::string source;                  // the source's name (its directory under sources/)
+  std::string source;  // the source's name (its directory under sources/)
   int k = 0;
   std::string method;
   RealEvalResult metrics;
   int64_t train_steps = 0;
   double train_seconds = 0;
-  std::filesystem::path dataset;       // the run's dataset (photos), for the worst-frame sheets
-  std::filesystem::path run_dir;       // where its renders are
+  std::filesystem::path dataset;  // the run's dataset (photos), for the worst-frame sheets
+  std::filesystem::path run_dir;  // where its renders are
   // "<source>_k<K>_<method>": the directory name under runs/.
   std::string Name() const;
   Json ToJson() const;
@@ -34,10 +34,10 @@ struct RealRunRecord {
 // What the report says about each source: where it came from and how it was tracked.
 struct RealSourceInfo {
   std::string name;
-  std::string origin;                 // the path or description given
-  int pool_train = 0;                 // training frames available
-  int test = 0;                       // held-out frames
-  std::vector<std::string> notes;     // e.g. "K = 10 left out: only 6 training frames"
+  std::string origin;              // the path or description given
+  int pool_train = 0;              // training frames available
+  int test = 0;                    // held-out frames
+  std::vector<std::string> notes;  // e.g. "K = 10 left out: only 6 training frames"
 };
 
 struct RealReportContext {

@@ -1,5 +1,5 @@
 // The bench report as LaTeX tables (report.tex, beside report.md): for a paper, the numbers of the
-// aggregate (eval/report.h) in booktabs tables, one per K (rows: tier x method; columns: PSNR, SSIM,
+// aggregate (study/report.h) in booktabs tables, one per K (rows: tier x method; columns: PSNR, SSIM,
 // LPIPS where measured, expr_gain, id_distance_gt, id_excess) and one of the far tier across K.
 // Cells are the mean +- sample std over identities; the best mean of each tier is set in bold
 // among the methods that reproduce at least kMinExpressionGain of the expression (a face that does
@@ -8,7 +8,7 @@
 
 #include <string>
 
-#include "icef/eval/report.h"
+#include "icef/study/report.h"
 
 namespace icef::eval {
 

@@ -1,4 +1,4 @@
-#include "icef/eval/report_latex.h"
+#include "icef/study/report_latex.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>

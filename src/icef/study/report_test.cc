@@ -1,4 +1,4 @@
-#include "icef/eval/report.h"
+#include "icef/study/report.h"
 
 #include <gtest/gtest.h>
 
@@ -15,7 +15,8 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path TempDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("icef_report_test_" + name + "_" + std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("icef_report_test_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
@@ -138,7 +139,7 @@ TEST(ReportTest, AFaceThatDoesNotMoveNeverWins) {
   std::vector<RunRecord> runs;
   for (uint64_t seed : {1, 2, 3}) {
     runs.push_back(MakeRun(seed, 5, "icef", 24.0, 0.40, 0.6 + 0.05 * seed));  // moves: gain 0.65 .. 0.75
-    runs.push_back(MakeRun(seed, 5, "warp", 27.0, 0.20, 0.0));                // still: better PSNR and identity
+    runs.push_back(MakeRun(seed, 5, "warp", 27.0, 0.20, 0.0));  // still: better PSNR and identity
   }
   // Seen from either side: the still face is never better, and the verdict names its under-expression.
   Aggregate a = AggregateRuns(runs);
@@ -157,10 +158,12 @@ TEST(ReportTest, AFaceThatDoesNotMoveNeverWins) {
   a = AggregateRuns(runs);
   EXPECT_EQ(ComparePair(a, 5, Tier::kFar, "warp", "icef").outcome, Outcome::kUnderExpresses);
   // Equal gains within the spread: identity and PSNR decide.
-  std::vector<RunRecord> close = {MakeRun(1, 5, "icef", 24.0, 0.3, 0.70), MakeRun(1, 5, "warp", 23.0, 0.4, 0.71)};
+  std::vector<RunRecord> close = {MakeRun(1, 5, "icef", 24.0, 0.3, 0.70),
+                                  MakeRun(1, 5, "warp", 23.0, 0.4, 0.71)};
   EXPECT_EQ(ComparePair(AggregateRuns(close), 5, Tier::kFar, "icef", "warp").outcome, Outcome::kBetter);
   close[0] = MakeRun(1, 5, "icef", 24.0, 0.3, 0.60);
-  EXPECT_EQ(ComparePair(AggregateRuns(close), 5, Tier::kFar, "icef", "warp").outcome, Outcome::kUnderExpresses);
+  EXPECT_EQ(ComparePair(AggregateRuns(close), 5, Tier::kFar, "icef", "warp").outcome,
+            Outcome::kUnderExpresses);
 }
 
 TEST(ReportTest, NoVerdictWithoutBaseline) {
@@ -176,7 +179,8 @@ TEST(ReportTest, WritesMarkdownJsonAndPlots) {
   // Stored as bench runs and read back (sorted by identity, K, method).
   for (auto it = runs.rbegin(); it != runs.rend(); ++it) {
     fs::create_directories(dir / "runs" / it->id.Name());
-    ASSERT_TRUE(WriteFileAtomic(dir / "runs" / it->id.Name() / "metrics.json", FormatJson(RunRecordJson(*it))).ok());
+    ASSERT_TRUE(
+        WriteFileAtomic(dir / "runs" / it->id.Name() / "metrics.json", FormatJson(RunRecordJson(*it))).ok());
   }
   const Result<std::vector<RunRecord>> read = ReadRunRecords(dir);
   ASSERT_TRUE(read.ok()) << read.status().message();
@@ -199,8 +203,9 @@ TEST(ReportTest, WritesMarkdownJsonAndPlots) {
             std::string::npos);
   EXPECT_NE(md->find("expr_gain"), std::string::npos);
   EXPECT_NE(md->find("FDNeRF and NeRFFaceEditing proper are not available"), std::string::npos);
-  EXPECT_NE(md->find("| far | `icef` | 3 | 1.20 | 22.00 ± 2.00 [20.00, 24.00] | 26.00 ± 0.00 [26.00, 26.00] |"),
-            std::string::npos)
+  EXPECT_NE(
+      md->find("| far | `icef` | 3 | 1.20 | 22.00 ± 2.00 [20.00, 24.00] | 26.00 ± 0.00 [26.00, 26.00] |"),
+      std::string::npos)
       << *md;
   EXPECT_NE(md->find("LPIPS: unavailable"), std::string::npos);
   EXPECT_NE(md->find("| id2_k3_warp | 100 |"), std::string::npos);
@@ -264,7 +269,7 @@ TEST(ReportTest, TrainingReplicatesCountOncePerIdentityWithTheirSpread) {
   const Aggregate a = AggregateRuns(runs);
   const AggregateCell* icef = a.Find(3, "icef", Tier::kFar);
   ASSERT_NE(icef, nullptr);
-  EXPECT_EQ(icef->runs, 3);  // identities, not trainings
+  EXPECT_EQ(icef->runs, 3);                                // identities, not trainings
   EXPECT_DOUBLE_EQ(icef->Get(Metric::kPsnr)->mean, 23.0);  // (21 + 24 + 24) / 3
   // The spread: identities 1 and 2 ranges 2 and 4 dB (mean 3); expr_gain 0.2 and 0.
   const ReplicateSpreadCell* spread = nullptr;
@@ -282,7 +287,8 @@ TEST(ReportTest, TrainingReplicatesCountOncePerIdentityWithTheirSpread) {
   const fs::path dir = TempDir("replicates");
   for (const RunRecord& r : runs) {
     fs::create_directories(dir / "runs" / r.id.Name());
-    ASSERT_TRUE(WriteFileAtomic(dir / "runs" / r.id.Name() / "metrics.json", FormatJson(RunRecordJson(r))).ok());
+    ASSERT_TRUE(
+        WriteFileAtomic(dir / "runs" / r.id.Name() / "metrics.json", FormatJson(RunRecordJson(r))).ok());
   }
   const Result<std::vector<RunRecord>> read = ReadRunRecords(dir);
   ASSERT_TRUE(read.ok()) << read.status().message();
@@ -329,12 +335,16 @@ TEST(ReportTest, TrainingViewFitAndPerIdentityTable) {
       << md;
   EXPECT_NE(md.find("| id2_k3_warp | 100 | 2.0s | 0.5s | 2 | 0 | 24.00 |"), std::string::npos) << md;
   EXPECT_NE(md.find("## Per identity"), std::string::npos) << md;
-  EXPECT_NE(md.find("| identity | method | K | train face_psnr | worst view | face detail | observed psnr | far psnr | "
-                    "observed region_psnr | observed id_distance_gt | far expr_gain |"),
-            std::string::npos)
+  EXPECT_NE(
+      md.find(
+          "| identity | method | K | train face_psnr | worst view | face detail | observed psnr | far psnr | "
+          "observed region_psnr | observed id_distance_gt | far expr_gain |"),
+      std::string::npos)
       << md;
   // Seed 2, warp: far PSNR 23 (observed 33), no region PSNR, id_distance_gt 0.2 observed, gain 0.8.
-  EXPECT_NE(md.find("| 2 | `warp` | 3 | 24.00 | 23.00 | 0.90 | 33.00 | 23.00 | - | 0.200 | 0.800 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| 2 | `warp` | 3 | 24.00 | 23.00 | 0.90 | 33.00 | 23.00 | - | 0.200 | 0.800 |"),
+            std::string::npos)
+      << md;
   EXPECT_LT(md.find("| 1 | `icef` |"), md.find("| 1 | `warp` |"));
   EXPECT_LT(md.find("| 1 | `warp` |"), md.find("| 2 | `icef` |"));
   EXPECT_NE(md.find("**Worst identity by training-view face PSNR**: seed 2 (mean 28.50 dB over its 2 runs; "
@@ -368,7 +378,8 @@ TEST(ReportTest, TrainingViewFitAndPerIdentityTable) {
   const std::string old_md = ReportMarkdown(AggregateRuns(old), old, validation, {});
   EXPECT_EQ(old_md.find("training-view fit\n\n| method"), std::string::npos) << old_md;
   EXPECT_NE(old_md.find("| id2_k3_warp | 100 | 2.0s | 0.5s | 2 | 0 | - |"), std::string::npos) << old_md;
-  EXPECT_NE(old_md.find("**Worst identity by training-view face PSNR**: no values."), std::string::npos) << old_md;
+  EXPECT_NE(old_md.find("**Worst identity by training-view face PSNR**: no values."), std::string::npos)
+      << old_md;
 }
 
 TEST(ReportTest, WorstIdentityLinksItsTrainingViewsBesideTheirTruth) {
@@ -399,7 +410,8 @@ TEST(ReportTest, WorstIdentityLinksItsTrainingViewsBesideTheirTruth) {
   EXPECT_NE(md->find("lowest run `id1_k3_icef`, 30.00 dB).\n"), std::string::npos) << *md;
   const Result<Json> json = ReadJsonFile(dir / "report.json");
   ASSERT_TRUE(json.ok());
-  EXPECT_EQ((*json)["worst_identity"]["train_fit_face_psnr"]["training_views"], "worst_id2_k3_warp_training_views.png");
+  EXPECT_EQ((*json)["worst_identity"]["train_fit_face_psnr"]["training_views"],
+            "worst_id2_k3_warp_training_views.png");
   EXPECT_FALSE((*json)["worst_identity"]["observed_psnr"].contains("training_views"));
 
   // A test bench has no worst identity and writes no sheet.

@@ -1,4 +1,4 @@
-#include "icef/eval/training_view_sheet.h"
+#include "icef/study/training_view_sheet.h"
 
 #include <algorithm>
 #include <system_error>

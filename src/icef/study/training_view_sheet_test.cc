@@ -1,7 +1,6 @@
-#include "icef/eval/training_view_sheet.h"
+#include "icef/study/training_view_sheet.h"
 
 #include <gtest/gtest.h>
-
 #include <unistd.h>
 
 #include <fstream>
@@ -14,7 +13,8 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path TempDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("icef_sheet_test_" + name + "_" + std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("icef_sheet_test_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
@@ -65,7 +65,8 @@ TEST(TrainingViewSheetTest, NoRendersNoSheetAndAnUnreadableOneNamesTheFile) {
   std::ofstream(renders / "fit_train_000_vs_truth.png") << "not a png";
   const Result<std::optional<std::string>> bad = WriteTrainingViewSheet(dir, "id1_k5_icef");
   ASSERT_FALSE(bad.ok());
-  EXPECT_NE(bad.status().message().find("fit_train_000_vs_truth.png"), std::string::npos) << bad.status().message();
+  EXPECT_NE(bad.status().message().find("fit_train_000_vs_truth.png"), std::string::npos)
+      << bad.status().message();
   EXPECT_FALSE(fs::exists(dir / "worst_id1_k5_icef_training_views.png"));
   fs::remove_all(dir);
 }

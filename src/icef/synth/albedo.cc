@@ -3,9 +3,9 @@
 // hair strokes, scalp hair, eyes (sclera, iris, pupil), eyelids with lashes and the mouth cavity.
 #include <cmath>
 
+#include "icef/face/sdf_primitives.h"
 #include "icef/synth/head_model.h"
 #include "icef/synth/noise.h"
-#include "icef/face/sdf_primitives.h"
 
 namespace icef::synth {
 
@@ -18,13 +18,18 @@ namespace {
 Vec3f Mix(const Vec3f& a, const Vec3f& b, float t) { return a + t * (b - a); }
 }  // namespace
 
-Vec3f HeadModel::Albedo(const face::FaceModel::Sample& sample, const Vec3f& x, const ExpressionState& state) const {
+Vec3f HeadModel::Albedo(const face::FaceModel::Sample& sample, const Vec3f& x,
+                        const ExpressionState& state) const {
   const Vec3f& p = sample.canonical;
   switch (sample.material) {
-    case Material::kEyeball: return EyeAlbedo(p, p.x() < 0.f ? 0 : 1);
-    case Material::kEyelid: return LidAlbedo(p, state);
-    case Material::kMouthCavity: return CavityAlbedo(x, state);
-    case Material::kSkin: break;
+    case Material::kEyeball:
+      return EyeAlbedo(p, p.x() < 0.f ? 0 : 1);
+    case Material::kEyelid:
+      return LidAlbedo(p, state);
+    case Material::kMouthCavity:
+      return CavityAlbedo(x, state);
+    case Material::kSkin:
+      break;
   }
   return SkinAlbedo(p);
 }
@@ -62,7 +67,8 @@ Vec3f HeadModel::SkinAlbedo(const Vec3f& p) const {
   // Stubble: dense fine dark dots over the upper lip, chin and jaw.
   if (id.stubble_density > 0.f && p.z() > 0.f) {
     const float below_nose = 1.f - SmoothStep(g.mouth_y + 0.03f, g.mouth_y + 0.045f, p.y());
-    const float cheek_edge = 1.f - SmoothStep(g.mouth_y + 0.0f, g.mouth_y + 0.06f, p.y() + 0.5f * std::abs(p.x()));
+    const float cheek_edge =
+        1.f - SmoothStep(g.mouth_y + 0.0f, g.mouth_y + 0.06f, p.y() + 0.5f * std::abs(p.x()));
     const float zone = below_nose * std::max(cheek_edge, 1.f - SmoothStep(0.04f, 0.07f, std::abs(p.x())));
     if (zone > 0.f) {
       const float dots = CellSpots(p, 380.f, id.stubble_density * zone, seed + 8u);
@@ -71,9 +77,11 @@ Vec3f HeadModel::SkinAlbedo(const Vec3f& p) const {
   }
   // Freckles over the cheeks and the nose.
   const float freckle_zone =
-      p.z() > 0.12f ? EllipsoidBump(p, Vec3f(0.f, -0.02f, 0.26f), Vec3f(1.f / 0.19f, 1.f / 0.1f, 1.f / 0.2f)) : 0.f;
+      p.z() > 0.12f ? EllipsoidBump(p, Vec3f(0.f, -0.02f, 0.26f), Vec3f(1.f / 0.19f, 1.f / 0.1f, 1.f / 0.2f))
+                    : 0.f;
   if (freckle_zone > 0.f) {
-    const float spots = CellSpots(p, 55.f, id.freckle_density * std::min(1.f, 1.6f * freckle_zone), seed + 4u);
+    const float spots =
+        CellSpots(p, 55.f, id.freckle_density * std::min(1.f, 1.6f * freckle_zone), seed + 4u);
     c = Mix(c, c.cwiseProduct(Vec3f(0.72f, 0.58f, 0.48f)), 0.75f * spots);
   }
   // Moles.
@@ -99,13 +107,15 @@ Vec3f HeadModel::SkinAlbedo(const Vec3f& p) const {
     const float lt = id.shape.lip_thickness;
     const float bow = 0.003f * std::exp(-p.x() * p.x() / (0.012f * 0.012f));  // cupid's bow dip
     const float ux = p.x() / (g.mouth_half_width * 1.02f);
-    const float uy_up = (p.y() - (g.mouth_y + 0.0085f * lt)) / (0.0095f * lt + (p.y() > g.mouth_y + 0.0085f * lt ? -bow : 0.f));
+    const float uy_up = (p.y() - (g.mouth_y + 0.0085f * lt)) /
+                        (0.0095f * lt + (p.y() > g.mouth_y + 0.0085f * lt ? -bow : 0.f));
     const float uy_low = (p.y() - (g.mouth_y - 0.009f * lt)) / (0.011f * lt);
     const float e_up = ux * ux + uy_up * uy_up, e_low = ux * ux + uy_low * uy_low;
     const float lip = 1.f - SmoothStep(0.75f, 1.05f, std::min(e_up, e_low));
     c = Mix(c, id.lip_color.cwiseProduct(Vec3f::Ones() * (1.f + 0.05f * b1)), lip);
     // The seam between the lips.
-    const float seam = (1.f - SmoothStep(0.0008f, 0.0028f, std::abs(p.y() - g.mouth_y))) * (1.f - SmoothStep(0.8f, 1.f, std::abs(ux)));
+    const float seam = (1.f - SmoothStep(0.0008f, 0.0028f, std::abs(p.y() - g.mouth_y))) *
+                       (1.f - SmoothStep(0.8f, 1.f, std::abs(ux)));
     c = Mix(c, id.lip_color * 0.35f, seam);
   }
   // Brows: arched bands of dark hair strokes.
@@ -116,7 +126,8 @@ Vec3f HeadModel::SkinAlbedo(const Vec3f& p) const {
     const float centre = g.brow_y + 0.011f * (1.f - lx * lx) - 0.004f * lx;
     const float half = 0.0105f * (1.f - 0.4f * lx);
     const float dy = (p.y() - centre) / half;
-    const float band = (1.f - SmoothStep(0.55f, 1.f, std::abs(dy))) * (1.f - SmoothStep(0.9f, 1.15f, std::abs(lx)));
+    const float band =
+        (1.f - SmoothStep(0.55f, 1.f, std::abs(dy))) * (1.f - SmoothStep(0.9f, 1.15f, std::abs(lx)));
     if (band <= 0.f) continue;
     // Strokes grow upwards at the inner end and outwards along the arch elsewhere.
     const float angle = 1.25f - 1.0f * SmoothStep(-1.f, 0.2f, lx);
@@ -136,7 +147,8 @@ Vec3f HeadModel::EyeAlbedo(const Vec3f& p, int side) const {
   if (angle < 0.17f) return Vec3f(0.03f, 0.03f, 0.035f);  // pupil
   if (angle < 0.43f) {
     const float azimuth = std::atan2(q.y(), q.x());
-    const float fibres = ValueNoise(Vec3f(std::cos(azimuth) * 9.f, std::sin(azimuth) * 9.f, angle * 14.f), seed);
+    const float fibres =
+        ValueNoise(Vec3f(std::cos(azimuth) * 9.f, std::sin(azimuth) * 9.f, angle * 14.f), seed);
     Vec3f c = identity_.iris_color * (0.8f + 0.3f * fibres);
     const float limbus = SmoothStep(0.36f, 0.43f, angle);
     c *= 1.f - 0.55f * limbus;
@@ -155,7 +167,8 @@ Vec3f HeadModel::LidAlbedo(const Vec3f& p, const ExpressionState& state) const {
   // Lashes along both lid edges (the upper edge moves as the eye closes).
   const float to_upper = std::abs(elevation - state.lid_upper[side]);
   const float to_lower = std::abs(elevation - face_.geometry().lid_lower);
-  const float lash = std::max(1.f - SmoothStep(0.04f, 0.11f, to_upper), 0.6f * (1.f - SmoothStep(0.02f, 0.06f, to_lower)));
+  const float lash =
+      std::max(1.f - SmoothStep(0.04f, 0.11f, to_upper), 0.6f * (1.f - SmoothStep(0.02f, 0.06f, to_lower)));
   return Mix(c, Vec3f(0.07f, 0.05f, 0.05f), 0.85f * lash);
 }
 
@@ -163,7 +176,8 @@ Vec3f HeadModel::CavityAlbedo(const Vec3f& x, const ExpressionState& state) cons
   const Vec3f q = (x - state.cavity_c).cwiseQuotient(state.cavity_r);
   Vec3f c = Vec3f(0.16f, 0.045f, 0.05f) * (0.45f + 0.55f * SmoothStep(-0.6f, 0.6f, q.z()));
   // Upper teeth show under the upper lip when the mouth is open enough.
-  const float teeth = SmoothStep(0.35f, 0.5f, q.y()) * SmoothStep(-0.4f, 0.1f, q.z()) * (1.f - SmoothStep(0.6f, 0.9f, std::abs(q.x())));
+  const float teeth = SmoothStep(0.35f, 0.5f, q.y()) * SmoothStep(-0.4f, 0.1f, q.z()) *
+                      (1.f - SmoothStep(0.6f, 0.9f, std::abs(q.x())));
   return Mix(c, Vec3f(0.86f, 0.84f, 0.76f), teeth);
 }
 

@@ -1,5 +1,7 @@
 #include "icef/synth/contact_sheet.h"
 
+#include <stb_easy_font.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -7,13 +9,13 @@
 #include <sstream>
 #include <vector>
 
-#include <stb_easy_font.h>
-
 namespace icef::synth {
 
 Status ContactSheetOptions::Validate() const {
-  if (tile < 16 || tile > 1024) return Status::Error("tile: expected 16..1024 pixels, got " + std::to_string(tile));
-  if (max_columns < 1 || max_columns > 64) return Status::Error("max_columns: expected 1..64, got " + std::to_string(max_columns));
+  if (tile < 16 || tile > 1024)
+    return Status::Error("tile: expected 16..1024 pixels, got " + std::to_string(tile));
+  if (max_columns < 1 || max_columns > 64)
+    return Status::Error("max_columns: expected 1..64, got " + std::to_string(max_columns));
   return Status::Ok();
 }
 
@@ -71,7 +73,8 @@ Result<Image> TileRows(const Rows& rows, const ContactSheetOptions& options) {
   const int label_h = options.labels ? 12 : 0, gap = 4;
   const int cell_w = options.tile + gap, cell_h = options.tile + label_h + gap;
   int columns = 1;
-  for (const auto& r : rows) columns = std::max(columns, std::min<int>(options.max_columns, static_cast<int>(r.second.size())));
+  for (const auto& r : rows)
+    columns = std::max(columns, std::min<int>(options.max_columns, static_cast<int>(r.second.size())));
   Image sheet(columns * cell_w + gap, static_cast<int>(rows.size()) * cell_h + gap, 3, 1.f);
   for (size_t r = 0; r < rows.size(); ++r) {
     const auto& cells = rows[r].second;
@@ -82,7 +85,8 @@ Result<Image> TileRows(const Rows& rows, const ContactSheetOptions& options) {
       for (int y = 0; y < options.tile; ++y)
         for (int x = 0; x < options.tile; ++x)
           for (int ch = 0; ch < 3; ++ch) sheet.At(ox + x, oy + y, ch) = tile.At(x, y, ch);
-      if (options.labels) DrawText(sheet, ox + 1, oy + options.tile + 2, cells[c].label, Vec3f(0.1f, 0.1f, 0.1f));
+      if (options.labels)
+        DrawText(sheet, ox + 1, oy + options.tile + 2, cells[c].label, Vec3f(0.1f, 0.1f, 0.1f));
     }
   }
   return sheet;
@@ -107,7 +111,8 @@ Result<Image> MakeContactSheet(const Dataset& dataset, const ContactSheetOptions
     neutrals.push_back(n);
   }
   std::vector<Cell> neutral_row;
-  for (size_t i = 0; i < neutrals.size(); ++i) neutral_row.push_back({&dataset, &neutrals[i], "neutral v" + std::to_string(i)});
+  for (size_t i = 0; i < neutrals.size(); ++i)
+    neutral_row.push_back({&dataset, &neutrals[i], "neutral v" + std::to_string(i)});
   if (!neutral_row.empty()) rows.push_back({"neutral", neutral_row});
   // One tile per distinct test expression, per tier; views taken in turn.
   for (Tier tier : {Tier::kObserved, Tier::kNear, Tier::kModerate, Tier::kFar}) {
@@ -138,7 +143,8 @@ Result<Image> MakeTrainingSheet(const std::vector<Dataset>& datasets, const Cont
   Rows rows;
   for (const Dataset& d : datasets) {
     std::vector<Cell> row;
-    const std::string name = d.root.filename().empty() ? d.root.parent_path().filename().string() : d.root.filename().string();
+    const std::string name =
+        d.root.filename().empty() ? d.root.parent_path().filename().string() : d.root.filename().string();
     for (size_t i = 0; i < d.train.size(); ++i)
       row.push_back({&d, &d.train[i], i == 0 ? name : "train " + std::to_string(i)});
     rows.push_back({name, row});

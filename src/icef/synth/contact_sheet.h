@@ -25,7 +25,8 @@ struct ContactSheetOptions {
 };
 
 // Loads the frames' images (errors name the file) and tiles them into an RGB image.
-Result<Image> MakeContactSheet(const Dataset& dataset, const ContactSheetOptions& options = ContactSheetOptions());
+Result<Image> MakeContactSheet(const Dataset& dataset,
+                               const ContactSheetOptions& options = ContactSheetOptions());
 
 // One row per dataset of its training frames (the first tile labelled with the dataset's directory
 // name): several subjects side by side, e.g. the scenes of `icef synth --diverse`.

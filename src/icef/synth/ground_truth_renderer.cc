@@ -6,8 +6,10 @@
 namespace icef::synth {
 
 Status RenderOptions::Validate() const {
-  if (supersample < 1 || supersample > 8) return Status::Error("supersample: expected 1..8, got " + std::to_string(supersample));
-  if (!light_direction.allFinite() || light_direction.norm() < 1e-6f) return Status::Error("light_direction: expected a non-zero finite vector");
+  if (supersample < 1 || supersample > 8)
+    return Status::Error("supersample: expected 1..8, got " + std::to_string(supersample));
+  if (!light_direction.allFinite() || light_direction.norm() < 1e-6f)
+    return Status::Error("light_direction: expected a non-zero finite vector");
   if (!(ambient >= 0.f) || !(diffuse >= 0.f)) return Status::Error("ambient/diffuse: expected values >= 0");
   if (!(fill >= 0.f) || !(specular >= 0.f)) return Status::Error("fill/specular: expected values >= 0");
   if (fill > 0.f && (!fill_direction.allFinite() || fill_direction.norm() < 1e-6f))
@@ -19,8 +21,8 @@ Status RenderOptions::Validate() const {
 
 std::string RenderOptions::ToString() const {
   std::ostringstream os;
-  os << "RenderOptions(supersample=" << supersample << ", light=[" << light_direction.transpose() << "], ambient=" << ambient
-     << ", diffuse=" << diffuse;
+  os << "RenderOptions(supersample=" << supersample << ", light=[" << light_direction.transpose()
+     << "], ambient=" << ambient << ", diffuse=" << diffuse;
   if (fill > 0.f) os << ", fill=" << fill << "@[" << fill_direction.transpose() << "]";
   if (specular > 0.f) os << ", specular=" << specular << "^" << shininess;
   if (canonical_shading) os << ", canonical_shading";
@@ -50,7 +52,8 @@ Image RenderGroundTruth(const HeadModel& head, const Camera& camera, const std::
             const Ray ray = camera.RayThrough(x + (sx + 0.5) / ss, y + (sy + 0.5) / ss);
             const auto interval = bounds.Intersect(ray);
             if (!interval) continue;
-            const float t = face_model.Trace(ray, interval->t_near, interval->t_far, state, options.max_steps);
+            const float t =
+                face_model.Trace(ray, interval->t_near, interval->t_far, state, options.max_steps);
             if (t < 0.f) continue;
             const Vec3f p = ray.At(t);
             const face::FaceModel::Sample sample = face_model.Evaluate(p, state);
@@ -63,7 +66,8 @@ Image RenderGroundTruth(const HeadModel& head, const Camera& camera, const std::
             Vec3f rgb = albedo * shade;
             if (options.specular > 0.f && sample.material != face::Material::kMouthCavity && lambert > 0.f) {
               const Vec3f half = (light - ray.direction.normalized()).normalized();
-              rgb += Vec3f::Constant(options.specular * std::pow(std::max(0.f, normal.dot(half)), options.shininess));
+              rgb += Vec3f::Constant(options.specular *
+                                     std::pow(std::max(0.f, normal.dot(half)), options.shininess));
             }
             sum += rgb;
             ++hits;
@@ -79,7 +83,8 @@ Image RenderGroundTruth(const HeadModel& head, const Camera& camera, const std::
   return image;
 }
 
-LandmarkView ProjectLandmarks(const HeadModel& head, const Camera& camera, const std::vector<float>& expression) {
+LandmarkView ProjectLandmarks(const HeadModel& head, const Camera& camera,
+                              const std::vector<float>& expression) {
   const face::FaceModel& face_model = head.face();
   const face::ExpressionState state = face_model.Prepare(expression);
   const std::array<Vec3f, 68> points = face_model.Landmarks(state);

@@ -49,7 +49,8 @@ struct RenderOptions {
 // The RGBA image of the head at `expression` ([face::kNumExpressions] weights) seen by `camera`.
 // Deterministic: pixels are independent, so the result does not depend on the thread count.
 Image RenderGroundTruth(const HeadModel& head, const Camera& camera, const std::vector<float>& expression,
-                        const Executor& executor = Executor(), const RenderOptions& options = RenderOptions());
+                        const Executor& executor = Executor(),
+                        const RenderOptions& options = RenderOptions());
 
 // Landmarks of one view: 3D (head frame), 2D (pixels, +0.5 centres) and visibility.
 struct LandmarkView {
@@ -60,6 +61,7 @@ struct LandmarkView {
   // surface.
   std::vector<bool> visible;
 };
-LandmarkView ProjectLandmarks(const HeadModel& head, const Camera& camera, const std::vector<float>& expression);
+LandmarkView ProjectLandmarks(const HeadModel& head, const Camera& camera,
+                              const std::vector<float>& expression);
 
 }  // namespace icef::synth

@@ -56,7 +56,8 @@ TEST(GroundTruthRendererTest, CanonicalShadingChangesOnlyTheShadingOfExpressions
     for (int x = 0; x < kRes; ++x) {
       coverage_diff += std::abs(observed.At(x, y, 3) - moved.At(x, y, 3));  // same geometry
       // The same albedo under other light: the colour's chromaticity stays, its brightness moves.
-      if (observed.At(x, y, 3) == 1.f && std::abs(observed.At(x, y, 1) - moved.At(x, y, 1)) > 0.02f) ++changed;
+      if (observed.At(x, y, 3) == 1.f && std::abs(observed.At(x, y, 1) - moved.At(x, y, 1)) > 0.02f)
+        ++changed;
     }
   EXPECT_EQ(coverage_diff, 0.0);
   EXPECT_GT(changed, 20) << "the opened jaw and the puffed cheeks should be shaded as at neutral";
@@ -83,8 +84,10 @@ TEST(GroundTruthRendererTest, WhiteBackgroundAlphaMaskAndAFaceInTheMiddle) {
 }
 
 TEST(GroundTruthRendererTest, DifferentIdentitiesLookDifferent) {
-  const Image a = RenderGroundTruth(HeadModel(IdentityParams::FromSeed(1)), TestCamera(), Zeros(), Executor(2));
-  const Image b = RenderGroundTruth(HeadModel(IdentityParams::FromSeed(2)), TestCamera(), Zeros(), Executor(2));
+  const Image a =
+      RenderGroundTruth(HeadModel(IdentityParams::FromSeed(1)), TestCamera(), Zeros(), Executor(2));
+  const Image b =
+      RenderGroundTruth(HeadModel(IdentityParams::FromSeed(2)), TestCamera(), Zeros(), Executor(2));
   double diff = 0.0;
   for (size_t i = 0; i < a.pixels.size(); ++i) diff += std::abs(a.pixels[i] - b.pixels[i]);
   EXPECT_GT(diff / a.pixels.size(), 0.02);
@@ -106,7 +109,8 @@ TEST(GroundTruthRendererTest, EachExpressionMovesOnlyItsRegion) {
     const LandmarkView lm = ProjectLandmarks(head, cam, beta);
     Vec2f lo = Vec2f::Constant(1e9f), hi = Vec2f::Constant(-1e9f);
     for (int i : ExpressionRegionLandmarks(e)) {
-      for (const Vec2f& p : {neutral_lm.landmarks_2d[i], lm.landmarks_2d[i]}) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+      for (const Vec2f& p : {neutral_lm.landmarks_2d[i], lm.landmarks_2d[i]})
+        lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
     }
     // The warp windows reach ~0.1 head units beyond the landmarks; the jaw also stretches the neck.
     const float margin = (e == kJawOpen ? 0.2f : 0.1f) * px_per_unit;
@@ -116,7 +120,8 @@ TEST(GroundTruthRendererTest, EachExpressionMovesOnlyItsRegion) {
     for (int y = 0; y < kRes; ++y)
       for (int x = 0; x < kRes; ++x) {
         float change = 0.f;
-        for (int c = 0; c < 4; ++c) change = std::max(change, std::abs(img.At(x, y, c) - neutral.At(x, y, c)));
+        for (int c = 0; c < 4; ++c)
+          change = std::max(change, std::abs(img.At(x, y, c) - neutral.At(x, y, c)));
         const bool in_region = x + 1 >= lo.x() && x <= hi.x() && y + 1 >= lo.y() && y <= hi.y();
         (in_region ? inside : outside) = std::max(in_region ? inside : outside, change);
       }

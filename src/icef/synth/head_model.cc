@@ -6,7 +6,8 @@
 
 namespace icef::synth {
 
-HeadModel::HeadModel(const IdentityParams& identity) : identity_(identity), face_(identity.shape, identity.style) {
+HeadModel::HeadModel(const IdentityParams& identity)
+    : identity_(identity), face_(identity.shape, identity.style) {
   BuildMoles();
 }
 

@@ -19,7 +19,8 @@ TEST(HeadModelTest, IdentitiesHaveDifferentShapesAndLandmarks) {
   EXPECT_EQ(a.face().shape().ToArray(), IdentityParams::FromSeed(1).shape.ToArray());
   EXPECT_NE(a.face().shape().ToArray(), b.face().shape().ToArray());
   float total = 0.f;
-  for (int i = 0; i < 68; ++i) total += (a.face().NeutralLandmarks()[i] - b.face().NeutralLandmarks()[i]).norm();
+  for (int i = 0; i < 68; ++i)
+    total += (a.face().NeutralLandmarks()[i] - b.face().NeutralLandmarks()[i]).norm();
   EXPECT_GT(total / 68.f, 0.005f);
   EXPECT_NE(IdentityParams::FromSeed(1).ToString(), IdentityParams::FromSeed(2).ToString());
 }

@@ -71,13 +71,19 @@ IdentityParams IdentityParams::FromSeed(uint64_t seed) {
   Vec3f skin = tone < 0.6f ? Mix(light, mid, tone / 0.6f) : Mix(mid, dark, (tone - 0.6f) / 0.4f);
   const float tint = u(-0.03, 0.03);
   p.skin_tone = (skin + Vec3f(tint, 0.f, -tint)).cwiseMax(0.f).cwiseMin(1.f);
-  p.lip_color = (p.skin_tone.cwiseProduct(Vec3f(0.85f, 0.55f, 0.58f)) + Vec3f(u(0.0, 0.08), 0.f, 0.02f))
-                    .cwiseMin(1.f);
-  const Vec3f irises[] = {{0.25f, 0.42f, 0.60f}, {0.30f, 0.48f, 0.32f}, {0.38f, 0.24f, 0.12f},
-                          {0.22f, 0.14f, 0.08f}, {0.45f, 0.45f, 0.42f}};
+  p.lip_color =
+      (p.skin_tone.cwiseProduct(Vec3f(0.85f, 0.55f, 0.58f)) + Vec3f(u(0.0, 0.08), 0.f, 0.02f)).cwiseMin(1.f);
+  const Vec3f irises[] = {{0.25f, 0.42f, 0.60f},
+                          {0.30f, 0.48f, 0.32f},
+                          {0.38f, 0.24f, 0.12f},
+                          {0.22f, 0.14f, 0.08f},
+                          {0.45f, 0.45f, 0.42f}};
   p.iris_color = irises[rng.Below(5)];
-  const Vec3f hairs[] = {{0.08f, 0.06f, 0.05f}, {0.22f, 0.14f, 0.08f}, {0.45f, 0.30f, 0.16f},
-                         {0.70f, 0.55f, 0.32f}, {0.50f, 0.20f, 0.08f}};
+  const Vec3f hairs[] = {{0.08f, 0.06f, 0.05f},
+                         {0.22f, 0.14f, 0.08f},
+                         {0.45f, 0.30f, 0.16f},
+                         {0.70f, 0.55f, 0.32f},
+                         {0.50f, 0.20f, 0.08f}};
   p.hair_color = hairs[rng.Below(5)];
   p.brow_color = 0.5f * p.hair_color + Vec3f(0.03f, 0.02f, 0.015f);
   p.blotch_strength = u(0.2, 1.0);
@@ -99,8 +105,11 @@ void DrawDiverseSkin(uint64_t seed, IdentityParams* p) {
   Rng rng(seed, StreamId("synth.scene.skin"));
   auto u = [&](double lo, double hi) { return static_cast<float>(rng.Uniform(lo, hi)); };
   // Five anchors from very light to very dark; the tone is uniform along them.
-  const Vec3f anchors[] = {{0.96f, 0.82f, 0.74f}, {0.90f, 0.72f, 0.60f}, {0.74f, 0.53f, 0.40f},
-                           {0.46f, 0.30f, 0.21f}, {0.24f, 0.15f, 0.105f}};
+  const Vec3f anchors[] = {{0.96f, 0.82f, 0.74f},
+                           {0.90f, 0.72f, 0.60f},
+                           {0.74f, 0.53f, 0.40f},
+                           {0.46f, 0.30f, 0.21f},
+                           {0.24f, 0.15f, 0.105f}};
   // The spread's ends (within 0.06 of 0 and 1) map to the palette's ends, so six seeds reach them.
   const float tone = std::clamp((SpreadUnit(seed, 0.6180339887, rng) - 0.06f) / 0.84f, 0.f, 1.f);
   const float at = tone * 4.f;
@@ -110,11 +119,15 @@ void DrawDiverseSkin(uint64_t seed, IdentityParams* p) {
   p->skin_tone = (skin + Vec3f(tint, 0.f, -tint)).cwiseMax(0.f).cwiseMin(1.f);
   // Lips: redder on light skin, darker and browner on dark skin; always darker than the skin.
   const Vec3f lip_factor = Mix(Vec3f(0.88f, 0.52f, 0.56f), Vec3f(0.78f, 0.58f, 0.62f), tone);
-  p->lip_color = (p->skin_tone.cwiseProduct(lip_factor) + (1.f - tone) * Vec3f(u(0.02, 0.08), 0.f, 0.01f)).cwiseMin(1.f);
+  p->lip_color =
+      (p->skin_tone.cwiseProduct(lip_factor) + (1.f - tone) * Vec3f(u(0.02, 0.08), 0.f, 0.01f)).cwiseMin(1.f);
   // Hair and brows: any colour on light skin, dark on dark skin (brows keep a contrast of at
   // least ~2.5x the skin's luminance either way).
-  const Vec3f hairs[] = {{0.05f, 0.04f, 0.035f}, {0.18f, 0.11f, 0.06f}, {0.42f, 0.28f, 0.15f},
-                         {0.68f, 0.52f, 0.30f}, {0.48f, 0.19f, 0.07f}};
+  const Vec3f hairs[] = {{0.05f, 0.04f, 0.035f},
+                         {0.18f, 0.11f, 0.06f},
+                         {0.42f, 0.28f, 0.15f},
+                         {0.68f, 0.52f, 0.30f},
+                         {0.48f, 0.19f, 0.07f}};
   const int hair = tone > 0.6f ? static_cast<int>(rng.Below(2)) : static_cast<int>(rng.Below(5));
   p->hair_color = hairs[hair];
   const float skin_luma = p->skin_tone.dot(Vec3f(0.2126f, 0.7152f, 0.0722f));
@@ -135,13 +148,13 @@ void DrawFineDetail(uint64_t seed, IdentityParams* p) {
 std::string IdentityParams::ToString() const {
   std::ostringstream os;
   const face::ShapeParams& s = shape;
-  os << "IdentityParams(head=" << s.head_width << "x" << s.head_height << "x" << s.head_depth << ", jaw=" << s.jaw_width
-     << ", chin=" << s.chin_length << ", nose=" << s.nose_length << "/" << s.nose_width << "/" << s.nose_bridge
-     << ", eyes=" << s.eye_spacing << ", lips=" << s.lip_thickness << ", brows=" << s.brow_height
-     << ", cheeks=" << s.cheek_fullness << ", mouth=" << s.mouth_width << ", skin=[" << skin_tone.transpose()
-     << "], freckles=" << freckle_density << ", moles=" << num_moles << ", pores=" << pore_strength << "@"
-     << pore_scale << ", wrinkles=" << wrinkle_strength << ", stubble=" << stubble_density << ", "
-     << style.ToString() << ")";
+  os << "IdentityParams(head=" << s.head_width << "x" << s.head_height << "x" << s.head_depth
+     << ", jaw=" << s.jaw_width << ", chin=" << s.chin_length << ", nose=" << s.nose_length << "/"
+     << s.nose_width << "/" << s.nose_bridge << ", eyes=" << s.eye_spacing << ", lips=" << s.lip_thickness
+     << ", brows=" << s.brow_height << ", cheeks=" << s.cheek_fullness << ", mouth=" << s.mouth_width
+     << ", skin=[" << skin_tone.transpose() << "], freckles=" << freckle_density << ", moles=" << num_moles
+     << ", pores=" << pore_strength << "@" << pore_scale << ", wrinkles=" << wrinkle_strength
+     << ", stubble=" << stubble_density << ", " << style.ToString() << ")";
   return os.str();
 }
 

@@ -34,9 +34,9 @@ struct IdentityParams {
   float hairline = 0.0f;         // hairline offset (head units, + = higher forehead)
   uint32_t detail_seed = 1;      // key of every noise pattern (pores, freckles, moles, strands)
   // Fine detail at the pixel scale (the `detail` scene axis; the defaults are the classic head):
-  float pore_scale = 1.0f;       // pore frequency multiplier (2 = pores half the size)
-  float wrinkle_strength = 0.0f; // forehead lines and crow's feet, 0..1
-  float stubble_density = 0.0f;  // beard stubble dots over the lower face, 0..1
+  float pore_scale = 1.0f;        // pore frequency multiplier (2 = pores half the size)
+  float wrinkle_strength = 0.0f;  // forehead lines and crow's feet, 0..1
+  float stubble_density = 0.0f;   // beard stubble dots over the lower face, 0..1
 
   // The average head with the generic style and the default albedo (expression tests use it as a
   // fixed subject).

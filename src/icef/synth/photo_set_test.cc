@@ -271,7 +271,8 @@ TEST(PhotoSetTest, WritesPhotosAlphaTruthAndStyle) {
   const auto scales = IdentityParams::FromSeed(o.identity_seed).shape.ToArray();
   ASSERT_EQ((*truth)["shape"].size(), size_t(face::ShapeParams::kCount));
   for (int i = 0; i < face::ShapeParams::kCount; ++i)
-    EXPECT_NEAR((*truth)["shape"][face::kShapeParamNames[i]].get<double>(), scales[i], 1e-6) << face::kShapeParamNames[i];
+    EXPECT_NEAR((*truth)["shape"][face::kShapeParamNames[i]].get<double>(), scales[i], 1e-6)
+        << face::kShapeParamNames[i];
   const Result<Json> style = ReadJsonFile(dir / kStyleInfoFile);
   ASSERT_TRUE(style.ok()) << style.status().message();
   EXPECT_EQ((*style)["identity_seed"], 3);

@@ -3,12 +3,11 @@
 // consecutive seeds span every axis, pinning an axis leaves the others' draws alone, a placed head
 // keeps its cameras, 3D landmarks and 2D landmarks consistent, and every drawn scene is lit.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-
-#include <unistd.h>
 
 #include "icef/data/dataset.h"
 #include "icef/synth/ground_truth_renderer.h"
@@ -56,7 +55,8 @@ TEST(SceneTest, AxesParseByNameAndRejectUnknownOnes) {
 
 TEST(SceneTest, SixConsecutiveSeedsSpanEveryAxis) {
   float luma_min = 1, luma_max = 0;
-  double scale_min = 9, scale_max = 0, yaw_min = 90, yaw_max = 0, size_min = 9, size_max = 0, az_min = 9, az_max = -9;
+  double scale_min = 9, scale_max = 0, yaw_min = 90, yaw_max = 0, size_min = 9, size_max = 0, az_min = 9,
+         az_max = -9;
   int second_lights = 0;
   for (uint64_t seed = kFirstSeed; seed < kFirstSeed + 6; ++seed) {
     const SynthOptions o = ResolveScene(Diverse(seed));
@@ -168,8 +168,9 @@ TEST(SceneTest, DrawnScenesAreLitAndTheSheenShows) {
     in.width = in.height = 40;
     in.fl_x = in.fl_y = 3.6 * 40;
     in.cx = in.cy = 20;
-    const Image image = RenderGroundTruth(head, OrbitCamera(in, 3.5, 0, 0), std::vector<float>(face::kNumExpressions, 0.f),
-                                          Executor(1), o.render);
+    const Image image =
+        RenderGroundTruth(head, OrbitCamera(in, 3.5, 0, 0), std::vector<float>(face::kNumExpressions, 0.f),
+                          Executor(1), o.render);
     double sum = 0;
     int n = 0, clipped = 0;
     for (int y = 0; y < image.height; ++y)

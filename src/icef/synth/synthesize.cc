@@ -7,8 +7,8 @@
 
 #include "icef/core/rng.h"
 #include "icef/face/expression.h"
-#include "icef/io/atomic_file.h"
 #include "icef/face/face_model.h"
+#include "icef/io/atomic_file.h"
 #include "icef/synth/head_model.h"
 
 namespace icef::synth {
@@ -21,10 +21,13 @@ SceneAxes SceneAxes::All() {
   return a;
 }
 
-bool SceneAxes::Any() const { return skin || lighting || placement || camera || views || resolution || detail; }
+bool SceneAxes::Any() const {
+  return skin || lighting || placement || camera || views || resolution || detail;
+}
 
 const std::vector<std::string>& SceneAxes::Names() {
-  static const std::vector<std::string> kNames = {"skin", "lighting", "placement", "camera", "views", "resolution", "detail"};
+  static const std::vector<std::string> kNames = {"skin",  "lighting",   "placement", "camera",
+                                                  "views", "resolution", "detail"};
   return kNames;
 }
 
@@ -59,28 +62,42 @@ std::string SceneAxes::ToString() const {
 
 Status SynthOptions::Validate() const {
   if (out_dir.empty()) return Status::Error("out_dir: required");
-  if (num_train < 1 || num_train > 1000) return Status::Error("k: expected 1..1000 training frames, got " + std::to_string(num_train));
-  if (resolution < 8 || resolution > 4096) return Status::Error("res: expected 8..4096 pixels, got " + std::to_string(resolution));
-  if (test_views < 1 || test_views > 1000) return Status::Error("test_views: expected 1..1000, got " + std::to_string(test_views));
-  if (novel_per_tier < 0 || novel_per_tier > 1000) return Status::Error("novel_per_tier: expected 0..1000, got " + std::to_string(novel_per_tier));
+  if (num_train < 1 || num_train > 1000)
+    return Status::Error("k: expected 1..1000 training frames, got " + std::to_string(num_train));
+  if (resolution < 8 || resolution > 4096)
+    return Status::Error("res: expected 8..4096 pixels, got " + std::to_string(resolution));
+  if (test_views < 1 || test_views > 1000)
+    return Status::Error("test_views: expected 1..1000, got " + std::to_string(test_views));
+  if (novel_per_tier < 0 || novel_per_tier > 1000)
+    return Status::Error("novel_per_tier: expected 0..1000, got " + std::to_string(novel_per_tier));
   if (!(near_threshold > 0.0) || !(far_threshold > near_threshold))
-    return Status::Error("tier thresholds: expected 0 < near (" + std::to_string(near_threshold) + ") < far (" +
-                         std::to_string(far_threshold) + ")");
-  if (far_threshold > 2.5) return Status::Error("far threshold: expected <= 2.5 (far expressions are drawn up to ~1.5 per parameter), got " + std::to_string(far_threshold));
-  if (!(camera_distance > 1.5)) return Status::Error("camera_distance: expected > 1.5 (outside the head's box), got " + std::to_string(camera_distance));
-  if (!(focal_scale > 0.1)) return Status::Error("focal_scale: expected > 0.1, got " + std::to_string(focal_scale));
+    return Status::Error("tier thresholds: expected 0 < near (" + std::to_string(near_threshold) +
+                         ") < far (" + std::to_string(far_threshold) + ")");
+  if (far_threshold > 2.5)
+    return Status::Error(
+        "far threshold: expected <= 2.5 (far expressions are drawn up to ~1.5 per parameter), got " +
+        std::to_string(far_threshold));
+  if (!(camera_distance > 1.5))
+    return Status::Error("camera_distance: expected > 1.5 (outside the head's box), got " +
+                         std::to_string(camera_distance));
+  if (!(focal_scale > 0.1))
+    return Status::Error("focal_scale: expected > 0.1, got " + std::to_string(focal_scale));
   if (!(max_yaw_deg >= 0.0 && max_yaw_deg <= 80.0)) return Status::Error("max_yaw_deg: expected 0..80");
   if (!(max_pitch_deg >= 0.0 && max_pitch_deg <= 60.0)) return Status::Error("max_pitch_deg: expected 0..60");
   if (!(max_drawn_resolution >= 128 && max_drawn_resolution <= 4096))
-    return Status::Error("max_drawn_resolution: expected 128..4096, got " + std::to_string(max_drawn_resolution));
-  if (!(head_scale >= 0.25 && head_scale <= 4.0)) return Status::Error("head_scale: expected 0.25..4, got " + std::to_string(head_scale));
+    return Status::Error("max_drawn_resolution: expected 128..4096, got " +
+                         std::to_string(max_drawn_resolution));
+  if (!(head_scale >= 0.25 && head_scale <= 4.0))
+    return Status::Error("head_scale: expected 0.25..4, got " + std::to_string(head_scale));
   if (!head_offset.allFinite()) return Status::Error("head_offset: expected finite values");
   const Aabb head = face::FaceModel(face::ShapeParams()).Bounds();
   for (int a = 0; a < 3; ++a) {
-    const double lo = head_scale * head.min[a] + head_offset[a], hi = head_scale * head.max[a] + head_offset[a];
+    const double lo = head_scale * head.min[a] + head_offset[a],
+                 hi = head_scale * head.max[a] + head_offset[a];
     if (lo < -1.0 || hi > 1.0)
-      return Status::Error("head_scale/head_offset: the head (axis " + std::to_string(a) + ": " + std::to_string(lo) +
-                           ".." + std::to_string(hi) + ") leaves the dataset's box [-1, 1]");
+      return Status::Error("head_scale/head_offset: the head (axis " + std::to_string(a) + ": " +
+                           std::to_string(lo) + ".." + std::to_string(hi) +
+                           ") leaves the dataset's box [-1, 1]");
   }
   return render.Validate().WithContext("render");
 }
@@ -106,7 +123,8 @@ SynthOptions ResolveScene(const SynthOptions& options) {
     Rng rng(seed, StreamId("synth.scene.lighting"));
     // Key light anywhere over the front, from 70 degrees left to right and from slightly below
     // to high above; strength and ambient (the fill ratio) vary independently.
-    const double azimuth = (-70.0 + 140.0 * SpreadUnit(seed, 0.7182818285, rng)) * M_PI / 180.0, elevation = rng.Uniform(-10.0, 60.0) * M_PI / 180.0;
+    const double azimuth = (-70.0 + 140.0 * SpreadUnit(seed, 0.7182818285, rng)) * M_PI / 180.0,
+                 elevation = rng.Uniform(-10.0, 60.0) * M_PI / 180.0;
     o.render.light_direction = Vec3f(static_cast<float>(std::sin(azimuth) * std::cos(elevation)),
                                      static_cast<float>(std::sin(elevation)),
                                      static_cast<float>(std::cos(azimuth) * std::cos(elevation)));
@@ -116,8 +134,9 @@ SynthOptions ResolveScene(const SynthOptions& options) {
     if (rng.UniformDouble() < 0.5) {
       const double a2 = -std::copysign(1.0, azimuth) * rng.Uniform(40.0, 130.0) * M_PI / 180.0;
       const double e2 = rng.Uniform(-10.0, 40.0) * M_PI / 180.0;
-      o.render.fill_direction = Vec3f(static_cast<float>(std::sin(a2) * std::cos(e2)), static_cast<float>(std::sin(e2)),
-                                      static_cast<float>(std::cos(a2) * std::cos(e2)));
+      o.render.fill_direction =
+          Vec3f(static_cast<float>(std::sin(a2) * std::cos(e2)), static_cast<float>(std::sin(e2)),
+                static_cast<float>(std::cos(a2) * std::cos(e2)));
       o.render.fill = static_cast<float>(rng.Uniform(0.1, 0.4));
     }
     o.render.specular = static_cast<float>(rng.Uniform(0.0, 0.14));
@@ -138,7 +157,8 @@ SynthOptions ResolveScene(const SynthOptions& options) {
     // (the classic 3.5 / 3.6 is ~80 %).
     Rng rng(seed, StreamId("synth.scene.camera"));
     o.camera_distance = rng.Uniform(2.8, 6.0);
-    o.focal_scale = 3.6 * (o.camera_distance / 3.5) * ((0.5 + 0.35 * SpreadUnit(seed, 0.7320508076, rng)) / 0.8);
+    o.focal_scale =
+        3.6 * (o.camera_distance / 3.5) * ((0.5 + 0.35 * SpreadUnit(seed, 0.7320508076, rng)) / 0.8);
   }
   if (o.vary.views) {
     Rng rng(seed, StreamId("synth.scene.views"));
@@ -173,18 +193,26 @@ Json SceneInfoJson(const SynthOptions& o, const IdentityParams& id) {
   doc["note"] = "The scene of this synthetic dataset (icef synth; not part of the dataset format).";
   doc["identity_seed"] = o.identity_seed;
   doc["drawn_axes"] = o.vary.ToString();
-  doc["lighting"] = Json{{"key_direction", vec(o.render.light_direction)}, {"key", o.render.diffuse},
-                         {"ambient", o.render.ambient}, {"fill_direction", vec(o.render.fill_direction)},
-                         {"fill", o.render.fill}, {"specular", o.render.specular}, {"shininess", o.render.shininess},
+  doc["lighting"] = Json{{"key_direction", vec(o.render.light_direction)},
+                         {"key", o.render.diffuse},
+                         {"ambient", o.render.ambient},
+                         {"fill_direction", vec(o.render.fill_direction)},
+                         {"fill", o.render.fill},
+                         {"specular", o.render.specular},
+                         {"shininess", o.render.shininess},
                          {"canonical_shading", o.render.canonical_shading}};
   doc["placement"] = Json{{"head_scale", o.head_scale}, {"head_offset", vec(o.head_offset)}};
   doc["camera"] = Json{{"distance", o.camera_distance}, {"focal_scale", o.focal_scale}};
   doc["views"] = Json{{"max_yaw_deg", o.max_yaw_deg}, {"max_pitch_deg", o.max_pitch_deg}};
   doc["resolution"] = o.resolution;
-  doc["skin"] = Json{{"skin_tone", vec(id.skin_tone)}, {"lip_color", vec(id.lip_color)},
-                     {"brow_color", vec(id.brow_color)}, {"hair_color", vec(id.hair_color)}};
-  doc["detail"] = Json{{"pore_strength", id.pore_strength}, {"pore_scale", id.pore_scale},
-                       {"wrinkle_strength", id.wrinkle_strength}, {"stubble_density", id.stubble_density}};
+  doc["skin"] = Json{{"skin_tone", vec(id.skin_tone)},
+                     {"lip_color", vec(id.lip_color)},
+                     {"brow_color", vec(id.brow_color)},
+                     {"hair_color", vec(id.hair_color)}};
+  doc["detail"] = Json{{"pore_strength", id.pore_strength},
+                       {"pore_scale", id.pore_scale},
+                       {"wrinkle_strength", id.wrinkle_strength},
+                       {"stubble_density", id.stubble_density}};
   return doc;
 }
 
@@ -267,20 +295,22 @@ std::vector<float> TrainExpression(uint64_t seed, int k) {
   Rng rng(seed, StreamId("synth.train_expression"), 0, k);
   std::vector<float> beta(face::kNumExpressions, 0.f);
   const int active = 2 + static_cast<int>(rng.Below(3));
-  for (int a = 0; a < active; ++a) beta[rng.Below(face::kNumExpressions)] = static_cast<float>(rng.Uniform(0.15, 0.65));
+  for (int a = 0; a < active; ++a)
+    beta[rng.Below(face::kNumExpressions)] = static_cast<float>(rng.Uniform(0.15, 0.65));
   return beta;
 }
 
 // A candidate novel expression for a tier (the tier of the result is decided from its delta).
-std::vector<float> NovelCandidate(Tier tier, const std::vector<std::vector<float>>& train, const SynthOptions& o,
-                                  Rng& rng) {
+std::vector<float> NovelCandidate(Tier tier, const std::vector<std::vector<float>>& train,
+                                  const SynthOptions& o, Rng& rng) {
   std::vector<float> beta(face::kNumExpressions, 0.f);
   if (tier == Tier::kFar) {
     // Several parameters pushed to 0.9-1.5 on top of a softened training expression.
     const auto& base = train[rng.Below(train.size())];
     for (int i = 0; i < face::kNumExpressions; ++i) beta[i] = 0.5f * base[i];
     const int active = 3 + static_cast<int>(rng.Below(2));
-    for (int a = 0; a < active; ++a) beta[rng.Below(face::kNumExpressions)] = static_cast<float>(rng.Uniform(0.9, 1.5));
+    for (int a = 0; a < active; ++a)
+      beta[rng.Below(face::kNumExpressions)] = static_cast<float>(rng.Uniform(0.9, 1.5));
     return beta;
   }
   // A training expression moved by a step of the tier's length along 2-4 random parameters.
@@ -341,9 +371,11 @@ Result<SynthPlan> PlanSynthesis(const SynthOptions& options) {
   for (const auto* cameras : {&plan.train_cameras, &plan.test_cameras})
     for (const Camera& c : *cameras)
       if (WorldFromHead(o, c).Center().cwiseAbs().maxCoeff() <= 1.0)
-        return Status::Error("camera_distance/head_scale/head_offset: a camera lies inside the dataset's box [-1, 1]^3");
+        return Status::Error(
+            "camera_distance/head_scale/head_offset: a camera lies inside the dataset's box [-1, 1]^3");
   // Test expressions: every training expression (observed), then novel ones per tier.
-  for (const auto& beta : plan.train_expressions) plan.test_expressions.push_back({beta, 0.0, Tier::kObserved});
+  for (const auto& beta : plan.train_expressions)
+    plan.test_expressions.push_back({beta, 0.0, Tier::kObserved});
   for (Tier tier : {Tier::kNear, Tier::kModerate, Tier::kFar}) {
     for (int n = 0; n < o.novel_per_tier; ++n) {
       bool found = false;
@@ -369,8 +401,8 @@ Result<SynthPlan> PlanSynthesis(const SynthOptions& options) {
 namespace {
 
 // A frame seen by `camera` (head frame); its camera and 3D landmarks are stored in the world frame.
-Frame MakeFrame(const SynthOptions& o, const HeadModel& head, const Camera& camera, const std::vector<float>& beta,
-                std::string file_path) {
+Frame MakeFrame(const SynthOptions& o, const HeadModel& head, const Camera& camera,
+                const std::vector<float>& beta, std::string file_path) {
   Frame f;
   f.file_path = std::move(file_path);
   f.camera = WorldFromHead(o, camera);
@@ -403,7 +435,9 @@ Status SynthesizeDataset(const SynthOptions& requested, const Executor& executor
   const SynthOptions& options = plan.resolved;
   std::error_code ec;
   fs::create_directories(options.out_dir / "images", ec);
-  if (ec) return Status::Error((options.out_dir / "images").string() + ": cannot create directory: " + ec.message());
+  if (ec)
+    return Status::Error((options.out_dir / "images").string() +
+                         ": cannot create directory: " + ec.message());
   const IdentityParams identity = SynthIdentity(options);
   const HeadModel head(identity);
   const face::StyleGap gap = face::MeasureStyleGap(identity.shape, identity.style);
@@ -426,17 +460,17 @@ Status SynthesizeDataset(const SynthOptions& requested, const Executor& executor
     return frame;
   };
   for (int k = 0; k < options.num_train; ++k) {
-    ICEF_ASSIGN_OR_RETURN(Frame f, render(MakeFrame(options, head, plan.train_cameras[k], plan.train_expressions[k],
-                                                    Numbered("train", k)),
+    ICEF_ASSIGN_OR_RETURN(Frame f, render(MakeFrame(options, head, plan.train_cameras[k],
+                                                    plan.train_expressions[k], Numbered("train", k)),
                                           plan.train_cameras[k]));
     ds.train.push_back(std::move(f));
   }
   const std::vector<float> neutral(face::kNumExpressions, 0.f);
   std::vector<Frame> neutral_frames;  // [V]: their landmarks go into the test frames of the view
   for (int v = 0; v < num_views; ++v) {
-    ICEF_ASSIGN_OR_RETURN(Frame f, render(MakeFrame(options, head, plan.test_cameras[v], neutral,
-                                                    Numbered("test_neutral", v)),
-                                          plan.test_cameras[v]));
+    ICEF_ASSIGN_OR_RETURN(
+        Frame f, render(MakeFrame(options, head, plan.test_cameras[v], neutral, Numbered("test_neutral", v)),
+                        plan.test_cameras[v]));
     neutral_frames.push_back(std::move(f));
   }
   int index = 0;
@@ -455,9 +489,12 @@ Status SynthesizeDataset(const SynthOptions& requested, const Executor& executor
   ICEF_RETURN_IF_ERROR(SaveDataset(ds));
   ICEF_RETURN_IF_ERROR(
       WriteFileAtomic(options.out_dir / kStyleInfoFile, FormatJson(StyleInfoJson(options, identity, gap))));
-  ICEF_RETURN_IF_ERROR(WriteFileAtomic(options.out_dir / kSceneInfoFile, FormatJson(SceneInfoJson(options, identity))));
+  ICEF_RETURN_IF_ERROR(
+      WriteFileAtomic(options.out_dir / kSceneInfoFile, FormatJson(SceneInfoJson(options, identity))));
   if (style_gap) *style_gap = gap;
-  if (progress) progress->Finish(std::to_string(ds.train.size()) + " train, " + std::to_string(ds.test.size()) + " test frames");
+  if (progress)
+    progress->Finish(std::to_string(ds.train.size()) + " train, " + std::to_string(ds.test.size()) +
+                     " test frames");
   if (written) *written = std::move(ds);
   return Status::Ok();
 }

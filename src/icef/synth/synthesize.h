@@ -67,7 +67,8 @@ struct SynthOptions {
   int test_views = 3;
   // Novel test expressions per tier (near, moderate, far).
   int novel_per_tier = 2;
-  // Tier thresholds on delta: near = (0, near_threshold], moderate = (near_threshold, far_threshold], far above.
+  // Tier thresholds on delta: near = (0, near_threshold], moderate = (near_threshold, far_threshold], far
+  // above.
   double near_threshold = 0.35;
   double far_threshold = 0.8;
   // Camera distance from the head centre (head units; the head is ~0.75 tall).
@@ -124,10 +125,10 @@ Json StyleInfoJson(const SynthOptions& options, const IdentityParams& identity, 
 struct SynthPlan {
   SynthOptions resolved;  // ResolveScene(options)
   Intrinsics intrinsics;
-  std::vector<Camera> train_cameras;                 // [K]
+  std::vector<Camera> train_cameras;                  // [K]
   std::vector<std::vector<float>> train_expressions;  // [K][face::kNumExpressions]
-  std::vector<Camera> test_cameras;                  // [V]
-  std::vector<TestExpression> test_expressions;      // K observed, then near, moderate, far
+  std::vector<Camera> test_cameras;                   // [V]
+  std::vector<TestExpression> test_expressions;       // K observed, then near, moderate, far
 };
 Result<SynthPlan> PlanSynthesis(const SynthOptions& options);
 
@@ -150,7 +151,8 @@ int64_t SynthImageCount(const SynthOptions& options);
 // Renders and writes the dataset (images/ + transforms_{train,test}.json via SaveDataset, and
 // kStyleInfoFile). The written Dataset is returned through `written` and the subject's style gap
 // (face::MeasureStyleGap at weight 1) through `style_gap` when non-null. progress may be null.
-Status SynthesizeDataset(const SynthOptions& options, const Executor& executor, ProgressBar* progress = nullptr,
-                         Dataset* written = nullptr, face::StyleGap* style_gap = nullptr);
+Status SynthesizeDataset(const SynthOptions& options, const Executor& executor,
+                         ProgressBar* progress = nullptr, Dataset* written = nullptr,
+                         face::StyleGap* style_gap = nullptr);
 
 }  // namespace icef::synth

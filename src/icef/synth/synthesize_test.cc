@@ -1,15 +1,14 @@
 #include "icef/synth/synthesize.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
 
-#include <unistd.h>
-
+#include "icef/face/expression.h"
 #include "icef/io/atomic_file.h"
 #include "icef/synth/contact_sheet.h"
-#include "icef/face/expression.h"
 
 namespace icef::synth {
 namespace {
@@ -17,7 +16,8 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path TempDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("icef_synth_test_" + name + "_" + std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("icef_synth_test_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   return dir;
 }
@@ -125,7 +125,8 @@ TEST(SynthesizeTest, WritesALoadableDeterministicDataset) {
     ASSERT_TRUE(f.delta && f.tier && f.neutral_file_path);
     const double delta = ExpressionDelta(f.expression, train);
     EXPECT_NEAR(*f.delta, delta, 1e-6);  // the JSON's delta agrees with the expressions
-    EXPECT_EQ(*f.tier, TierForDelta(delta < 1e-9 ? 0.0 : delta, (*ds.tier_thresholds)[0], (*ds.tier_thresholds)[1]));
+    EXPECT_EQ(*f.tier,
+              TierForDelta(delta < 1e-9 ? 0.0 : delta, (*ds.tier_thresholds)[0], (*ds.tier_thresholds)[1]));
     EXPECT_TRUE(f.landmarks_2d && f.landmarks_3d && f.landmarks_2d_visible);
     // The neutral of the view keeps its landmarks (eval aligns the neutral reference with them):
     // the same for every frame of the view, and brows, eyes or lips move with the expression.
@@ -176,7 +177,8 @@ TEST(SynthesizeTest, RendersTheIdentitysStyleUnlessGenericIsAsked) {
     EXPECT_GT(diff, 1e-3f) << "train frame " << k;  // every training expression shows the style
   }
   // Neutral frames do not depend on the style; expressive ones do.
-  EXPECT_EQ(*ReadFile(a / "images" / "test_neutral_000.png"), *ReadFile(b / "images" / "test_neutral_000.png"));
+  EXPECT_EQ(*ReadFile(a / "images" / "test_neutral_000.png"),
+            *ReadFile(b / "images" / "test_neutral_000.png"));
   EXPECT_NE(*ReadFile(a / "images" / "train_000.png"), *ReadFile(b / "images" / "train_000.png"));
   // style.json records the style and the gap; the dataset loader ignores it.
   const Result<Json> info = ReadJsonFile(a / kStyleInfoFile);

@@ -41,7 +41,8 @@ inline double MaxRelativeError(std::vector<double>* values, const std::vector<do
     const double lm = loss();
     (*values)[i] = saved;
     const double numeric = (lp - lm) / (2.0 * h);
-    const double err = std::abs(analytic[i] - numeric) / std::max({std::abs(analytic[i]), std::abs(numeric), floor});
+    const double err =
+        std::abs(analytic[i] - numeric) / std::max({std::abs(analytic[i]), std::abs(numeric), floor});
     worst = std::max(worst, err);
   };
   if (indices.empty()) {
@@ -130,11 +131,12 @@ struct ParameterGradientCheck {
       ++report.checked;
       const double tol = rel_tol * std::abs(fd) + abs_tol_frac * largest + abs_tol;
       if (!(std::abs(analytic[i] - fd) <= tol))
-        failures << "parameter " << i << ": analytic " << analytic[i] << ", numeric " << fd << " (tolerance " << tol
-                 << ")\n";
+        failures << "parameter " << i << ": analytic " << analytic[i] << ", numeric " << fd << " (tolerance "
+                 << tol << ")\n";
     }
     if (report.checked < std::min<int64_t>(min_checked, k))
-      failures << "only " << report.checked << " of " << k << " parameters checked (the rest straddle kinks)\n";
+      failures << "only " << report.checked << " of " << k
+               << " parameters checked (the rest straddle kinks)\n";
     if (largest == 0.0) failures << "every analytic gradient is zero\n";
     report.failures = failures.str();
     return report;

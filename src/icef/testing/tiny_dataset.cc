@@ -61,7 +61,8 @@ double Distance(const std::vector<float>& a, const std::vector<float>& b) {
 }  // namespace
 
 Status TinyDatasetOptions::Validate() const {
-  if (num_train < 1 || num_test < 0 || num_val < 0) return Status::Error("need num_train >= 1, num_test/num_val >= 0");
+  if (num_train < 1 || num_test < 0 || num_val < 0)
+    return Status::Error("need num_train >= 1, num_test/num_val >= 0");
   if (width < 1 || height < 1) return Status::Error("image size must be positive");
   if (expression_dim < 0) return Status::Error("expression_dim must be >= 0");
   return Status::Ok();
@@ -69,8 +70,8 @@ Status TinyDatasetOptions::Validate() const {
 
 std::string TinyDatasetOptions::ToString() const {
   std::ostringstream os;
-  os << "TinyDatasetOptions(train=" << num_train << ", test=" << num_test << ", val=" << num_val << ", " << width
-     << "x" << height << ", B=" << expression_dim << ", landmarks_2d=" << landmarks_2d
+  os << "TinyDatasetOptions(train=" << num_train << ", test=" << num_test << ", val=" << num_val << ", "
+     << width << "x" << height << ", B=" << expression_dim << ", landmarks_2d=" << landmarks_2d
      << ", landmarks_3d=" << landmarks_3d << ", alpha=" << alpha << ", seed=" << seed << ")";
   return os.str();
 }
@@ -84,7 +85,8 @@ Dataset WriteTinyDataset(const fs::path& dir, const TinyDatasetOptions& options)
   d.aabb.min = Vec3f::Constant(-1.f);
   d.aabb.max = Vec3f::Constant(1.f);
   d.expression_dim = options.expression_dim;
-  for (int i = 0; i < options.expression_dim; ++i) d.expression_names.push_back(std::string(1, 'e').append(std::to_string(i)));
+  for (int i = 0; i < options.expression_dim; ++i)
+    d.expression_names.push_back(std::string(1, 'e').append(std::to_string(i)));
   d.background = Vec3f(1.f, 1.f, 1.f);
   d.tier_thresholds = std::array<double, 2>{0.5, 1.0};
 
@@ -98,7 +100,8 @@ Dataset WriteTinyDataset(const fs::path& dir, const TinyDatasetOptions& options)
   std::vector<Vec3f> landmarks(kNumLandmarks);
   Rng landmark_rng(options.seed, StreamId("tiny_dataset/landmarks"));
   for (Vec3f& p : landmarks)
-    p = Vec3f(landmark_rng.Uniform(-0.5, 0.5), landmark_rng.Uniform(-0.5, 0.5), landmark_rng.Uniform(-0.5, 0.5));
+    p = Vec3f(landmark_rng.Uniform(-0.5, 0.5), landmark_rng.Uniform(-0.5, 0.5),
+              landmark_rng.Uniform(-0.5, 0.5));
 
   const std::pair<const char*, int> splits[] = {
       {"train", options.num_train}, {"test", options.num_test}, {"val", options.num_val}};
@@ -123,10 +126,13 @@ Dataset WriteTinyDataset(const fs::path& dir, const TinyDatasetOptions& options)
         double delta = 1e300;
         for (const Frame& t : d.train) delta = std::min(delta, Distance(f.expression, t.expression));
         f.delta = delta;
-        f.tier = delta == 0 ? Tier::kObserved : delta <= 0.5 ? Tier::kNear : delta <= 1.0 ? Tier::kModerate : Tier::kFar;
+        f.tier = delta == 0     ? Tier::kObserved
+                 : delta <= 0.5 ? Tier::kNear
+                 : delta <= 1.0 ? Tier::kModerate
+                                : Tier::kFar;
       }
-      const Status written = WritePng(dir / f.file_path, RandomImage(options.width, options.height,
-                                                                     options.alpha ? 4 : 3, rng));
+      const Status written =
+          WritePng(dir / f.file_path, RandomImage(options.width, options.height, options.alpha ? 4 : 3, rng));
       ICEF_CHECK(written.ok(), written.message());
       std::string s(split);
       (s == "train" ? d.train : s == "test" ? d.test : d.val).push_back(std::move(f));
@@ -183,13 +189,15 @@ TinyNerfaceInfo WriteTinyNerfaceDataset(const fs::path& dir, const TinyNerfaceOp
     fs::create_directories(dir / split);
     Json doc = Json::object();
     doc["camera_angle_x"] = info.camera_angle_x;
-    doc["intrinsics"] = Json::array({info.intrinsics[0], info.intrinsics[1], info.intrinsics[2], info.intrinsics[3]});
+    doc["intrinsics"] =
+        Json::array({info.intrinsics[0], info.intrinsics[1], info.intrinsics[2], info.intrinsics[3]});
     Json frames = Json::array();
     for (int i = 0; i < count; ++i) {
       Rng rng(options.seed, StreamId(split), 0, i);
       char name[64];
       std::snprintf(name, sizeof name, "%s/f_%04d", split, i);
-      ICEF_CHECK(WritePng(dir / (std::string(name) + ".png"), RandomImage(options.size, options.size, 3, rng)).ok());
+      ICEF_CHECK(
+          WritePng(dir / (std::string(name) + ".png"), RandomImage(options.size, options.size, 3, rng)).ok());
       const Camera camera = OrbitCamera(k, i, count);
       Json m = Json::array();
       for (int r = 0; r < 4; ++r) {

@@ -12,16 +12,16 @@
 namespace icef::testing {
 
 struct TinyDatasetOptions {
-  int num_train = 3;           // training frames (K)
-  int num_test = 2;            // test frames; they carry delta and tier
-  int num_val = 0;             // validation frames
-  int width = 8;               // image width in pixels
-  int height = 6;              // image height in pixels
-  int expression_dim = 4;      // B; expression_names are "e0", "e1", ...
-  bool landmarks_2d = true;    // 68 projected landmarks on every frame
-  bool landmarks_3d = false;   // 68 world-frame landmarks on every frame
-  bool alpha = false;          // RGBA images instead of RGB
-  uint64_t seed = 1;           // every random value derives from it
+  int num_train = 3;          // training frames (K)
+  int num_test = 2;           // test frames; they carry delta and tier
+  int num_val = 0;            // validation frames
+  int width = 8;              // image width in pixels
+  int height = 6;             // image height in pixels
+  int expression_dim = 4;     // B; expression_names are "e0", "e1", ...
+  bool landmarks_2d = true;   // 68 projected landmarks on every frame
+  bool landmarks_3d = false;  // 68 world-frame landmarks on every frame
+  bool alpha = false;         // RGBA images instead of RGB
+  uint64_t seed = 1;          // every random value derives from it
   Status Validate() const;
   std::string ToString() const;
 };
@@ -33,15 +33,15 @@ struct TinyDatasetOptions {
 Dataset WriteTinyDataset(const std::filesystem::path& dir, const TinyDatasetOptions& options = {});
 
 struct TinyNerfaceOptions {
-  int num_train = 3;         // frames in transforms_train.json
-  int num_val = 1;           // frames in transforms_val.json
-  int num_test = 1;          // frames in transforms_test.json
-  int size = 8;              // square image size in pixels
-  int expression_dim = 76;   // NerFace's usual expression length
+  int num_train = 3;        // frames in transforms_train.json
+  int num_val = 1;          // frames in transforms_val.json
+  int num_test = 1;         // frames in transforms_test.json
+  int size = 8;             // square image size in pixels
+  int expression_dim = 76;  // NerFace's usual expression length
   // Focal lengths as NerFace's real_to_nerf.py writes them: the file's fx, fy negative, and train
   // frames 1 and 2 with their own "intrinsics", one focal length negative each (needs num_train >= 3).
   bool signed_focals = false;
-  uint64_t seed = 2;         // every random value derives from it
+  uint64_t seed = 2;  // every random value derives from it
   Status Validate() const;
   std::string ToString() const;
 };
@@ -57,7 +57,8 @@ struct TinyNerfaceInfo {
 // transforms_{train,val,test}.json with camera_angle_x, a global "intrinsics" [fx, fy, cx, cy],
 // per-frame "expression" and "bbox", file paths "./train/f_0000" without extension, images
 // train/f_0000.png ..., and the background image bg/00050.png. No w, h, aabb or expression_dim.
-TinyNerfaceInfo WriteTinyNerfaceDataset(const std::filesystem::path& dir, const TinyNerfaceOptions& options = {});
+TinyNerfaceInfo WriteTinyNerfaceDataset(const std::filesystem::path& dir,
+                                        const TinyNerfaceOptions& options = {});
 
 // A ray in double precision: origin and unit direction, world frame.
 struct RayD {

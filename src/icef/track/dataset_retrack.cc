@@ -4,12 +4,13 @@
 #include <set>
 #include <system_error>
 
+#include "icef/core/enum_table.h"
 #include "icef/face/expression.h"
 #include "icef/face/shape_params.h"
 #include "icef/io/atomic_file.h"
 #include "icef/io/image.h"
-#include "icef/track/head_mask.h"
 #include "icef/landmarks/landmark_detection.h"
+#include "icef/track/head_mask.h"
 
 namespace icef::track {
 
@@ -33,33 +34,35 @@ std::vector<int> SpreadFrames(int n, int max) {
     for (int i = 0; i < n; ++i) frames.push_back(i);
     return frames;
   }
-  for (int i = 0; i < max; ++i) frames.push_back(static_cast<int>(std::lround(double(i) * (n - 1) / (max - 1))));
+  for (int i = 0; i < max; ++i)
+    frames.push_back(static_cast<int>(std::lround(double(i) * (n - 1) / (max - 1))));
   return frames;
 }
 
+constexpr std::array<EnumEntry<RetrackLandmarks>, 3> kRetrackLandmarksNames = {
+    {{RetrackLandmarks::kDetect, "detect"},
+     {RetrackLandmarks::kDatasetDlib, "dlib"},
+     {RetrackLandmarks::kDatasetModel, "model"}}};
+
 const char* RetrackLandmarksName(RetrackLandmarks landmarks) {
-  switch (landmarks) {
-    case RetrackLandmarks::kDetect: return "detect";
-    case RetrackLandmarks::kDatasetDlib: return "dlib";
-    case RetrackLandmarks::kDatasetModel: return "model";
-  }
-  return "?";
+  return EnumName(kRetrackLandmarksNames, landmarks);
 }
 
 std::optional<RetrackLandmarks> ParseRetrackLandmarks(const std::string& name) {
-  for (RetrackLandmarks l : {RetrackLandmarks::kDetect, RetrackLandmarks::kDatasetDlib, RetrackLandmarks::kDatasetModel})
-    if (name == RetrackLandmarksName(l)) return l;
-  return std::nullopt;
+  return ParseEnum(kRetrackLandmarksNames, name);
 }
 
 double RetrackPhotometricWeight(RetrackLandmarks landmarks) {
   return landmarks == RetrackLandmarks::kDatasetModel ? 0.0 : TrackFitOptions().photometric_weight;
 }
 
-int RetrackSilhouettePoints(RetrackLandmarks landmarks) { return landmarks == RetrackLandmarks::kDatasetModel ? 0 : 200; }
+int RetrackSilhouettePoints(RetrackLandmarks landmarks) {
+  return landmarks == RetrackLandmarks::kDatasetModel ? 0 : 200;
+}
 
 double RetrackLandmarkSigma(RetrackLandmarks landmarks) {
-  return landmarks == RetrackLandmarks::kDatasetModel ? kRetrackModelLandmarkSigmaIod : kRetrackLandmarkSigmaIod;
+  return landmarks == RetrackLandmarks::kDatasetModel ? kRetrackModelLandmarkSigmaIod
+                                                      : kRetrackLandmarkSigmaIod;
 }
 
 Status RetrackOptions::Validate() const {
@@ -70,13 +73,16 @@ Status RetrackOptions::Validate() const {
 }
 
 std::string RetrackOptions::ToString() const {
-  return "RetrackOptions(landmarks=" + std::string(RetrackLandmarksName(landmarks)) + ", skip_bad=" + std::to_string(skip_bad) +
-         ", silhouette_points=" + std::to_string(silhouette_points) + ", detector=" + LandmarkDetectorName(detector) + ", predictor=" +
-         (predictor_path.empty() ? std::string("default") : predictor_path.string()) + ", fit_style=" + std::to_string(fit_style) +
-         ", " + fit.ToString() + ")";
+  return "RetrackOptions(landmarks=" + std::string(RetrackLandmarksName(landmarks)) +
+         ", skip_bad=" + std::to_string(skip_bad) +
+         ", silhouette_points=" + std::to_string(silhouette_points) +
+         ", detector=" + LandmarkDetectorName(detector) +
+         ", predictor=" + (predictor_path.empty() ? std::string("default") : predictor_path.string()) +
+         ", fit_style=" + std::to_string(fit_style) + ", " + fit.ToString() + ")";
 }
 
-Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions& options, const Executor& executor,
+Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions& options,
+                                     const Executor& executor,
                                      const std::function<void(const std::string&)>& log) {
   ICEF_RETURN_IF_ERROR(options.Validate().WithContext("track fit options"));
   RetrackResult result;
@@ -90,7 +96,9 @@ Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions
     lo.overwrite = true;
     lo.averaged = true;  // as icef track detects (and as detector_landmarks.inc was measured)
     lo.mesh = options.detector == LandmarkDetector::kMesh;
-    if (log) log(std::string("detecting the landmarks of every frame (") + LandmarkDetectorName(options.detector) + ")");
+    if (log)
+      log(std::string("detecting the landmarks of every frame (") + LandmarkDetectorName(options.detector) +
+          ")");
     ICEF_ASSIGN_OR_RETURN(const LandmarkDetectionReport report, DetectDatasetLandmarks(source, lo, executor));
     for (const FrameLandmarks& fl : report.frames) {
       Frame& f = (*Split(d, fl.split))[fl.index];
@@ -117,8 +125,11 @@ Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions
         continue;
       }
       const std::string name = FrameName(split, static_cast<int>(i), (*frames)[i]);
-      const std::string why = options.landmarks == RetrackLandmarks::kDetect ? "no face found" : "no landmarks_2d";
-      if (!options.skip_bad) return Status::Error(source.root.string() + ": " + name + ": " + why + " (--skip-bad drops such frames)");
+      const std::string why =
+          options.landmarks == RetrackLandmarks::kDetect ? "no face found" : "no landmarks_2d";
+      if (!options.skip_bad)
+        return Status::Error(source.root.string() + ": " + name + ": " + why +
+                             " (--skip-bad drops such frames)");
       result.skipped.push_back(name + ": " + why);
       if (log) log("skipped " + name + ": " + why);
     }
@@ -132,7 +143,8 @@ Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions
     std::vector<Frame>* frames = Split(d, split);
     for (size_t i = 0; i < frames->size(); ++i) {
       Frame& f = (*frames)[i];
-      track_frames.push_back(TrackFrame{*f.landmarks_2d, f.camera.intrinsics(), f.camera.world_from_cam(), {}});
+      track_frames.push_back(
+          TrackFrame{*f.landmarks_2d, f.camera.intrinsics(), f.camera.world_from_cam(), {}});
       order.push_back(&f);
       result.frame_names.push_back(FrameName(split, static_cast<int>(i), f));
     }
@@ -140,12 +152,14 @@ Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions
   TrackFitOptions fit_options = options.fit;
   const bool default_weight = fit_options.photometric_weight < 0;
   if (default_weight) fit_options.photometric_weight = RetrackPhotometricWeight(options.landmarks);
-  if (fit_options.landmark_sigma_iod < 0) fit_options.landmark_sigma_iod = RetrackLandmarkSigma(options.landmarks);
+  if (fit_options.landmark_sigma_iod < 0)
+    fit_options.landmark_sigma_iod = RetrackLandmarkSigma(options.landmarks);
   const int silhouette_points =
       options.silhouette_points < 0 ? RetrackSilhouettePoints(options.landmarks) : options.silhouette_points;
   // The images: for the photometric refit (track_fit.h), composited over the dataset's background;
   // their alpha masks' edges for the silhouette term. Loaded one at a time unless the refit keeps them.
-  const bool photometric = fit_options.photometric_weight > 0 && order.size() <= static_cast<size_t>(kMaxPhotometricFrames);
+  const bool photometric =
+      fit_options.photometric_weight > 0 && order.size() <= static_cast<size_t>(kMaxPhotometricFrames);
   if (fit_options.photometric_weight > 0 && !photometric && log)
     log("photometric refit skipped: " + std::to_string(order.size()) + " frames (at most " +
         std::to_string(kMaxPhotometricFrames) + "); the landmarks alone give the expressions");
@@ -156,7 +170,8 @@ Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions
   std::optional<Image> background_image;
   if (silhouette_points > 0 && d.background_file_path) {
     Result<Image> bg = ReadImage(d.root / *d.background_file_path);
-    if (!bg.ok()) return bg.status().WithContext((d.root / *d.background_file_path).string() + ": background_file_path");
+    if (!bg.ok())
+      return bg.status().WithContext((d.root / *d.background_file_path).string() + ": background_file_path");
     background_image = std::move(*bg);
   }
   int masked = 0, differenced = 0;
@@ -167,7 +182,8 @@ Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions
     for (size_t k = 0; k < order.size(); ++k) {
       if (!photometric && !outlined[k]) continue;
       ICEF_ASSIGN_OR_RETURN(Image rgba, LoadFrameImage(d, *order[k]));
-      const bool by_background = !rgba.HasAlpha() && background_image && background_image->width == rgba.width &&
+      const bool by_background = !rgba.HasAlpha() && background_image &&
+                                 background_image->width == rgba.width &&
                                  background_image->height == rgba.height;
       if (outlined[k] && (rgba.HasAlpha() || by_background)) {
         Image mask(rgba.width, rgba.height, 1);
@@ -212,8 +228,9 @@ Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions
       log("silhouettes: at most " + std::to_string(kMaxSilhouetteFrames) +
           " frames, spread over the sequence, add their outlines; the others keep their landmarks");
     if (differenced > 0)
-      log("silhouettes: the outlines of " + std::to_string(differenced) + " of " + std::to_string(order.size()) +
-          " frames against the background image " + *d.background_file_path + " (" + part + ")");
+      log("silhouettes: the outlines of " + std::to_string(differenced) + " of " +
+          std::to_string(order.size()) + " frames against the background image " + *d.background_file_path +
+          " (" + part + ")");
     if (masked + differenced == 0)
       log("silhouettes: no frame has an alpha mask or a background image to tell it from; landmarks only");
   }
@@ -224,12 +241,14 @@ Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions
     fit_options.photometric_hold_similarity = true;
     if (default_weight) fit_options.photometric_weight = kRetrackPhotometricWeightWithOutlines;
     if (log)
-      log("photometric refit: weight " + std::to_string(static_cast<int>(std::lround(fit_options.photometric_weight))) +
+      log("photometric refit: weight " +
+          std::to_string(static_cast<int>(std::lround(fit_options.photometric_weight))) +
           ", the similarity the outlines placed held; the colours read the expressions");
   }
   result.photometric_weight = photometric ? fit_options.photometric_weight : 0.0;
   result.similarity_held = fit_options.photometric_hold_similarity;
-  fit_options.detector = options.landmarks == RetrackLandmarks::kDetect ? options.detector : LandmarkDetector::kDlib;
+  fit_options.detector =
+      options.landmarks == RetrackLandmarks::kDetect ? options.detector : LandmarkDetector::kDlib;
   if (options.landmarks == RetrackLandmarks::kDatasetModel) {
     // The face model's own landmarks, as exact as the data that carries them: the priors of a
     // sub-pixel source (track_fit_test's), not those balanced against dlib's scatter.
@@ -268,7 +287,8 @@ Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions
     Frame& f = *order[k];
     f.expression = result.fit.frames[k].expression;
     std::vector<Vec3f> world;
-    for (const Vec3f& p : result.fit.frames[k].landmarks_head) world.push_back(sim.ApplyInverse(p.cast<double>()).cast<float>());
+    for (const Vec3f& p : result.fit.frames[k].landmarks_head)
+      world.push_back(sim.ApplyInverse(p.cast<double>()).cast<float>());
     f.landmarks_3d = world;
     f.neutral_landmarks_2d.reset();  // in the source's terms; the neutral image is kept
     f.neutral_landmarks_3d.reset();
@@ -283,7 +303,8 @@ Json RetrackReportJson(const RetrackResult& result) {
   for (size_t k = 0; k < result.fit.frames.size(); ++k) {
     const TrackedFrame& f = result.fit.frames[k];
     Json expression = Json::object();
-    for (int e = 0; e < face::kNumExpressions; ++e) expression[face::kExpressionNames[e]] = JsonFloat(f.expression[e]);
+    for (int e = 0; e < face::kNumExpressions; ++e)
+      expression[face::kExpressionNames[e]] = JsonFloat(f.expression[e]);
     frames.push_back(Json{{"frame", result.frame_names[k]},
                           {"landmark_rms_iod", f.rms_iod},
                           {"landmark_max_iod", f.max_iod},
@@ -318,9 +339,10 @@ Json RetrackReportJson(const RetrackResult& result) {
               {"silhouette_refit", result.fit.silhouettes},
               {"landmark_max_iod", result.fit.max_iod},
               {"iterations", result.fit.iterations},
-              {"head_from_world", {{"scale", s.scale},
-                                   {"rotation", rotation},
-                                   {"translation", {s.translation.x(), s.translation.y(), s.translation.z()}}}},
+              {"head_from_world",
+               {{"scale", s.scale},
+                {"rotation", rotation},
+                {"translation", {s.translation.x(), s.translation.y(), s.translation.z()}}}},
               {"shape", shape}};
 }
 

@@ -117,9 +117,9 @@ struct RetrackResult {
   // Frames where the detector found no face and the dataset's own landmarks_2d were fitted instead.
   std::vector<std::string> fallbacks;
   std::vector<std::string> frame_names;  // per fitted frame, in fit order: "train[0] images/..."
-  int outlined_frames = 0;           // frames that added their outlines
-  double photometric_weight = 0;     // the refit's weight as used (0: off)
-  bool similarity_held = false;      // the refit kept the similarity the outlines placed
+  int outlined_frames = 0;               // frames that added their outlines
+  double photometric_weight = 0;         // the refit's weight as used (0: off)
+  bool similarity_held = false;          // the refit kept the similarity the outlines placed
   // RetrackOptions::fit_style with the face model's landmarks: the style fit (its style is the one
   // the weights were read in unless style_rejected).
   std::optional<face::FaceFit> style_fit;
@@ -127,7 +127,8 @@ struct RetrackResult {
 };
 
 // Errors: a frame without a face (unless skip_bad) naming it, a fit that fails.
-Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions& options, const Executor& executor,
+Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions& options,
+                                     const Executor& executor,
                                      const std::function<void(const std::string&)>& log = nullptr);
 
 // Per frame: name, landmark residual, expression; plus the similarity and the shape.

@@ -101,7 +101,8 @@ TEST(DatasetRetrackTest, SyntheticDatasetKeepsItsCamerasAndGetsItsExpressionsBac
     EXPECT_EQ(d.train[i].camera.world_from_cam(), source->train[i].camera.world_from_cam());
     EXPECT_EQ(d.train[i].file_path, source->train[i].file_path);
     for (int e = 0; e < face::kNumExpressions; ++e)
-      if (e != face::kCheekPuff) sum2 += std::pow(d.train[i].expression[e] - source->train[i].expression[e], 2), ++n;
+      if (e != face::kCheekPuff)
+        sum2 += std::pow(d.train[i].expression[e] - source->train[i].expression[e], 2), ++n;
   }
   EXPECT_LT(std::sqrt(sum2 / n), 0.25);
   // Detected landmarks: the photometric refit runs by default on the dataset's images and sees the
@@ -133,8 +134,10 @@ TEST(DatasetRetrackTest, SyntheticDatasetKeepsItsCamerasAndGetsItsExpressionsBac
   dlib.silhouette_points = -1;
   const Result<RetrackResult> dlib_outlined = RetrackDataset(*source, dlib, Executor(2));
   ASSERT_TRUE(dlib_outlined.ok()) << dlib_outlined.status().message();
-  const double dlib_only_deg = Eigen::AngleAxisd(dlib_only->fit.head_from_world->rotation).angle() * 180 / M_PI;
-  const double dlib_outlined_deg = Eigen::AngleAxisd(dlib_outlined->fit.head_from_world->rotation).angle() * 180 / M_PI;
+  const double dlib_only_deg =
+      Eigen::AngleAxisd(dlib_only->fit.head_from_world->rotation).angle() * 180 / M_PI;
+  const double dlib_outlined_deg =
+      Eigen::AngleAxisd(dlib_outlined->fit.head_from_world->rotation).angle() * 180 / M_PI;
   EXPECT_GT(dlib_only_deg, dlib_outlined_deg + 2.0);
   EXPECT_LT(dlib_outlined_deg, 7.0);
   EXPECT_LT(dlib_only_deg, 15.0);  // loose: catches a fit gone wrong
@@ -155,7 +158,8 @@ TEST(DatasetRetrackTest, SyntheticDatasetKeepsItsCamerasAndGetsItsExpressionsBac
     double sum = 0;
     for (size_t i = 0; i < d.train.size(); ++i)
       for (int e = 0; e < face::kNumExpressions; ++e)
-        if (e != face::kCheekPuff) sum += std::pow(tracked.train[i].expression[e] - source->train[i].expression[e], 2);
+        if (e != face::kCheekPuff)
+          sum += std::pow(tracked.train[i].expression[e] - source->train[i].expression[e], 2);
     return std::sqrt(sum / n);
   };
   const double exact_rms = weight_rms(exact->dataset);
@@ -178,12 +182,14 @@ TEST(DatasetRetrackTest, SyntheticDatasetKeepsItsCamerasAndGetsItsExpressionsBac
   const Result<RetrackResult> generic = RetrackDataset(*source, own_generic, Executor(2));
   ASSERT_TRUE(generic.ok()) << generic.status().message();
   EXPECT_FALSE(generic->style_fit.has_value());
-  EXPECT_LT(exact->fit.rms_iod, generic->fit.rms_iod) << exact->fit.BriefReport() << " vs " << generic->fit.BriefReport();
+  EXPECT_LT(exact->fit.rms_iod, generic->fit.rms_iod)
+      << exact->fit.BriefReport() << " vs " << generic->fit.BriefReport();
   // The landmarks written are the styled model's: the trainer's face-model fit (at the tracked
   // weights) finds a style in them again; in the generic dataset's it finds none.
   const auto trainer_fit = [](const Dataset& tracked) {
     std::vector<face::FitFrame> frames;
-    for (const Frame& f : tracked.train) frames.push_back(face::FitFrame{f.expression, f.landmarks_3d, std::nullopt, std::nullopt});
+    for (const Frame& f : tracked.train)
+      frames.push_back(face::FitFrame{f.expression, f.landmarks_3d, std::nullopt, std::nullopt});
     face::FaceFitOptions o;
     o.fit_style = true;
     return face::FitFaceModel(frames, o);
@@ -231,7 +237,8 @@ TEST(DatasetRetrackTest, SyntheticDatasetKeepsItsCamerasAndGetsItsExpressionsBac
         for (int y = 0; y < over.height; ++y)
           for (int x = 0; x < over.width; ++x)
             for (int c = 0; c < 3; ++c)
-              over.At(x, y, c) = rgba->At(x, y, 3) * rgba->At(x, y, c) + (1 - rgba->At(x, y, 3)) * bg.At(x, y, c);
+              over.At(x, y, c) =
+                  rgba->At(x, y, 3) * rgba->At(x, y, c) + (1 - rgba->At(x, y, 3)) * bg.At(x, y, c);
         ASSERT_TRUE(WritePng(rgb.root / f.file_path, over).ok());
         f.neutral_file_path.reset();
       }
@@ -246,8 +253,9 @@ TEST(DatasetRetrackTest, SyntheticDatasetKeepsItsCamerasAndGetsItsExpressionsBac
     ASSERT_TRUE(b.ok()) << b.status().message();
     for (const TrackedFrame& f : b->fit.frames) EXPECT_GT(f.silhouette_used, 10) << f.ToString();
     EXPECT_LT(Eigen::AngleAxisd(b->fit.head_from_world->rotation).angle() * 180 / M_PI, 1.0);
-    EXPECT_TRUE(std::any_of(lines.begin(), lines.end(),
-                            [](const std::string& l) { return l.find("against the background image bg.png") != std::string::npos; }));
+    EXPECT_TRUE(std::any_of(lines.begin(), lines.end(), [](const std::string& l) {
+      return l.find("against the background image bg.png") != std::string::npos;
+    }));
   }
 
   // Written, it loads back with its images; a second write does not replace it.
@@ -268,11 +276,13 @@ TEST(DatasetRetrackTest, OutlinesComeFromFramesSpreadOverALongSequence) {
   ASSERT_EQ(static_cast<int>(spread.size()), kMaxSilhouetteFrames);
   EXPECT_EQ(spread.front(), 0);
   EXPECT_EQ(spread.back(), 4999);
-  for (size_t i = 1; i < spread.size(); ++i) EXPECT_NEAR(spread[i] - spread[i - 1], 4999.0 / (kMaxSilhouetteFrames - 1), 1.0);
+  for (size_t i = 1; i < spread.size(); ++i)
+    EXPECT_NEAR(spread[i] - spread[i - 1], 4999.0 / (kMaxSilhouetteFrames - 1), 1.0);
 }
 
 TEST(DatasetRetrackTest, LandmarkSourcesParse) {
-  for (RetrackLandmarks l : {RetrackLandmarks::kDetect, RetrackLandmarks::kDatasetDlib, RetrackLandmarks::kDatasetModel})
+  for (RetrackLandmarks l :
+       {RetrackLandmarks::kDetect, RetrackLandmarks::kDatasetDlib, RetrackLandmarks::kDatasetModel})
     EXPECT_EQ(ParseRetrackLandmarks(RetrackLandmarksName(l)), l);
   EXPECT_FALSE(ParseRetrackLandmarks("mediapipe").has_value());
 }

@@ -5,13 +5,15 @@ namespace icef::track {
 namespace {
 
 // `icef track --calibrate-detector`:
-// 12 identities, 417 views; per landmark the offset's coefficients of ViewFeatures (head units), then the reprojection residual in pixels at 360x480
+// 12 identities, 417 views; per landmark the offset's coefficients of ViewFeatures (head units), then the
+// reprojection residual in pixels at 360x480
 const std::array<std::array<Vec3f, 4>, 68> kCoefficients = {{
 #include "icef/track/detector_landmarks.inc"
 }};
 
 // `icef track --calibrate-detector --detector mesh`:
-// 12 identities, 417 views; per landmark the offset's coefficients of ViewFeatures (head units), then the reprojection residual in pixels at 360x480
+// 12 identities, 417 views; per landmark the offset's coefficients of ViewFeatures (head units), then the
+// reprojection residual in pixels at 360x480
 const std::array<std::array<Vec3f, 4>, 68> kMeshCoefficients = {{
 #include "icef/track/mesh_landmarks.inc"
 }};

@@ -1,10 +1,10 @@
 // dlib's landmark convention on the face model. The face model's 68 landmarks are where its own
 // design puts them (the synthetic ground truth uses them); dlib's detector, run on renders of the
 // same head (DetectFace averaged, as the tracker runs it), puts some elsewhere: its jaw line
-// follows the silhouette up to the temples, its brows sit lower, its mouth corners wider. The tracker fits the model to dlib's landmarks, so it moves
-// each landmark's canonical point by the offset measured here before the expression warp
-// (face::FaceModel::Landmarks with offsets). The offset depends on the view (dlib's jaw line is
-// the silhouette, its eye corners and nose drift as the head turns): it is linear in
+// follows the silhouette up to the temples, its brows sit lower, its mouth corners wider. The tracker fits
+// the model to dlib's landmarks, so it moves each landmark's canonical point by the offset measured here
+// before the expression warp (face::FaceModel::Landmarks with offsets). The offset depends on the view
+// (dlib's jaw line is the silhouette, its eye corners and nose drift as the head turns): it is linear in
 // ViewFeatures of the direction from the head towards the camera. The table comes from
 // `icef track --calibrate-detector` (app/detector_calibration.h: validation identities 101-112,
 // 35 views each, neutral).
@@ -31,6 +31,5 @@ const char* LandmarkDetectorName(LandmarkDetector detector);  // "dlib", "mesh"
 // mesh_landmarks.inc, measured the same way (`icef track --calibrate-detector --detector mesh`).
 std::array<Vec3f, 68> DetectorLandmarkOffsets(LandmarkDetector detector, const Vec3f& camera_head);
 std::array<Vec3f, 68> DlibLandmarkOffsets(const Vec3f& camera_head);  // DetectorLandmarkOffsets(kDlib, ...)
-
 
 }  // namespace icef::track

@@ -15,7 +15,8 @@ Status HeadMaskOptions::Validate() const {
   if (!(sure_inside >= 0 && sure_inside < 0.5)) return Status::Error("sure_inside must be in [0, 0.5)");
   if (!(band > 0 && band < 1)) return Status::Error("band must be in (0, 1)");
   if (iterations < 1) return Status::Error("iterations must be >= 1");
-  if (!(person_background >= 0 && person_background < 1)) return Status::Error("person_background must be in [0, 1)");
+  if (!(person_background >= 0 && person_background < 1))
+    return Status::Error("person_background must be in [0, 1)");
   if (!(person_foreground > person_background && person_foreground <= 1))
     return Status::Error("person_foreground must be in (person_background, 1]");
   return Status::Ok();
@@ -40,7 +41,8 @@ Image HeadSilhouette(const face::FaceModel& model, const std::vector<float>& exp
       for (int x = 0; x < camera.width(); ++x) {
         const Ray ray = camera.PixelRay(x, static_cast<int>(y));
         const auto hit = box.Intersect(ray);
-        if (hit && model.Trace(ray, hit->t_near, hit->t_far, state) >= 0) out.At(x, static_cast<int>(y), 0) = 1.f;
+        if (hit && model.Trace(ray, hit->t_near, hit->t_far, state) >= 0)
+          out.At(x, static_cast<int>(y), 0) = 1.f;
       }
   });
   return out;
@@ -53,7 +55,8 @@ Image HeadMask(const Image& image, const Image& silhouette, const Image& outside
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x)
       for (int c = 0; c < 3; ++c)
-        rgb.at<cv::Vec3b>(y, x)[c] = static_cast<uint8_t>(std::lround(std::clamp(image.Rgb(x, y)[c], 0.f, 1.f) * 255));
+        rgb.at<cv::Vec3b>(y, x)[c] =
+            static_cast<uint8_t>(std::lround(std::clamp(image.Rgb(x, y)[c], 0.f, 1.f) * 255));
   cv::Mat inside(h, w, CV_8U), not_inside(h, w, CV_8U);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
@@ -79,7 +82,8 @@ Image HeadMask(const Image& image, const Image& silhouette, const Image& outside
       } else if (dist_out.at<float>(y, x) < options.band * w) {
         // Near the head: hair where the person segmentation sees the person (hair as dark as the
         // background behind it is otherwise cut off flat along the skull), else probably background.
-        label = !person.empty() && person.At(x, y, 0) > options.person_foreground ? cv::GC_PR_FGD : cv::GC_PR_BGD;
+        label =
+            !person.empty() && person.At(x, y, 0) > options.person_foreground ? cv::GC_PR_FGD : cv::GC_PR_BGD;
       } else {
         label = cv::GC_BGD;
       }
@@ -88,9 +92,9 @@ Image HeadMask(const Image& image, const Image& silhouette, const Image& outside
       mask.at<uint8_t>(y, x) = label;
     }
   Image out(w, h, 1);
-  if (fg == 0) return out;                  // nothing of the head in view
-  if (bg > 0) {                             // GrabCut needs both sides
-    cv::theRNG().state = 0x1cef;            // its k-means starts from OpenCV's thread RNG: pin it
+  if (fg == 0) return out;        // nothing of the head in view
+  if (bg > 0) {                   // GrabCut needs both sides
+    cv::theRNG().state = 0x1cef;  // its k-means starts from OpenCV's thread RNG: pin it
     cv::Mat bgd_model, fgd_model;
     cv::grabCut(rgb, mask, cv::Rect(), bgd_model, fgd_model, options.iterations, cv::GC_INIT_WITH_MASK);
   }
@@ -138,7 +142,8 @@ Image BackgroundDifferenceMask(const Image& frame, const Image& background, doub
   cv::Mat fore(h, w, CV_8U);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x)
-      fore.at<uint8_t>(y, x) = (frame.Rgb(x, y) - background.Rgb(x, y)).cwiseAbs().maxCoeff() > threshold ? 255 : 0;
+      fore.at<uint8_t>(y, x) =
+          (frame.Rgb(x, y) - background.Rgb(x, y)).cwiseAbs().maxCoeff() > threshold ? 255 : 0;
   // Lone pixels of sensor noise and compression out, thin gaps closed.
   const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(3, 3));
   cv::morphologyEx(fore, fore, cv::MORPH_OPEN, kernel);

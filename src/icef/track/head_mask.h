@@ -22,11 +22,14 @@
 namespace icef::track {
 
 struct HeadMaskOptions {
-  double sure_inside = 0.04;   // silhouette pixels deeper than this (fraction of the image width) are sure foreground
-  double band = 0.12;          // outside pixels within this distance of the silhouette are probable background
-  int iterations = 5;          // GrabCut iterations
-  double person_background = 0.05;  // person probability below which a pixel outside the sure core is sure background
-  double person_foreground = 0.5;   // person probability above which a pixel in the band is probable foreground (hair)
+  double sure_inside =
+      0.04;            // silhouette pixels deeper than this (fraction of the image width) are sure foreground
+  double band = 0.12;  // outside pixels within this distance of the silhouette are probable background
+  int iterations = 5;  // GrabCut iterations
+  double person_background =
+      0.05;  // person probability below which a pixel outside the sure core is sure background
+  double person_foreground =
+      0.5;  // person probability above which a pixel in the band is probable foreground (hair)
 
   Status Validate() const;
   std::string ToString() const;
@@ -39,8 +42,8 @@ Image HeadSilhouette(const face::FaceModel& model, const std::vector<float>& exp
 // The mask (1-channel, 0 or 1) of `image` (RGB or RGBA; alpha ignored). `outside` (1-channel, may be
 // empty) marks pixels that lie outside the original photo; `person` (1-channel, may be empty) is a
 // person segmentation's probability per pixel. Deterministic.
-Image HeadMask(const Image& image, const Image& silhouette, const Image& outside, const Image& person = Image(),
-               const HeadMaskOptions& options = {});
+Image HeadMask(const Image& image, const Image& silhouette, const Image& outside,
+               const Image& person = Image(), const HeadMaskOptions& options = {});
 
 // The mask (1-channel, 0 or 1) of the person alone: where `person` (a person segmentation's
 // probability) is above `threshold` and the pixel lies inside the photo (`outside`, may be empty),

@@ -21,7 +21,8 @@ cv::Mat AsMat(const Image& image) {
 }  // namespace
 
 std::string CropBox::ToString() const {
-  return "CropBox(x0=" + std::to_string(x0) + ", y0=" + std::to_string(y0) + ", size=" + std::to_string(size) + ")";
+  return "CropBox(x0=" + std::to_string(x0) + ", y0=" + std::to_string(y0) +
+         ", size=" + std::to_string(size) + ")";
 }
 
 CropBox HeadCropBox(const Camera& camera, double margin) {
@@ -51,9 +52,11 @@ Image CropImage(const Image& photo, const CropBox& box, int resolution, Image* o
   const int side = std::max(1, static_cast<int>(std::lround(box.size)));
   const double s = side / box.size;  // ~1: the crop at its own scale
   // OpenCV maps pixel indices (centres at integers): crop index j <- photo index (j + 0.5) / s + x0 - 0.5.
-  const cv::Mat affine = (cv::Mat_<double>(2, 3) << s, 0, -s * box.x0 + 0.5 * (s - 1), 0, s, -s * box.y0 + 0.5 * (s - 1));
+  const cv::Mat affine =
+      (cv::Mat_<double>(2, 3) << s, 0, -s * box.x0 + 0.5 * (s - 1), 0, s, -s * box.y0 + 0.5 * (s - 1));
   cv::Mat at_scale;
-  cv::warpAffine(AsMat(photo), at_scale, affine, cv::Size(side, side), cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+  cv::warpAffine(AsMat(photo), at_scale, affine, cv::Size(side, side), cv::INTER_LINEAR,
+                 cv::BORDER_REPLICATE);
   cv::Mat resized;
   cv::resize(at_scale, resized, cv::Size(resolution, resolution), 0, 0,
              resolution < side ? cv::INTER_AREA : cv::INTER_LINEAR);
@@ -74,7 +77,8 @@ Image CropImage(const Image& photo, const CropBox& box, int resolution, Image* o
 Image ResizeImage(const Image& image, int width, int height) {
   cv::Mat resized;
   const bool shrink = width < image.width || height < image.height;
-  cv::resize(AsMat(image), resized, cv::Size(width, height), 0, 0, shrink ? cv::INTER_AREA : cv::INTER_LINEAR);
+  cv::resize(AsMat(image), resized, cv::Size(width, height), 0, 0,
+             shrink ? cv::INTER_AREA : cv::INTER_LINEAR);
   Image out(width, height, image.channels);
   std::copy(resized.ptr<float>(), resized.ptr<float>() + out.pixels.size(), out.pixels.begin());
   return out;
@@ -95,7 +99,8 @@ std::vector<Vec2f> CropPoints(std::span<const Vec2f> points, const CropBox& box,
   const double scale = resolution / box.size;
   std::vector<Vec2f> out;
   for (const Vec2f& p : points)
-    out.push_back(Vec2f(static_cast<float>((p.x() - box.x0) * scale), static_cast<float>((p.y() - box.y0) * scale)));
+    out.push_back(
+        Vec2f(static_cast<float>((p.x() - box.x0) * scale), static_cast<float>((p.y() - box.y0) * scale)));
   return out;
 }
 
@@ -133,13 +138,27 @@ Image Oriented(const Image& stored, int orientation) {
     for (int x = 0; x < out.width; ++x) {
       int sx = x, sy = y;  // the stored pixel shown at (x, y)
       switch (orientation) {
-        case 2: sx = stored.width - 1 - x; break;
-        case 3: sx = stored.width - 1 - x, sy = stored.height - 1 - y; break;
-        case 4: sy = stored.height - 1 - y; break;
-        case 5: sx = y, sy = x; break;
-        case 6: sx = y, sy = stored.height - 1 - x; break;
-        case 7: sx = stored.width - 1 - y, sy = stored.height - 1 - x; break;
-        case 8: sx = stored.width - 1 - y, sy = x; break;
+        case 2:
+          sx = stored.width - 1 - x;
+          break;
+        case 3:
+          sx = stored.width - 1 - x, sy = stored.height - 1 - y;
+          break;
+        case 4:
+          sy = stored.height - 1 - y;
+          break;
+        case 5:
+          sx = y, sy = x;
+          break;
+        case 6:
+          sx = y, sy = stored.height - 1 - x;
+          break;
+        case 7:
+          sx = stored.width - 1 - y, sy = stored.height - 1 - x;
+          break;
+        case 8:
+          sx = stored.width - 1 - y, sy = x;
+          break;
       }
       for (int c = 0; c < stored.channels; ++c) out.At(x, y, c) = stored.At(sx, sy, c);
     }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <opencv2/imgproc.hpp>
 #include <optional>
 #include <sstream>
 #include <system_error>
@@ -14,8 +15,6 @@
 #include "icef/io/atomic_file.h"
 #include "icef/landmarks/face_mesh.h"
 #include "icef/track/dataset_retrack.h"
-
-#include <opencv2/imgproc.hpp>
 
 namespace icef::track {
 
@@ -70,12 +69,14 @@ Result<std::vector<Detected>> DetectAll(std::vector<TrackInput>& inputs, const F
         out[i].photo = Oriented(*image, ExifOrientation(inputs[i].source));
       }
       if (out[i].photo.HasAlpha()) out[i].photo = CompositeOver(out[i].photo, Vec3f::Ones());
-      out[i].detection = mesh ? DetectFaceWithMesh(local, *mesh, out[i].photo) : local.DetectFace(out[i].photo, /*averaged=*/true);
+      out[i].detection = mesh ? DetectFaceWithMesh(local, *mesh, out[i].photo)
+                              : local.DetectFace(out[i].photo, /*averaged=*/true);
     }
   });
   for (size_t i = 0; i < inputs.size(); ++i)
     if (!read_errors[i].ok())
-      return Status::Error(inputs[i].source.string() + ": cannot read the image: " + read_errors[i].message());
+      return Status::Error(inputs[i].source.string() +
+                           ": cannot read the image: " + read_errors[i].message());
   return out;
 }
 
@@ -90,7 +91,8 @@ Intrinsics PhotoIntrinsics(const fs::path& exif_path, const Image& photo, const 
   if (options.focal) {
     k.fl_x = *options.focal;
     *source = FocalSource::kFlag;
-  } else if (const auto exif = exif_path.empty() ? std::nullopt : ExifFocalPixels(exif_path, photo.width, photo.height)) {
+  } else if (const auto exif =
+                 exif_path.empty() ? std::nullopt : ExifFocalPixels(exif_path, photo.width, photo.height)) {
     k.fl_x = *exif;
     *source = FocalSource::kExif;
   } else {
@@ -116,7 +118,8 @@ HeadCrop CropHead(const face::FaceModel& model, const TrackedFrame& tracked, con
   const Camera photo_camera(photo.photo_intrinsics, Inverse(tracked.cam_from_head));
   c.box = HeadCropBox(photo_camera, options.crop_margin);
   c.rgb = CropImage(photo.photo, c.box, options.resolution, &c.outside);
-  c.camera = Camera(CropIntrinsics(photo.photo_intrinsics, c.box, options.resolution), Inverse(tracked.cam_from_head));
+  c.camera = Camera(CropIntrinsics(photo.photo_intrinsics, c.box, options.resolution),
+                    Inverse(tracked.cam_from_head));
   const Image silhouette = HeadSilhouette(model, tracked.expression, c.camera, executor);
   Image person;
   if (segmenter) {
@@ -133,8 +136,8 @@ HeadCrop CropHead(const face::FaceModel& model, const TrackedFrame& tracked, con
 // max_points edge points of the photo's mask (evenly spaced along it), in the photo's pixels; with
 // skin_only, those of them where skin lies just inside the edge (SkinEdges: the face's own outline,
 // not hair over the cheeks, a hat or a collar).
-std::vector<Vec2f> SilhouettePoints(const HeadCrop& c, const TrackedPhoto& photo, int resolution, int max_points,
-                                    bool skin_only) {
+std::vector<Vec2f> SilhouettePoints(const HeadCrop& c, const TrackedPhoto& photo, int resolution,
+                                    int max_points, bool skin_only) {
   std::vector<Vec2f> points = MaskEdgePoints(c.mask, c.outside, max_points);
   if (skin_only) {
     const std::vector<Vec2f> lm = CropPoints(photo.detection.landmarks, c.box, resolution);
@@ -152,7 +155,8 @@ std::vector<Vec2f> SilhouettePoints(const HeadCrop& c, const TrackedPhoto& photo
 
 // The dataset frame and image of one tracked photo.
 void BuildFrame(const face::FaceModel& model, const TrackedFrame& tracked, const TrackOptions& options,
-                const PersonSegmenter* segmenter, const Executor& executor, TrackedPhoto* photo, Frame* frame) {
+                const PersonSegmenter* segmenter, const Executor& executor, TrackedPhoto* photo,
+                Frame* frame) {
   const HeadCrop c = CropHead(model, tracked, *photo, options, segmenter, executor);
   photo->crop = c.box;
   photo->image = Image(options.resolution, options.resolution, 4);
@@ -169,7 +173,6 @@ void BuildFrame(const face::FaceModel& model, const TrackedFrame& tracked, const
   frame->landmarks_2d = CropPoints(photo->detection.landmarks, photo->crop, options.resolution);
   frame->landmarks_3d = std::vector<Vec3f>(tracked.landmarks_head.begin(), tracked.landmarks_head.end());
 }
-
 
 // Blinks: an eye-close weight above one half.
 bool IsBlink(const std::vector<float>& expression) {
@@ -251,9 +254,12 @@ double FaceSharpness(const Image& photo, std::span<const Vec2f> landmarks) {
 
 const char* FocalSourceName(FocalSource source) {
   switch (source) {
-    case FocalSource::kFlag: return "flag";
-    case FocalSource::kExif: return "exif";
-    case FocalSource::kDefault: return "default";
+    case FocalSource::kFlag:
+      return "flag";
+    case FocalSource::kExif:
+      return "exif";
+    case FocalSource::kDefault:
+      return "default";
   }
   return "?";
 }
@@ -261,7 +267,8 @@ const char* FocalSourceName(FocalSource source) {
 Status TrackOptions::Validate() const {
   if (resolution < 32 || resolution > 4096) return Status::Error("resolution must be in [32, 4096]");
   if (num_train < 0) return Status::Error("the number of training frames must be >= 0");
-  if (focal && !(*focal > 0 && std::isfinite(*focal))) return Status::Error("focal must be a finite number > 0");
+  if (focal && !(*focal > 0 && std::isfinite(*focal)))
+    return Status::Error("focal must be a finite number > 0");
   if (num_test < 0) return Status::Error("the number of test photos must be >= 0");
   if (!(crop_margin >= 1 && crop_margin <= 3)) return Status::Error("crop_margin must be in [1, 3]");
   if (silhouette_points < 0) return Status::Error("silhouette_points must be >= 0");
@@ -274,8 +281,8 @@ std::string TrackOptions::ToString() const {
   os << "TrackOptions(resolution=" << resolution << ", focal=" << (focal ? std::to_string(*focal) : "auto")
      << ", num_test=" << num_test << ", num_train=" << num_train << ", allow_blink=" << allow_blink
      << ", skip_bad=" << skip_bad << ", crop_margin=" << crop_margin
-     << ", silhouette_points=" << silhouette_points << ", segmentation=" << static_cast<int>(segmentation) << ", "
-     << fit.ToString() << ", " << mask.ToString() << ")";
+     << ", silhouette_points=" << silhouette_points << ", segmentation=" << static_cast<int>(segmentation)
+     << ", " << fit.ToString() << ", " << mask.ToString() << ")";
   return os.str();
 }
 
@@ -305,7 +312,8 @@ Result<TrackResult> TrackInputs(std::vector<TrackInput> inputs, const TrackOptio
   // Decoded frames carry no EXIF; photo files are read (and their EXIF) by name.
   std::vector<bool> decoded(inputs.size());
   for (size_t i = 0; i < inputs.size(); ++i) decoded[i] = inputs[i].image.has_value();
-  ICEF_ASSIGN_OR_RETURN(std::vector<Detected> detected, DetectAll(inputs, detector, mesh ? &*mesh : nullptr, executor));
+  ICEF_ASSIGN_OR_RETURN(std::vector<Detected> detected,
+                        DetectAll(inputs, detector, mesh ? &*mesh : nullptr, executor));
 
   TrackResult result;
   for (size_t i = 0; i < inputs.size(); ++i) {
@@ -313,7 +321,8 @@ Result<TrackResult> TrackInputs(std::vector<TrackInput> inputs, const TrackOptio
     if (!detected[i].detection.ok()) {
       why = "no face found";
     } else if (detected[i].detection->num_faces > 1) {
-      why = std::to_string(detected[i].detection->num_faces) + " faces found; icef track needs exactly one per photo";
+      why = std::to_string(detected[i].detection->num_faces) +
+            " faces found; icef track needs exactly one per photo";
     }
     if (!why.empty()) {
       const std::string label = inputs[i].Label();
@@ -329,19 +338,21 @@ Result<TrackResult> TrackInputs(std::vector<TrackInput> inputs, const TrackOptio
     p.photo = std::move(detected[i].photo);
     p.detection = std::move(*detected[i].detection);
     p.sharpness = FaceSharpness(p.photo, p.detection.landmarks);
-    p.photo_intrinsics = PhotoIntrinsics(decoded[i] ? fs::path() : inputs[i].source, p.photo, options, &p.focal_source);
+    p.photo_intrinsics =
+        PhotoIntrinsics(decoded[i] ? fs::path() : inputs[i].source, p.photo, options, &p.focal_source);
     result.photos.push_back(std::move(p));
   }
   const int kept = static_cast<int>(result.photos.size());
   if (options.num_train <= 0 && kept - options.num_test < 1)
-    return Status::Error("icef track: needs at least one training photo with a face besides the --test ones, got " +
-                         std::to_string(kept) + " photo" + (kept == 1 ? "" : "s") + " with a face and --test " +
-                         std::to_string(options.num_test));
+    return Status::Error(
+        "icef track: needs at least one training photo with a face besides the --test ones, got " +
+        std::to_string(kept) + " photo" + (kept == 1 ? "" : "s") + " with a face and --test " +
+        std::to_string(options.num_test));
   if (options.num_train > 0 && kept < options.num_train + std::max(options.num_test, 1))
     return Status::Error("icef track: --frames " + std::to_string(options.num_train) + " --test " +
                          std::to_string(options.num_test) + " needs at least " +
-                         std::to_string(options.num_train + std::max(options.num_test, 1)) + " frames with a face, got " +
-                         std::to_string(kept));
+                         std::to_string(options.num_train + std::max(options.num_test, 1)) +
+                         " frames with a face, got " + std::to_string(kept));
 
   std::vector<TrackFrame> frames;
   for (const TrackedPhoto& p : result.photos)
@@ -359,8 +370,8 @@ Result<TrackResult> TrackInputs(std::vector<TrackInput> inputs, const TrackOptio
       // which background GrabCut keeps rarely touches, and the fit proved sensitive to small changes
       // of that edge (docs/tracking.md); the segmentation cleans the dataset's alpha only.
       const HeadCrop c = CropHead(first, result.fit.frames[i], result.photos[i], options, nullptr, executor);
-      frames[i].silhouette = SilhouettePoints(c, result.photos[i], options.resolution, options.silhouette_points,
-                                              options.fit.silhouette_face_only);
+      frames[i].silhouette = SilhouettePoints(c, result.photos[i], options.resolution,
+                                              options.silhouette_points, options.fit.silhouette_face_only);
       frames[i].photo = &result.photos[i].photo;
     }
     ICEF_ASSIGN_OR_RETURN(result.fit, FitTrack(frames, options.fit));
@@ -385,7 +396,8 @@ Result<TrackResult> TrackInputs(std::vector<TrackInput> inputs, const TrackOptio
   d.aabb.max += Vec3f::Constant(0.1f);
   d.background = Vec3f::Ones();
   d.tier_thresholds = std::array<double, 2>{kNearThreshold, kFarThreshold};
-  d.train.resize(std::count_if(result.photos.begin(), result.photos.end(), [](const TrackedPhoto& p) { return !p.test; }));
+  d.train.resize(std::count_if(result.photos.begin(), result.photos.end(),
+                               [](const TrackedPhoto& p) { return !p.test; }));
   d.test.resize(used - d.train.size());
   for (int i = 0; i < used; ++i) {
     TrackedPhoto& p = result.photos[i];
@@ -394,9 +406,10 @@ Result<TrackResult> TrackInputs(std::vector<TrackInput> inputs, const TrackOptio
   }
   for (Frame& f : d.test) {
     f.delta = ExpressionDistance(f.expression, d.train);
-    f.tier = *f.delta == 0 ? Tier::kObserved : *f.delta <= kNearThreshold ? Tier::kNear
-                                              : *f.delta <= kFarThreshold ? Tier::kModerate
-                                                                          : Tier::kFar;
+    f.tier = *f.delta == 0                ? Tier::kObserved
+             : *f.delta <= kNearThreshold ? Tier::kNear
+             : *f.delta <= kFarThreshold  ? Tier::kModerate
+                                          : Tier::kFar;
   }
   return result;
 }
@@ -408,7 +421,8 @@ Json TrackReportJson(const TrackResult& result) {
     const TrackedFrame& f = result.fit.frames[i];
     const Frame& frame = (p.test ? result.dataset.test : result.dataset.train)[p.frame_index];
     Json expression = Json::object();
-    for (int e = 0; e < face::kNumExpressions; ++e) expression[face::kExpressionNames[e]] = JsonFloat(f.expression[e]);
+    for (int e = 0; e < face::kNumExpressions; ++e)
+      expression[face::kExpressionNames[e]] = JsonFloat(f.expression[e]);
     const Vec3d ypr = f.YawPitchRollDeg();
     const Vec3d t = f.cam_from_head.block<3, 1>(0, 3);
     photos.push_back(Json{{"photo", p.source.string()},
@@ -455,7 +469,8 @@ Status WriteTrackedDataset(const TrackResult& result, const fs::path& out_dir,
     for (const TrackedPhoto& p : result.photos)
       ICEF_RETURN_IF_ERROR(WritePng(tmp / (p.test ? d.test : d.train)[p.frame_index].file_path, p.image));
     ICEF_RETURN_IF_ERROR(SaveDataset(d));
-    ICEF_RETURN_IF_ERROR(WriteFileAtomic(tmp / "track" / "report.json", FormatJson(TrackReportJson(result)) + "\n"));
+    ICEF_RETURN_IF_ERROR(
+        WriteFileAtomic(tmp / "track" / "report.json", FormatJson(TrackReportJson(result)) + "\n"));
     for (const auto& [name, image] : extra) ICEF_RETURN_IF_ERROR(WritePng(tmp / name, image));
     return Status::Ok();
   });
@@ -470,7 +485,8 @@ Result<std::vector<fs::path>> ExpandPhotoArguments(const std::vector<fs::path>& 
       for (const auto& entry : fs::directory_iterator(a, ec)) {
         std::string ext = entry.path().extension().string();
         std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-        if (entry.is_regular_file() && (ext == ".png" || ext == ".jpg" || ext == ".jpeg")) files.push_back(entry.path());
+        if (entry.is_regular_file() && (ext == ".png" || ext == ".jpg" || ext == ".jpeg"))
+          files.push_back(entry.path());
       }
       if (ec) return Status::Error(a.string() + ": cannot list the directory: " + ec.message());
       std::sort(files.begin(), files.end());

@@ -31,18 +31,18 @@
 namespace icef::track {
 
 struct TrackOptions {
-  int resolution = 256;             // side of the square dataset images
-  std::optional<double> focal;      // focal length in pixels of the photos (else EXIF, else the default)
+  int resolution = 256;         // side of the square dataset images
+  std::optional<double> focal;  // focal length in pixels of the photos (else EXIF, else the default)
   // Without num_train: the last num_test photos become test frames. With num_train > 0: that many
   // training frames are chosen for coverage of head pose and expression (data/frame_coverage.h),
   // and num_test of the others (spread evenly in input order; 0 = all of them) are held out; the
   // rest are left out of the dataset.
   int num_test = 0;
   int num_train = 0;
-  bool allow_blink = false;         // with num_train: a frame with an eye closed may be a training frame
-  bool skip_bad = false;            // skip photos without exactly one face instead of stopping
-  double crop_margin = 1.15;        // crop side / the head box's projected extent
-  int silhouette_points = 200;      // refit with this many mask edge points per photo (0: landmarks only)
+  bool allow_blink = false;     // with num_train: a frame with an eye closed may be a training frame
+  bool skip_bad = false;        // skip photos without exactly one face instead of stopping
+  double crop_margin = 1.15;    // crop side / the head box's projected extent
+  int silhouette_points = 200;  // refit with this many mask edge points per photo (0: landmarks only)
   // The dataset's alpha: GrabCut alone, GrabCut with the person segmentation's confident background
   // as sure background (default), or the person segmentation alone (PersonMask: shoulders included).
   enum class Segmentation { kNone, kSelfie, kSelfieOnly };
@@ -73,14 +73,14 @@ struct TrackedPhoto {
   std::string name;              // TrackInput::Label()
   std::optional<double> time_s;  // a video frame's time
   double sharpness = 0;          // FaceSharpness of the photo
-  Image photo;                   // as read, turned upright by its EXIF orientation, alpha composited over white
-  FaceDetection detection;       // in the photo's coordinates
+  Image photo;              // as read, turned upright by its EXIF orientation, alpha composited over white
+  FaceDetection detection;  // in the photo's coordinates
   Intrinsics photo_intrinsics;
   FocalSource focal_source = FocalSource::kDefault;
   CropBox crop;
-  Image image;                   // the dataset image: RGBA crop, alpha = mask
+  Image image;  // the dataset image: RGBA crop, alpha = mask
   bool test = false;
-  int frame_index = 0;           // within its split
+  int frame_index = 0;  // within its split
 };
 
 struct TrackResult {
@@ -118,6 +118,7 @@ Status WriteTrackedDataset(const TrackResult& result, const std::filesystem::pat
 
 // The photo files of the arguments: files as given, directories expanded to their .png/.jpg/.jpeg
 // files (sorted by name). Errors name a path that does not exist.
-Result<std::vector<std::filesystem::path>> ExpandPhotoArguments(const std::vector<std::filesystem::path>& args);
+Result<std::vector<std::filesystem::path>> ExpandPhotoArguments(
+    const std::vector<std::filesystem::path>& args);
 
 }  // namespace icef::track

@@ -1,7 +1,6 @@
 #include "icef/track/photo_track.h"
 
 #include <gtest/gtest.h>
-
 #include <libexif/exif-data.h>
 #include <stb_image_write.h>
 
@@ -158,7 +157,8 @@ TEST_F(PhotoTrackTest, EitherDetectorTracks) {
       const Frame& f = r->dataset.train[r->photos[i].frame_index];
       const Mat3d d = f.camera.world_from_cam().block<3, 3>(0, 0).transpose() *
                       photos.truth[i].camera.world_from_cam().block<3, 3>(0, 0);
-      EXPECT_LT(Eigen::AngleAxisd(d).angle() * 180 / M_PI, 10.0) << LandmarkDetectorName(detector) << " photo " << i;
+      EXPECT_LT(Eigen::AngleAxisd(d).angle() * 180 / M_PI, 10.0)
+          << LandmarkDetectorName(detector) << " photo " << i;
       EXPECT_LT(r->fit.frames[i].rms_iod, 0.1) << LandmarkDetectorName(detector) << " photo " << i;
     }
     landmarks.push_back(r->photos[0].detection.landmarks);
@@ -169,7 +169,8 @@ TEST_F(PhotoTrackTest, EitherDetectorTracks) {
   double differ = 0;
   for (int i = 0; i < 68; ++i) differ = std::max(differ, double((landmarks[0][i] - landmarks[1][i]).norm()));
   EXPECT_GT(differ, 0.5);
-  for (int i : {36, 39, 42, 45}) EXPECT_LT((landmarks[0][i] - landmarks[1][i]).norm(), 8.0) << "landmark " << i;
+  for (int i : {36, 39, 42, 45})
+    EXPECT_LT((landmarks[0][i] - landmarks[1][i]).norm(), 8.0) << "landmark " << i;
   EXPECT_NE(DetectorLandmarkOffsets(LandmarkDetector::kMesh, Vec3f(0, 0, 3))[48],
             DetectorLandmarkOffsets(LandmarkDetector::kDlib, Vec3f(0, 0, 3))[48]);
 }
@@ -222,7 +223,8 @@ TEST_F(PhotoTrackTest, BadPhotosAreClearErrorsAndNothingIsWritten) {
 TEST(HeadMaskTest, EdgePointsLieBetweenInsideAndOutsidePixels) {
   Image mask(10, 8, 1), outside(10, 8, 1);
   for (int y = 2; y < 6; ++y)
-    for (int x = 3; x < 7; ++x) mask.At(x, y, 0) = 1.f;  // pixels [3, 7) x [2, 6): edges at x = 3, 7 and y = 2, 6
+    for (int x = 3; x < 7; ++x)
+      mask.At(x, y, 0) = 1.f;  // pixels [3, 7) x [2, 6): edges at x = 3, 7 and y = 2, 6
   std::vector<Vec2f> points = MaskEdgePoints(mask, Image(), 0);
   ASSERT_EQ(points.size(), 16u);
   for (const Vec2f& p : points) {
@@ -340,7 +342,8 @@ TEST(HeadMaskTest, PersonSegmentationBackgroundIsSureBackground) {
   const auto count = [&](const Image& mask, bool bar) {
     int n = 0;
     for (int y = 0; y < 64; ++y)
-      for (int x = 0; x < 64; ++x) n += mask.At(x, y, 0) > 0.5f && (bar ? in_bar(x, y) && !in_disk(x, y, 15.f) : in_disk(x, y, 14.f));
+      for (int x = 0; x < 64; ++x)
+        n += mask.At(x, y, 0) > 0.5f && (bar ? in_bar(x, y) && !in_disk(x, y, 15.f) : in_disk(x, y, 14.f));
     return n;
   };
   int disk = 0;
@@ -395,11 +398,11 @@ TEST(HeadMaskTest, BackgroundDifferenceMaskIsWhatStandsInFrontOfTheBackground) {
       inside += disk;
       wrong += (mask.At(x, y, 0) > 0.5f) != disk;
     }
-  EXPECT_LT(wrong, 0.05 * inside);           // the disk, with its hole filled
-  EXPECT_EQ(mask.At(32, 30, 0), 1.f);        // the hole
-  EXPECT_EQ(mask.At(5, 40, 0), 0.f);         // the lone pixel
-  EXPECT_EQ(mask.At(56, 5, 0), 0.f);         // the smaller blob: only the largest component stays
-  EXPECT_EQ(mask.At(32, 30 - 15, 0), 0.f);   // background outside the disk
+  EXPECT_LT(wrong, 0.05 * inside);          // the disk, with its hole filled
+  EXPECT_EQ(mask.At(32, 30, 0), 1.f);       // the hole
+  EXPECT_EQ(mask.At(5, 40, 0), 0.f);        // the lone pixel
+  EXPECT_EQ(mask.At(56, 5, 0), 0.f);        // the smaller blob: only the largest component stays
+  EXPECT_EQ(mask.At(32, 30 - 15, 0), 0.f);  // background outside the disk
   // Nothing in front: an empty mask.
   const Image none = BackgroundDifferenceMask(background, background);
   for (float v : none.pixels) EXPECT_EQ(v, 0.f);
@@ -428,7 +431,8 @@ TEST(PhotoCropTest, CropCarriesTheCameraAndThePoints) {
   const Vec2d dot = photo.Project(Vec3d(0.1, 0.1, 0))->uv;
   for (int y = -2; y <= 2; ++y)
     for (int x = -2; x <= 2; ++x)
-      for (int c = 0; c < 3; ++c) image.At(static_cast<int>(dot.x()) + x, static_cast<int>(dot.y()) + y, c) = 1.f;
+      for (int c = 0; c < 3; ++c)
+        image.At(static_cast<int>(dot.x()) + x, static_cast<int>(dot.y()) + y, c) = 1.f;
   Image outside;
   const Image cropped = CropImage(image, box, 200, &outside);
   const Vec2d where = crop.Project(Vec3d(0.1, 0.1, 0))->uv;
@@ -451,8 +455,11 @@ TEST(PhotoCropTest, ExifAndDefaultFocalLengths) {
 void WriteJpegWithExif(const fs::path& path, int width, int height, int mm, int orientation = 0) {
   std::string jpeg;
   std::vector<uint8_t> rgb(size_t(width) * height * 3, 128);
-  stbi_write_jpg_to_func([](void* ctx, void* data, int size) { static_cast<std::string*>(ctx)->append(static_cast<char*>(data), size); },
-                         &jpeg, width, height, 3, rgb.data(), 90);
+  stbi_write_jpg_to_func(
+      [](void* ctx, void* data, int size) {
+        static_cast<std::string*>(ctx)->append(static_cast<char*>(data), size);
+      },
+      &jpeg, width, height, 3, rgb.data(), 90);
   ExifData* exif = exif_data_new();
   exif_data_set_byte_order(exif, EXIF_BYTE_ORDER_INTEL);
   ExifEntry* entry = exif_entry_new();
@@ -525,7 +532,8 @@ TEST(PhotoTrackArgs, DirectoriesExpandToTheirPhotosAndMissingPathsAreErrors) {
   ASSERT_TRUE(files.ok());
   ASSERT_EQ(files->size(), 2u);
   EXPECT_EQ((*files)[0].filename(), "a.png");
-  EXPECT_NE(ExpandPhotoArguments({s.dir / "nope.jpg"}).status().message().find("no such file"), std::string::npos);
+  EXPECT_NE(ExpandPhotoArguments({s.dir / "nope.jpg"}).status().message().find("no such file"),
+            std::string::npos);
 }
 
 }  // namespace

@@ -1,9 +1,8 @@
 #include "icef/track/photometric.h"
 
-#include <opencv2/imgproc.hpp>
-
 #include <algorithm>
 #include <cmath>
+#include <opencv2/imgproc.hpp>
 #include <sstream>
 
 #include "icef/core/status.h"
@@ -13,7 +12,8 @@
 namespace icef::track {
 
 BlurredImage::BlurredImage(const Image& image, double sigma_px) : width_(image.width), height_(image.height) {
-  ICEF_CHECK(image.channels == 3 || image.channels == 4, "BlurredImage: 3 or 4 channels, got " + std::to_string(image.channels));
+  ICEF_CHECK(image.channels == 3 || image.channels == 4,
+             "BlurredImage: 3 or 4 channels, got " + std::to_string(image.channels));
   ICEF_CHECK(sigma_px >= 0, "BlurredImage: sigma_px must be >= 0");
   cv::Mat rgb(height_, width_, CV_32FC3);
   for (int y = 0; y < height_; ++y)
@@ -21,7 +21,8 @@ BlurredImage::BlurredImage(const Image& image, double sigma_px) : width_(image.w
       for (int c = 0; c < 3; ++c) rgb.ptr<float>(y)[3 * x + c] = image.At(x, y, c);
   if (sigma_px > 0) cv::GaussianBlur(rgb, rgb, cv::Size(0, 0), sigma_px, sigma_px, cv::BORDER_REPLICATE);
   rgb_.assign(size_t(width_) * height_ * 3, 0.f);
-  for (int y = 0; y < height_; ++y) std::copy_n(rgb.ptr<float>(y), 3 * width_, rgb_.data() + size_t(y) * width_ * 3);
+  for (int y = 0; y < height_; ++y)
+    std::copy_n(rgb.ptr<float>(y), 3 * width_, rgb_.data() + size_t(y) * width_ * 3);
 }
 
 bool BlurredImage::Sample(double u, double v, Vec3d* rgb) const {
@@ -33,7 +34,8 @@ bool BlurredImage::Sample(double u, double v, Vec3d* rgb) const {
   const double fx = x - x0, fy = y - y0;
   const auto at = [&](int xi, int yi, int c) { return double(rgb_[(size_t(yi) * width_ + xi) * 3 + c]); };
   for (int c = 0; c < 3; ++c)
-    (*rgb)[c] = (1 - fy) * ((1 - fx) * at(x0, y0, c) + fx * at(x1, y0, c)) + fy * ((1 - fx) * at(x0, y1, c) + fx * at(x1, y1, c));
+    (*rgb)[c] = (1 - fy) * ((1 - fx) * at(x0, y0, c) + fx * at(x1, y0, c)) +
+                fy * ((1 - fx) * at(x0, y1, c) + fx * at(x1, y1, c));
   return true;
 }
 
@@ -51,12 +53,14 @@ bool InsidePolygon(const std::vector<Vec2f>& polygon, float x, float y) {
   for (size_t i = 0, j = polygon.size() - 1; i < polygon.size(); j = i++) {
     const Vec2f& a = polygon[i];
     const Vec2f& b = polygon[j];
-    if ((a.y() > y) != (b.y() > y) && x < (b.x() - a.x()) * (y - a.y()) / (b.y() - a.y()) + a.x()) inside = !inside;
+    if ((a.y() > y) != (b.y() > y) && x < (b.x() - a.x()) * (y - a.y()) / (b.y() - a.y()) + a.x())
+      inside = !inside;
   }
   return inside;
 }
 
-std::vector<Vec3f> SamplesAtSpacing(const face::FaceModel& model, const face::ExpressionState& neutral, float spacing) {
+std::vector<Vec3f> SamplesAtSpacing(const face::FaceModel& model, const face::ExpressionState& neutral,
+                                    float spacing) {
   const std::array<Vec3f, 68>& lm = model.NeutralLandmarks();
   // The face's outline seen from the front: the jaw line (0-16), then the brows back (26-17).
   std::vector<Vec2f> outline;

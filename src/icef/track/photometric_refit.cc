@@ -21,7 +21,8 @@ namespace {
 // point's residual at the same perturbed weights, so a few states serve them all.
 class StateCache {
  public:
-  StateCache(const face::FaceModel* model, double max_expression) : model_(model), max_expression_(max_expression) {}
+  StateCache(const face::FaceModel* model, double max_expression)
+      : model_(model), max_expression_(max_expression) {}
   const face::ExpressionState& For(const double* e) {
     const std::vector<float> beta = ClampedExpression(e, max_expression_);
     for (const auto& [key, state] : entries_)
@@ -55,8 +56,9 @@ std::optional<Vec2d> ProjectHeadPoint(const FrameProblem& fp, const Shared& shar
 
 // The colour a frame shows at a neutral-face point for (expression, pose): the point carried by the
 // face model's inverse warp, projected, sampled.
-bool PointColour(const FrameProblem& fp, const Shared& shared, const PhotoContext& ctx, const BlurredImage& image,
-                 const Vec3f& x_c, const double* expression, const double* pose, Vec3d* rgb) {
+bool PointColour(const FrameProblem& fp, const Shared& shared, const PhotoContext& ctx,
+                 const BlurredImage& image, const Vec3f& x_c, const double* expression, const double* pose,
+                 Vec3d* rgb) {
   const Vec3f x = ctx.model->InverseWarp(x_c, ctx.states->For(expression));
   const auto uv = ProjectHeadPoint(fp, shared, pose, x);
   return uv && image.Sample(uv->x(), uv->y(), rgb);
@@ -112,7 +114,8 @@ class ColourCost : public ceres::CostFunction {
         x[j] = x0;
         const double span = forward ? h : 2 * h;
         for (int r = 0; r < 3; ++r)
-          jacobians[block][r * sizes[block] + j] = seen && seen_a && seen_b ? (a[r] - b[r]) / span * inv : 0.0;
+          jacobians[block][r * sizes[block] + j] =
+              seen && seen_a && seen_b ? (a[r] - b[r]) / span * inv : 0.0;
       }
     }
     return true;
@@ -136,8 +139,8 @@ class ColourCost : public ceres::CostFunction {
 // The points a frame sees at (expression, pose): first along their camera ray (nothing of the face
 // before them), facing the camera, inside the image.
 std::vector<char> VisiblePoints(const FrameProblem& fp, const Shared& shared, const PhotoContext& ctx,
-                                const BlurredImage& image, const std::vector<Vec3f>& points, const double* expression,
-                                const double* pose) {
+                                const BlurredImage& image, const std::vector<Vec3f>& points,
+                                const double* expression, const double* pose) {
   const face::ExpressionState& state = ctx.states->For(expression);
   const face::ExpressionState copy = state;  // the cache may evict it below
   const Camera camera = FrameCamera(fp, shared, pose);
@@ -186,25 +189,28 @@ Status PhotometricRefit(std::vector<FrameProblem>& problems, Shared& shared, con
     std::vector<std::vector<char>> visible;
     for (int k = 0; k < n; ++k) {
       images.emplace_back(*problems[k].frame->photo, blur_iod * problems[k].iod_px);
-      visible.push_back(VisiblePoints(problems[k], shared, ctx, images[k], points, s->expression[k].data(), PoseOf(*s, shared, k)));
+      visible.push_back(VisiblePoints(problems[k], shared, ctx, images[k], points, s->expression[k].data(),
+                                      PoseOf(*s, shared, k)));
     }
     // Each frame's colours at its visible points and its exposure: a gain per channel that brings
     // the median of its colours at the points every frame sees to the mean of all frames' medians
     // (the same points in each: a turned head shows more of its lit or its shaded side; medians: a
     // hand, a shadow or an open mouth in one photo barely move them). No such point: gains of 1.
-    std::vector<std::vector<std::optional<Vec3d>>> sampled(n, std::vector<std::optional<Vec3d>>(points.size()));
+    std::vector<std::vector<std::optional<Vec3d>>> sampled(n,
+                                                           std::vector<std::optional<Vec3d>>(points.size()));
     for (int k = 0; k < n; ++k)
       for (size_t p = 0; p < points.size(); ++p) {
         Vec3d rgb;
-        if (visible[k][p] && PointColour(problems[k], shared, ctx, images[k], points[p], s->expression[k].data(),
-                                         PoseOf(*s, shared, k), &rgb))
+        if (visible[k][p] && PointColour(problems[k], shared, ctx, images[k], points[p],
+                                         s->expression[k].data(), PoseOf(*s, shared, k), &rgb))
           sampled[k][p] = rgb;
       }
     std::vector<Vec3d> median(n, Vec3d::Ones());
     for (int k = 0; k < n; ++k) {
       std::array<std::vector<double>, 3> values;
       for (size_t p = 0; p < points.size(); ++p) {
-        const bool common = std::all_of(sampled.begin(), sampled.end(), [p](const auto& f) { return f[p].has_value(); });
+        const bool common =
+            std::all_of(sampled.begin(), sampled.end(), [p](const auto& f) { return f[p].has_value(); });
         if (common)
           for (int c = 0; c < 3; ++c) values[c].push_back((*sampled[k][p])[c]);
       }
@@ -241,8 +247,7 @@ Status PhotometricRefit(std::vector<FrameProblem>& problems, Shared& shared, con
       for (size_t p = 0; p < points.size(); ++p) {
         if (!visible[k][p] || seen_by[p] < 2) continue;
         cp.AddResidualBlock(new ColourCost(&problems[k], &shared, &ctx, &images[k], &exposure[k], points[p]),
-                            new ceres::ScaledLoss(new ceres::CauchyLoss(1.0),
-                                                  weight, ceres::TAKE_OWNERSHIP),
+                            new ceres::ScaledLoss(new ceres::CauchyLoss(1.0), weight, ceres::TAKE_OWNERSHIP),
                             s->expression[k].data(), pose, colour[p].data());
       }
     }
@@ -256,7 +261,8 @@ Status PhotometricRefit(std::vector<FrameProblem>& problems, Shared& shared, con
       for (size_t p = 0; p < points.size(); ++p) {
         Vec3d rgb;
         if (!visible[k][p] || seen_by[p] < 2 ||
-            !PointColour(problems[k], shared, ctx, images[k], points[p], s->expression[k].data(), PoseOf(*s, shared, k), &rgb))
+            !PointColour(problems[k], shared, ctx, images[k], points[p], s->expression[k].data(),
+                         PoseOf(*s, shared, k), &rgb))
           continue;
         sum2 += (exposure[k].Apply(rgb) - Vec3d(colour[p][0], colour[p][1], colour[p][2])).squaredNorm() / 3;
         ++s->photometric_used[k];

@@ -60,7 +60,8 @@ TEST(CanonicalFaceSamplesTest, SkinOfTheFaceWithoutTheEyes) {
   float brow_top = lm[17].y();
   for (int i = 17; i <= 26; ++i) brow_top = std::max(brow_top, lm[i].y());
   Vec2f eye_centre[2] = {Vec2f::Zero(), Vec2f::Zero()};
-  for (int i = 0; i < 6; ++i) eye_centre[0] += lm[36 + i].head<2>() / 6.f, eye_centre[1] += lm[42 + i].head<2>() / 6.f;
+  for (int i = 0; i < 6; ++i)
+    eye_centre[0] += lm[36 + i].head<2>() / 6.f, eye_centre[1] += lm[42 + i].head<2>() / 6.f;
   const float eye_half_width = 0.5f * (lm[39] - lm[36]).norm();
   int mouth = 0;
   for (const Vec3f& p : points) {
@@ -72,7 +73,7 @@ TEST(CanonicalFaceSamplesTest, SkinOfTheFaceWithoutTheEyes) {
     for (const Vec2f& c : eye_centre) EXPECT_GT((p.head<2>() - c).norm(), eye_half_width);
     mouth += (p.head<2>() - 0.5f * (lm[48] + lm[54]).head<2>()).norm() < 0.5f * (lm[54] - lm[48]).norm();
   }
-  EXPECT_GT(mouth, 10);  // the lips and around them: where expressions show
+  EXPECT_GT(mouth, 10);                                 // the lips and around them: where expressions show
   EXPECT_EQ(CanonicalFaceSamples(model, 400), points);  // deterministic
   EXPECT_LT(CanonicalFaceSamples(model, 100).size(), 150u);
 }

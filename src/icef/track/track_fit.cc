@@ -39,13 +39,11 @@ Mat3d AngleAxisMatrix(const double* aa) {
   return m;
 }
 
-
 std::vector<float> ClampedExpression(const double* e, double max_expression) {
   std::vector<float> beta(kExpr);
   for (int i = 0; i < kExpr; ++i) beta[i] = static_cast<float>(std::clamp(e[i], 0.0, max_expression));
   return beta;
 }
-
 
 // The camera seeing the head frame (photos) or the dataset world (known cameras) for a pose.
 Camera FrameCamera(const FrameProblem& fp, const Shared& shared, const double* pose) {
@@ -91,8 +89,8 @@ std::vector<std::optional<Vec2d>> Project(const FrameProblem& fp, Shared& shared
 }
 
 // Per-landmark errors in IOD (unweighted).
-std::vector<double> Errors(const FrameProblem& fp, Shared& shared, const double* shape, const double* expression,
-                           const double* pose) {
+std::vector<double> Errors(const FrameProblem& fp, Shared& shared, const double* shape,
+                           const double* expression, const double* pose) {
   const auto proj = Project(fp, shared, shape, expression, pose);
   std::vector<double> e(kNumLandmarks);
   for (int i = 0; i < kNumLandmarks; ++i)
@@ -180,7 +178,8 @@ Ray HeadRay(const FrameProblem& fp, const Shared& shared, const double* pose, co
   const Ray world = camera.RayThrough(uv.x(), uv.y());
   if (!shared.known_cameras) return world;
   const face::Similarity sim = SharedSimilarity(shared, pose);
-  return Ray{sim.Apply(world.origin.cast<double>()).cast<float>(), (sim.rotation * world.direction.cast<double>()).cast<float>()};
+  return Ray{sim.Apply(world.origin.cast<double>()).cast<float>(),
+             (sim.rotation * world.direction.cast<double>()).cast<float>()};
 }
 
 // The ray parameter of the ray's closest approach to the head's surface: the smallest distance
@@ -222,8 +221,9 @@ class SilhouetteCost : public FrameCost {
 
   // The unweighted gaps (IOD) of every point, for the outlier pass and the report.
   // `contacts`, when given, gets each ray's closest approach (head frame).
-  static std::vector<double> Gaps(const FrameProblem& fp, Shared& shared, const double* shape, const double* expression,
-                                  const double* pose, std::vector<Vec3f>* contacts = nullptr) {
+  static std::vector<double> Gaps(const FrameProblem& fp, Shared& shared, const double* shape,
+                                  const double* expression, const double* pose,
+                                  std::vector<Vec3f>* contacts = nullptr) {
     const face::FaceModel& model = shared.cache.For(shape);
     const face::ExpressionState state = model.Prepare(ClampedExpression(expression, shared.max_expression));
     std::vector<double> gaps;
@@ -243,7 +243,8 @@ class SilhouetteCost : public FrameCost {
     const std::vector<Vec2f>& points = fp_->frame->silhouette;
     t_star_.assign(points.size(), 0.f);
     for (size_t i = 0; i < points.size(); ++i)
-      if (fp_->silhouette_weight[i] > 0) t_star_[i] = ClosestApproach(model, state, HeadRay(*fp_, *shared_, params[2], points[i]));
+      if (fp_->silhouette_weight[i] > 0)
+        t_star_[i] = ClosestApproach(model, state, HeadRay(*fp_, *shared_, params[2], points[i]));
   }
 
   void Residuals(double const* const* params, double* residuals) const override {
@@ -251,8 +252,10 @@ class SilhouetteCost : public FrameCost {
     const face::ExpressionState state = model.Prepare(ClampedExpression(params[1], shared_->max_expression));
     const std::vector<Vec2f>& points = fp_->frame->silhouette;
     // A frame's points in use weigh together as much as 68 landmarks.
-    const auto used = std::count_if(fp_->silhouette_weight.begin(), fp_->silhouette_weight.end(), [](double v) { return v > 0; });
-    const double w = std::sqrt(double(kNumLandmarks) / double(std::max<ptrdiff_t>(used, 1))) / shared_->silhouette_sigma;
+    const auto used = std::count_if(fp_->silhouette_weight.begin(), fp_->silhouette_weight.end(),
+                                    [](double v) { return v > 0; });
+    const double w =
+        std::sqrt(double(kNumLandmarks) / double(std::max<ptrdiff_t>(used, 1))) / shared_->silhouette_sigma;
     for (size_t i = 0; i < points.size(); ++i) {
       if (fp_->silhouette_weight[i] == 0) {
         residuals[i] = 0;
@@ -296,17 +299,20 @@ Status CheckFrames(std::span<const TrackFrame> frames) {
   for (size_t k = 0; k < frames.size(); ++k) {
     const TrackFrame& f = frames[k];
     const std::string where = "track fit: frame " + std::to_string(k) + ": ";
-    if (f.landmarks_2d.size() != kNumLandmarks) return Status::Error(where + "landmarks_2d must have 68 points");
+    if (f.landmarks_2d.size() != kNumLandmarks)
+      return Status::Error(where + "landmarks_2d must have 68 points");
     for (const Vec2f& p : f.landmarks_2d)
       if (!p.allFinite()) return Status::Error(where + "landmarks_2d has a non-finite value");
     if (!(Iod2d(f.landmarks_2d) > 1e-6)) return Status::Error(where + "landmarks_2d: the eyes coincide");
-    if (Status s = f.intrinsics.Validate(); !s.ok()) return Status::Error(where + "intrinsics: " + s.message());
+    if (Status s = f.intrinsics.Validate(); !s.ok())
+      return Status::Error(where + "intrinsics: " + s.message());
     for (const Vec2f& p : f.silhouette)
       if (!p.allFinite()) return Status::Error(where + "silhouette has a non-finite point");
     if (f.world_from_cam.has_value() != known)
       return Status::Error(where + "camera poses must be known for every frame or for none");
     if (f.world_from_cam) {
-      if (Status s = ValidateRigid(*f.world_from_cam); !s.ok()) return Status::Error(where + "camera pose: " + s.message());
+      if (Status s = ValidateRigid(*f.world_from_cam); !s.ok())
+        return Status::Error(where + "camera pose: " + s.message());
     }
   }
   return Status::Ok();
@@ -327,16 +333,17 @@ void InitialPhotoPose(const TrackFrame& f, const face::FaceModel& average, doubl
   for (int i = 0; i < 3; ++i) pose[i] = 0, pose[3 + i] = t[i];
 }
 
-
 // The landmark (and silhouette) residuals of the frames `which`, their priors and bounds.
 void AddLandmarkBlocks(ceres::Problem& cp, std::vector<FrameProblem>& problems, const std::vector<int>& which,
-                       Shared& shared, const TrackFitOptions& options, bool fit_shape, bool fit_pose, Solution* s) {
+                       Shared& shared, const TrackFitOptions& options, bool fit_shape, bool fit_pose,
+                       Solution* s) {
   for (int k : which) {
     double* pose = shared.known_cameras ? s->pose[0].data() : s->pose[k].data();
-    cp.AddResidualBlock(new LandmarkCost(&problems[k], &shared), nullptr, s->shape.data(), s->expression[k].data(), pose);
+    cp.AddResidualBlock(new LandmarkCost(&problems[k], &shared), nullptr, s->shape.data(),
+                        s->expression[k].data(), pose);
     if (shared.use_silhouettes && !problems[k].frame->silhouette.empty())
-      cp.AddResidualBlock(new SilhouetteCost(&problems[k], &shared), nullptr, s->shape.data(), s->expression[k].data(),
-                          pose);
+      cp.AddResidualBlock(new SilhouetteCost(&problems[k], &shared), nullptr, s->shape.data(),
+                          s->expression[k].data(), pose);
     cp.AddResidualBlock(new ceres::AutoDiffCostFunction<GaussianPrior<kExpr>, kExpr, kExpr>(
                             new GaussianPrior<kExpr>{0.0, 1.0 / options.expression_prior_sigma}),
                         nullptr, s->expression[k].data());
@@ -392,7 +399,8 @@ int DropOutliers(std::vector<FrameProblem>& problems, const std::vector<int>& wh
   std::vector<std::vector<double>> errors;
   std::vector<double> all;
   for (int k : which) {
-    errors.push_back(Errors(problems[k], shared, s.shape.data(), s.expression[k].data(), PoseOf(s, shared, k)));
+    errors.push_back(
+        Errors(problems[k], shared, s.shape.data(), s.expression[k].data(), PoseOf(s, shared, k)));
     all.insert(all.end(), errors.back().begin(), errors.back().end());
   }
   std::nth_element(all.begin(), all.begin() + all.size() / 2, all.end());
@@ -408,7 +416,8 @@ int DropOutliers(std::vector<FrameProblem>& problems, const std::vector<int>& wh
   std::vector<double> all_gaps;
   for (int k : which) {
     if (!shared.use_silhouettes) break;
-    gaps.push_back(SilhouetteCost::Gaps(problems[k], shared, s.shape.data(), s.expression[k].data(), PoseOf(s, shared, k)));
+    gaps.push_back(SilhouetteCost::Gaps(problems[k], shared, s.shape.data(), s.expression[k].data(),
+                                        PoseOf(s, shared, k)));
     for (double& g : gaps.back()) all_gaps.push_back(g = std::abs(g));
   }
   if (all_gaps.empty()) return removed;
@@ -426,16 +435,18 @@ int DropOutliers(std::vector<FrameProblem>& problems, const std::vector<int>& wh
 // of its surface (farther: hair, a hat, a collar, a hand) and, with silhouette_face_only, touching
 // it between the chin and the brows (the face's own outline: a real head's crown is hair and its
 // neck runs into clothes, neither of which the face model has).
-void SelectSilhouettePoints(std::vector<FrameProblem>& problems, Shared& shared, const TrackFitOptions& options,
-                            const Solution& s) {
+void SelectSilhouettePoints(std::vector<FrameProblem>& problems, Shared& shared,
+                            const TrackFitOptions& options, const Solution& s) {
   for (size_t k = 0; k < problems.size(); ++k) {
     FrameProblem& fp = problems[k];
     if (fp.frame->silhouette.empty()) continue;
     const double* pose = PoseOf(s, shared, static_cast<int>(k));
     std::vector<Vec3f> contacts;
-    const std::vector<double> gaps = SilhouetteCost::Gaps(fp, shared, s.shape.data(), s.expression[k].data(), pose, &contacts);
+    const std::vector<double> gaps =
+        SilhouetteCost::Gaps(fp, shared, s.shape.data(), s.expression[k].data(), pose, &contacts);
     const face::FaceModel& model = shared.cache.For(s.shape.data());
-    const std::array<Vec3f, 68> lm = model.Landmarks(model.Prepare(ClampedExpression(s.expression[k].data(), shared.max_expression)));
+    const std::array<Vec3f, 68> lm =
+        model.Landmarks(model.Prepare(ClampedExpression(s.expression[k].data(), shared.max_expression)));
     float brow_y = 0;
     for (int i = 17; i <= 26; ++i) brow_y += lm[i].y() / 10.f;
     const float chin_y = lm[8].y();
@@ -465,8 +476,8 @@ using namespace internal;  // NOLINT(google-build-using-namespace): this file's 
 std::string TrackedFrame::ToString() const {
   std::ostringstream os;
   const Vec3d ypr = YawPitchRollDeg();
-  os << "TrackedFrame(yaw=" << ypr.x() << ", pitch=" << ypr.y() << ", roll=" << ypr.z() << ", rms_iod=" << rms_iod
-     << ", landmarks_used=" << landmarks_used << ")";
+  os << "TrackedFrame(yaw=" << ypr.x() << ", pitch=" << ypr.y() << ", roll=" << ypr.z()
+     << ", rms_iod=" << rms_iod << ", landmarks_used=" << landmarks_used << ")";
   return os.str();
 }
 
@@ -489,9 +500,12 @@ Status TrackFitOptions::Validate() const {
     return Status::Error("expression_prior_sigma must be a finite number > 0");
   if (!(expression_prior_laplace >= 0) || !std::isfinite(expression_prior_laplace) ||
       !(photometric_expression_prior_laplace >= 0) || !std::isfinite(photometric_expression_prior_laplace))
-    return Status::Error("expression_prior_laplace and photometric_expression_prior_laplace must be finite numbers >= 0");
-  if (!(max_expression > 0) || !std::isfinite(max_expression)) return Status::Error("max_expression must be > 0");
-  if (!(jaw_line_weight >= 0) || jaw_line_weight > 1) return Status::Error("jaw_line_weight must be in [0, 1]");
+    return Status::Error(
+        "expression_prior_laplace and photometric_expression_prior_laplace must be finite numbers >= 0");
+  if (!(max_expression > 0) || !std::isfinite(max_expression))
+    return Status::Error("max_expression must be > 0");
+  if (!(jaw_line_weight >= 0) || jaw_line_weight > 1)
+    return Status::Error("jaw_line_weight must be in [0, 1]");
   if (max_iterations < 1) return Status::Error("max_iterations must be >= 1");
   if (!(outlier_iod > 0)) return Status::Error("outlier_iod must be > 0");
   if (!(landmark_sigma_iod > 0) || !std::isfinite(landmark_sigma_iod))
@@ -510,17 +524,20 @@ Status TrackFitOptions::Validate() const {
   if (Status s = style.Validate(); !s.ok()) return Status::Error("style: " + s.message());
   if (!(photometric_blur_coarse_iod >= 0) || !(photometric_blur_fine_iod >= 0) ||
       !std::isfinite(photometric_blur_coarse_iod) || !std::isfinite(photometric_blur_fine_iod))
-    return Status::Error("photometric_blur_coarse_iod and photometric_blur_fine_iod must be finite numbers >= 0");
+    return Status::Error(
+        "photometric_blur_coarse_iod and photometric_blur_fine_iod must be finite numbers >= 0");
   return Status::Ok();
 }
 
 std::string TrackFitOptions::ToString() const {
   std::ostringstream os;
-  os << "TrackFitOptions(shape_prior_sigma=" << shape_prior_sigma << ", shape_min=" << shape_min << ", shape_max=" << shape_max << ", expression_prior_sigma="
-     << expression_prior_sigma << ", max_expression=" << max_expression << ", jaw_line_weight=" << jaw_line_weight
+  os << "TrackFitOptions(shape_prior_sigma=" << shape_prior_sigma << ", shape_min=" << shape_min
+     << ", shape_max=" << shape_max << ", expression_prior_sigma=" << expression_prior_sigma
+     << ", max_expression=" << max_expression << ", jaw_line_weight=" << jaw_line_weight
      << ", max_iterations=" << max_iterations << ", outlier_iod=" << outlier_iod
-     << ", dlib_convention=" << dlib_convention << ", detector=" << LandmarkDetectorName(detector) << ", landmark_sigma_iod=" << landmark_sigma_iod
-     << ", silhouette_sigma_iod=" << silhouette_sigma_iod << ", silhouette_max_gap_iod=" << silhouette_max_gap_iod
+     << ", dlib_convention=" << dlib_convention << ", detector=" << LandmarkDetectorName(detector)
+     << ", landmark_sigma_iod=" << landmark_sigma_iod << ", silhouette_sigma_iod=" << silhouette_sigma_iod
+     << ", silhouette_max_gap_iod=" << silhouette_max_gap_iod
      << ", silhouette_face_only=" << silhouette_face_only << ", photometric_weight=" << photometric_weight
      << ", photometric_hold_similarity=" << photometric_hold_similarity
      << ", photometric_sigma=" << photometric_sigma
@@ -536,8 +553,8 @@ std::string TrackFitOptions::ToString() const {
 std::string TrackFit::BriefReport() const {
   std::ostringstream os;
   os.precision(3);
-  os << "track fit: " << frames.size() << " images, landmark RMS " << rms_iod << " IOD (max " << max_iod << "), "
-     << iterations << " iterations, photometric refit " << photometric;
+  os << "track fit: " << frames.size() << " images, landmark RMS " << rms_iod << " IOD (max " << max_iod
+     << "), " << iterations << " iterations, photometric refit " << photometric;
   if (silhouettes.rfind("not used", 0) == 0) os << ", silhouette refit " << silhouettes;
   return os.str();
 }
@@ -582,10 +599,12 @@ Result<TrackFit> FitTrack(std::span<const TrackFrame> frames, const TrackFitOpti
     fo.fit_shape = false;
     ICEF_ASSIGN_OR_RETURN(const face::FaceFit initial, face::FitFaceModel(fit_frames, fo));
     shared.base = initial.head_from_world;
-    s.pose = {{0, 0, 0, shared.base.translation.x(), shared.base.translation.y(), shared.base.translation.z(), 0}};
+    s.pose = {
+        {0, 0, 0, shared.base.translation.x(), shared.base.translation.y(), shared.base.translation.z(), 0}};
   } else {
     s.pose.assign(n, std::vector<double>(kPhotoPose));
-    for (int k = 0; k < n; ++k) InitialPhotoPose(frames[k], average, iod_head, &problems[k].base_rotation, s.pose[k].data());
+    for (int k = 0; k < n; ++k)
+      InitialPhotoPose(frames[k], average, iod_head, &problems[k].base_rotation, s.pose[k].data());
   }
 
   // The joint solve over (evenly spaced) frames, then every other frame on the shape found.
@@ -609,7 +628,8 @@ Result<TrackFit> FitTrack(std::span<const TrackFrame> frames, const TrackFitOpti
     shared.use_silhouettes = true;
     SelectSilhouettePoints(problems, shared, options, s);
     const bool any = std::any_of(problems.begin(), problems.end(), [](const FrameProblem& fp) {
-      return std::any_of(fp.silhouette_weight.begin(), fp.silhouette_weight.end(), [](double w) { return w > 0; });
+      return std::any_of(fp.silhouette_weight.begin(), fp.silhouette_weight.end(),
+                         [](double w) { return w > 0; });
     });
     if (any) {
       // The silhouettes can pull the fit into a degenerate head (a shape scale on its bound, the
@@ -628,14 +648,17 @@ Result<TrackFit> FitTrack(std::span<const TrackFrame> frames, const TrackFitOpti
         s.iterations = iterations;
         s.silhouette_note = why.str();
         shared.use_silhouettes = false;
-        for (FrameProblem& fp : problems) std::fill(fp.silhouette_weight.begin(), fp.silhouette_weight.end(), 0.0);
+        for (FrameProblem& fp : problems)
+          std::fill(fp.silhouette_weight.begin(), fp.silhouette_weight.end(), 0.0);
         break;
       }
     }
   }
   // Then the images, when every frame has one and there are two to compare.
-  const bool photos = std::all_of(frames.begin(), frames.end(), [](const TrackFrame& f) { return f.photo != nullptr; });
-  if (options.photometric_weight > 0 && photos && n >= 2) ICEF_RETURN_IF_ERROR(PhotometricRefit(problems, shared, options, &s));
+  const bool photos =
+      std::all_of(frames.begin(), frames.end(), [](const TrackFrame& f) { return f.photo != nullptr; });
+  if (options.photometric_weight > 0 && photos && n >= 2)
+    ICEF_RETURN_IF_ERROR(PhotometricRefit(problems, shared, options, &s));
 
   TrackFit fit;
   fit.iterations = s.iterations;
@@ -653,7 +676,8 @@ Result<TrackFit> FitTrack(std::span<const TrackFrame> frames, const TrackFitOpti
     TrackedFrame tf;
     const double* pose = PoseOf(s, shared, k);
     tf.expression = ClampedExpression(s.expression[k].data(), options.max_expression);
-    const auto proj = Project(problems[k], shared, s.shape.data(), s.expression[k].data(), pose, &tf.landmarks_head);
+    const auto proj =
+        Project(problems[k], shared, s.shape.data(), s.expression[k].data(), pose, &tf.landmarks_head);
     const Camera camera = FrameCamera(problems[k], shared, pose);
     tf.cam_from_head = camera.cam_from_world();
     if (fit.head_from_world) {  // cam_from_world * world_from_head
@@ -671,7 +695,8 @@ Result<TrackFit> FitTrack(std::span<const TrackFrame> frames, const TrackFitOpti
       if (problems[k].weight[i] > 0) frame_sum2 += e[i] * e[i], ++tf.landmarks_used;
     }
     tf.rms_iod = std::sqrt(frame_sum2 / std::max(tf.landmarks_used, 1));
-    const std::vector<double> gaps = SilhouetteCost::Gaps(problems[k], shared, s.shape.data(), s.expression[k].data(), pose);
+    const std::vector<double> gaps =
+        SilhouetteCost::Gaps(problems[k], shared, s.shape.data(), s.expression[k].data(), pose);
     double gap_sum2 = 0;
     for (size_t i = 0; i < gaps.size(); ++i)
       if (problems[k].silhouette_weight[i] > 0) {
@@ -679,7 +704,8 @@ Result<TrackFit> FitTrack(std::span<const TrackFrame> frames, const TrackFitOpti
         tf.silhouette_points.push_back(frames[k].silhouette[i]);
       }
     tf.silhouette_rms_iod = std::sqrt(gap_sum2 / std::max(tf.silhouette_used, 1));
-    if (!s.photometric_rms.empty()) tf.photometric_rms = s.photometric_rms[k], tf.photometric_used = s.photometric_used[k];
+    if (!s.photometric_rms.empty())
+      tf.photometric_rms = s.photometric_rms[k], tf.photometric_used = s.photometric_used[k];
     sum2 += frame_sum2;
     used_all += tf.landmarks_used;
     fit.max_iod = std::max(fit.max_iod, tf.max_iod);

@@ -22,14 +22,14 @@
 #include "icef/face/shape_params.h"
 #include "icef/io/image.h"
 #include "icef/math/camera.h"
-#include "icef/track/detector_landmarks.h"
 #include "icef/math/types.h"
+#include "icef/track/detector_landmarks.h"
 
 namespace icef::track {
 
 // One image: its 68 detected landmarks and its camera (intrinsics; the pose only when known).
 struct TrackFrame {
-  std::vector<Vec2f> landmarks_2d;      // [68] pixels
+  std::vector<Vec2f> landmarks_2d;  // [68] pixels
   Intrinsics intrinsics;
   std::optional<Mat4d> world_from_cam;  // known camera pose (all frames or none)
   // Optional: points on the edge of the head's foreground mask (pixels, e.g. MaskEdgePoints of a
@@ -51,7 +51,7 @@ struct TrackFitOptions {
   // shape prior itself: on real photos 0.1 left the fitted head visibly off the face (landmark RMS
   // 0.06-0.10 IOD on the astronaut and Grace Hopper, against 0.035-0.042 at 0.05).
   double landmark_sigma_iod = 0.05;
-  double shape_prior_sigma = 0.1;       // std of each shape scale around 1
+  double shape_prior_sigma = 0.1;  // std of each shape scale around 1
   // Bounds of every shape scale (they keep the head buildable). A silhouette refit that ends with
   // one on a bound has degenerated (no head seen so far lies beyond 0.65-1.35): the landmarks' fit
   // is kept (TrackFit::silhouettes).
@@ -61,12 +61,14 @@ struct TrackFitOptions {
   // A Laplace (L1) prior on the weights besides the Gaussian one, cost sum(weights) / this scale
   // (0: none): a photo shows few expressions at once, and this prior leaves the others at exactly 0.
   double expression_prior_laplace = 0;
-  double max_expression = 1.5;          // upper bound of the weights (lower bound 0)
-  double jaw_line_weight = 0.5;         // weight of landmarks 0-16: the detector follows the silhouette there
-  int max_iterations = 80;              // Levenberg-Marquardt iterations per pass
-  double outlier_iod = 0.1;             // second pass: drop landmarks farther than this (IOD) and 3x the median
-  bool dlib_convention = true;          // the landmarks are a detector's: fit the model's landmarks moved by its offsets
-  LandmarkDetector detector = LandmarkDetector::kMesh;  // whose (DetectorLandmarkOffsets), with dlib_convention
+  double max_expression = 1.5;   // upper bound of the weights (lower bound 0)
+  double jaw_line_weight = 0.5;  // weight of landmarks 0-16: the detector follows the silhouette there
+  int max_iterations = 80;       // Levenberg-Marquardt iterations per pass
+  double outlier_iod = 0.1;      // second pass: drop landmarks farther than this (IOD) and 3x the median
+  bool dlib_convention =
+      true;  // the landmarks are a detector's: fit the model's landmarks moved by its offsets
+  LandmarkDetector detector =
+      LandmarkDetector::kMesh;  // whose (DetectorLandmarkOffsets), with dlib_convention
   // Silhouette points (TrackFrame::silhouette): their noise (IOD). A frame's points weigh together
   // as much as 68 landmarks at this noise would, however many there are.
   double silhouette_sigma_iod = 0.03;
@@ -78,13 +80,14 @@ struct TrackFitOptions {
   // by the fitted warp and pose must find the same colour there. A frame's colour residuals weigh
   // together this many times as much as its 68 landmarks (0: no refit).
   double photometric_weight = 16;
-  double photometric_sigma = 0.05;     // colour noise (colours in [0, 1]); also where the Cauchy loss discounts a point
+  double photometric_sigma =
+      0.05;  // colour noise (colours in [0, 1]); also where the Cauchy loss discounts a point
   // Known cameras: the refit keeps the shared similarity as the landmark and outline fit left it and
   // moves the expressions only (with outlines the similarity is placed; colours then pull it).
   bool photometric_hold_similarity = false;
-  double photometric_expression_prior_sigma = 0.2;  // the refit's expression_prior_sigma
+  double photometric_expression_prior_sigma = 0.2;    // the refit's expression_prior_sigma
   double photometric_expression_prior_laplace = 0.3;  // the refit's expression_prior_laplace
-  int photometric_points = 400;        // points on the neutral face (track/photometric.h)
+  int photometric_points = 400;                       // points on the neutral face (track/photometric.h)
   // The images are blurred by a Gaussian of this standard deviation (IOD), coarse then fine: each
   // blur is one Levenberg-Marquardt solve started from the last.
   double photometric_blur_coarse_iod = 0.1;
@@ -108,15 +111,15 @@ struct TrackedFrame {
   // The fitted model's own landmarks at that expression (head frame; the face model's convention,
   // which face/face_fit.h expects, whatever convention the fit used).
   std::array<Vec3f, 68> landmarks_head{};
-  std::vector<Vec2f> projected;             // [68] the fitted landmarks (the fit's convention) in the image
-  double rms_iod = 0;                       // landmark residual of this frame (inliers)
-  double max_iod = 0;                       // its largest landmark residual (all landmarks)
-  int landmarks_used = 0;                   // inliers
-  double photometric_rms = 0;               // colour residual of this frame's visible face points (0: no refit)
-  int photometric_used = 0;                 // those points
-  double silhouette_rms_iod = 0;            // silhouette gap of the inlier silhouette points (0: none given)
-  int silhouette_used = 0;                  // inlier silhouette points
-  std::vector<Vec2f> silhouette_points;     // those points (pixels), for overlays
+  std::vector<Vec2f> projected;          // [68] the fitted landmarks (the fit's convention) in the image
+  double rms_iod = 0;                    // landmark residual of this frame (inliers)
+  double max_iod = 0;                    // its largest landmark residual (all landmarks)
+  int landmarks_used = 0;                // inliers
+  double photometric_rms = 0;            // colour residual of this frame's visible face points (0: no refit)
+  int photometric_used = 0;              // those points
+  double silhouette_rms_iod = 0;         // silhouette gap of the inlier silhouette points (0: none given)
+  int silhouette_used = 0;               // inlier silhouette points
+  std::vector<Vec2f> silhouette_points;  // those points (pixels), for overlays
   std::string ToString() const;
   // The head's rotation relative to the camera, degrees: yaw (positive turns the face toward the
   // subject's left, the image's right), pitch (positive lifts the chin), roll (positive turns the

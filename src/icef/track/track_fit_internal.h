@@ -25,8 +25,10 @@ namespace icef::track::internal {
 inline constexpr int kNumLandmarks = 68;
 inline constexpr int kExpr = face::kNumExpressions;
 inline constexpr int kShape = face::ShapeParams::kCount;
-inline constexpr int kPhotoPose = 6;   // angle-axis on top of the frame's initial rotation [3], translation [3]
-inline constexpr int kSharedPose = 7;  // angle-axis on top of the initial rotation [3], translation [3], log scale [1]
+inline constexpr int kPhotoPose =
+    6;  // angle-axis on top of the frame's initial rotation [3], translation [3]
+inline constexpr int kSharedPose =
+    7;  // angle-axis on top of the initial rotation [3], translation [3], log scale [1]
 
 // Face models by shape: Ceres perturbs the shape block the same way for every frame, so a small
 // cache of recent shapes saves rebuilding the head (its landmarks come from marching its SDF).
@@ -68,10 +70,10 @@ struct Shared {
   bool known_cameras = false;
   bool dlib_convention = true;  // fit the model's landmarks moved by DetectorLandmarkOffsets(detector)
   LandmarkDetector detector = LandmarkDetector::kDlib;
-  double landmark_sigma = 0.06;  // TrackFitOptions::landmark_sigma_iod
+  double landmark_sigma = 0.06;    // TrackFitOptions::landmark_sigma_iod
   double silhouette_sigma = 0.03;  // TrackFitOptions::silhouette_sigma_iod
-  double iod_head = 1;  // the average head's inter-ocular distance (head units)
-  bool use_silhouettes = false;  // add the frames' silhouette residuals (the second stage)
+  double iod_head = 1;             // the average head's inter-ocular distance (head units)
+  bool use_silhouettes = false;    // add the frames' silhouette residuals (the second stage)
 };
 
 struct Solution {
@@ -95,7 +97,8 @@ face::Similarity SharedSimilarity(const Shared& shared, const double* pose);
 const double* PoseOf(const Solution& s, const Shared& shared, int k);
 // The landmark (and silhouette) residuals of the frames `which`, their priors and bounds.
 void AddLandmarkBlocks(ceres::Problem& cp, std::vector<FrameProblem>& problems, const std::vector<int>& which,
-                       Shared& shared, const TrackFitOptions& options, bool fit_shape, bool fit_pose, Solution* s);
+                       Shared& shared, const TrackFitOptions& options, bool fit_shape, bool fit_pose,
+                       Solution* s);
 // One Levenberg-Marquardt solve of the problem (single-threaded: deterministic).
 Status RunSolver(ceres::Problem& cp, const TrackFitOptions& options, Solution* s);
 

@@ -57,10 +57,12 @@ Truth MakePhotos(const face::FaceModel& head, int n, double noise_px, uint64_t s
     const double yaw = rng.Uniform(-30, 30) * M_PI / 180, pitch = rng.Uniform(-12, 12) * M_PI / 180,
                  roll = rng.Uniform(-8, 8) * M_PI / 180;
     Mat4d cam_from_head = Mat4d::Identity();
-    cam_from_head.block<3, 3>(0, 0) = (Eigen::AngleAxisd(roll, Vec3d::UnitZ()) * Eigen::AngleAxisd(pitch, Vec3d::UnitX()) *
-                                       Eigen::AngleAxisd(yaw, Vec3d::UnitY()))
-                                          .toRotationMatrix();
-    cam_from_head.block<3, 1>(0, 3) = Vec3d(rng.Uniform(-0.1, 0.1), rng.Uniform(-0.1, 0.1), -rng.Uniform(2.6, 3.4));
+    cam_from_head.block<3, 3>(0, 0) =
+        (Eigen::AngleAxisd(roll, Vec3d::UnitZ()) * Eigen::AngleAxisd(pitch, Vec3d::UnitX()) *
+         Eigen::AngleAxisd(yaw, Vec3d::UnitY()))
+            .toRotationMatrix();
+    cam_from_head.block<3, 1>(0, 3) =
+        Vec3d(rng.Uniform(-0.1, 0.1), rng.Uniform(-0.1, 0.1), -rng.Uniform(2.6, 3.4));
     const Camera camera(PhotoIntrinsics(), cam_from_head.inverse());
     TrackFrame f;
     f.intrinsics = PhotoIntrinsics();
@@ -144,8 +146,8 @@ TEST(TrackFitTest, LaplacePriorLeavesUnshownExpressionsAtZero) {
     rms_gaussian += std::pow(ExpressionRms(gaussian->frames[k].expression, truth.expression[k]), 2) / 5;
     rms_laplace += std::pow(ExpressionRms(laplace->frames[k].expression, truth.expression[k]), 2) / 5;
   }
-  std::printf("unshown weights at 0: %d of %d (Gaussian), %d (Laplace); expression RMS %.3f, %.3f\n", zero_gaussian,
-              unshown, zero_laplace, std::sqrt(rms_gaussian), std::sqrt(rms_laplace));
+  std::printf("unshown weights at 0: %d of %d (Gaussian), %d (Laplace); expression RMS %.3f, %.3f\n",
+              zero_gaussian, unshown, zero_laplace, std::sqrt(rms_gaussian), std::sqrt(rms_laplace));
   EXPECT_GE(zero_laplace, zero_gaussian + unshown / 4);
   EXPECT_LT(std::sqrt(rms_laplace), std::sqrt(rms_gaussian));
 }
@@ -155,7 +157,8 @@ void AddSilhouettes(const face::FaceModel& head, Truth* truth, int max_points) {
   for (size_t k = 0; k < truth->frames.size(); ++k) {
     Intrinsics small = PhotoIntrinsics();
     small.width /= 4, small.height /= 4, small.fl_x /= 4, small.fl_y /= 4, small.cx /= 4, small.cy /= 4;
-    const Image mask = HeadSilhouette(head, truth->expression[k], Camera(small, truth->cam_from_head[k].inverse()));
+    const Image mask =
+        HeadSilhouette(head, truth->expression[k], Camera(small, truth->cam_from_head[k].inverse()));
     truth->frames[k].silhouette = MaskEdgePoints(mask, Image(), max_points);
     for (Vec2f& p : truth->frames[k].silhouette) p *= 4.f;
   }
@@ -163,7 +166,8 @@ void AddSilhouettes(const face::FaceModel& head, Truth* truth, int max_points) {
 
 double MedianRotationErrorDeg(const TrackFit& fit, const Truth& truth) {
   std::vector<double> e;
-  for (size_t k = 0; k < fit.frames.size(); ++k) e.push_back(RotationErrorDeg(fit.frames[k].cam_from_head, truth.cam_from_head[k]));
+  for (size_t k = 0; k < fit.frames.size(); ++k)
+    e.push_back(RotationErrorDeg(fit.frames[k].cam_from_head, truth.cam_from_head[k]));
   std::sort(e.begin(), e.end());
   return e[e.size() / 2];
 }
@@ -201,7 +205,8 @@ TEST(TrackFitTest, SilhouettesSharpenThePose) {
     EXPECT_LE(f.silhouette_used, static_cast<int>(head_points[k])) << "frame " << k;  // no hair
     EXPECT_LT(f.silhouette_rms_iod, 0.03) << f.ToString();
   }
-  const double before = MedianRotationErrorDeg(*landmarks_only, truth), after = MedianRotationErrorDeg(*with, truth);
+  const double before = MedianRotationErrorDeg(*landmarks_only, truth),
+               after = MedianRotationErrorDeg(*with, truth);
   std::printf("median rotation error: %.2f deg from landmarks, %.2f deg with silhouettes\n", before, after);
   EXPECT_LT(after, 1.5);
   EXPECT_LT(after, 0.6 * before);
@@ -233,7 +238,8 @@ TEST(TrackFitTest, ASilhouetteRefitOnAShapeBoundKeepsTheLandmarkFit) {
   AddSilhouettes(face::FaceModel(wide), &truth, 200);
   const Result<TrackFit> refit = FitTrack(truth.frames, o);
   ASSERT_TRUE(refit.ok()) << refit.status().message();
-  EXPECT_EQ(refit->silhouettes.rfind("not used: the head's head_width ran to its bound", 0), 0u) << refit->silhouettes;
+  EXPECT_EQ(refit->silhouettes.rfind("not used: the head's head_width ran to its bound", 0), 0u)
+      << refit->silhouettes;
   EXPECT_NE(refit->BriefReport().find("silhouette refit not used"), std::string::npos);
   EXPECT_FLOAT_EQ(refit->shape.head_width, landmarks_only->shape.head_width);
   for (size_t k = 0; k < refit->frames.size(); ++k) {
@@ -302,7 +308,8 @@ TEST(TrackFitTest, PhotometricRefitReadsWhatTheLandmarksMiss) {
   std::vector<Mat4d> true_pose;
   for (int i = 0; i < 4; ++i) {
     Mat4d cam_from_head = Mat4d::Identity();
-    cam_from_head.block<3, 3>(0, 0) = Eigen::AngleAxisd(yaws[i] * M_PI / 180, Vec3d::UnitY()).toRotationMatrix();
+    cam_from_head.block<3, 3>(0, 0) =
+        Eigen::AngleAxisd(yaws[i] * M_PI / 180, Vec3d::UnitY()).toRotationMatrix();
     cam_from_head.block<3, 1>(0, 3) = Vec3d(0.02 * i, -0.03, -2.8);
     const Camera camera(k, cam_from_head.inverse());
     Image rgba = synth::RenderGroundTruth(head, camera, expressions[i]);
@@ -310,13 +317,15 @@ TEST(TrackFitTest, PhotometricRefitReadsWhatTheLandmarksMiss) {
     for (int y = 0; y < k.height; ++y)  // over a grey gradient
       for (int x = 0; x < k.width; ++x)
         for (int c = 0; c < 3; ++c)
-          rgb.At(x, y, c) = rgba.At(x, y, 3) * rgba.At(x, y, c) + (1 - rgba.At(x, y, 3)) * (0.3f + 0.4f * x / k.width);
+          rgb.At(x, y, c) =
+              rgba.At(x, y, 3) * rgba.At(x, y, c) + (1 - rgba.At(x, y, 3)) * (0.3f + 0.4f * x / k.width);
     photos.push_back(std::move(rgb));
     std::vector<float> seen = expressions[i];
     for (float& v : seen) v /= 3.f;
     TrackFrame f;
     f.intrinsics = k;
-    for (const Vec3f& p : face.Landmarks(face.Prepare(seen))) f.landmarks_2d.push_back(camera.Project(p.cast<double>())->uv.cast<float>());
+    for (const Vec3f& p : face.Landmarks(face.Prepare(seen)))
+      f.landmarks_2d.push_back(camera.Project(p.cast<double>())->uv.cast<float>());
     frames.push_back(f);
     true_pose.push_back(cam_from_head);
   }
@@ -347,15 +356,20 @@ TEST(TrackFitTest, PhotometricRefitReadsWhatTheLandmarksMiss) {
   for (int i = 0; i < 4; ++i) {
     std::printf("photo %d (true / landmarks / photos):", i);
     for (int e = 0; e < face::kNumExpressions; ++e)
-      if (expressions[i][e] > 0 || with->frames[i].expression[e] > 0.05 || landmarks_only->frames[i].expression[e] > 0.05)
+      if (expressions[i][e] > 0 || with->frames[i].expression[e] > 0.05 ||
+          landmarks_only->frames[i].expression[e] > 0.05)
         std::printf(" %s %.2f/%.2f/%.2f", face::kExpressionNames[e], expressions[i][e],
                     landmarks_only->frames[i].expression[e], with->frames[i].expression[e]);
     std::printf("\n");
   }
   EXPECT_LT(after, 0.85 * before);
   // The expressions the photos show most: the jaw's error at least halved, the smiles' cut by a quarter.
-  const auto error = [&](const Result<TrackFit>& fit, int i, int e) { return std::abs(fit->frames[i].expression[e] - expressions[i][e]); };
-  for (int i : {1, 3}) EXPECT_LT(error(with, i, face::kJawOpen), 0.5 * error(landmarks_only, i, face::kJawOpen)) << "photo " << i;
+  const auto error = [&](const Result<TrackFit>& fit, int i, int e) {
+    return std::abs(fit->frames[i].expression[e] - expressions[i][e]);
+  };
+  for (int i : {1, 3})
+    EXPECT_LT(error(with, i, face::kJawOpen), 0.5 * error(landmarks_only, i, face::kJawOpen))
+        << "photo " << i;
   EXPECT_LT(error(with, 2, face::kSmileLeft), 0.75 * error(landmarks_only, 2, face::kSmileLeft));
   EXPECT_LT(error(with, 3, face::kSmileRight), 0.75 * error(landmarks_only, 3, face::kSmileRight));
   for (float v : with->frames[0].expression) EXPECT_LT(v, 0.1f);  // the neutral photo stays neutral
@@ -377,22 +391,26 @@ TEST(TrackFitTest, PhotometricRefitReadsWhatTheLandmarksMiss) {
   for (int i : {1, 2}) {
     const Vec2f nose = frames[i].landmarks_2d[33], chin = frames[i].landmarks_2d[8];
     for (int y = static_cast<int>(nose.y()); y < static_cast<int>(chin.y()); ++y)
-      for (int x = 0; x < k.width; ++x) drawn[i].At(x, y, 0) = 1.f, drawn[i].At(x, y, 1) = 0.f, drawn[i].At(x, y, 2) = 1.f;
+      for (int x = 0; x < k.width; ++x)
+        drawn[i].At(x, y, 0) = 1.f, drawn[i].At(x, y, 1) = 0.f, drawn[i].At(x, y, 2) = 1.f;
   }
   for (int i = 0; i < 4; ++i) frames[i].photo = &drawn[i];
   const Result<TrackFit> rejected = FitTrack(frames, o);
   ASSERT_TRUE(rejected.ok()) << rejected.status().message();
-  EXPECT_EQ(rejected->photometric.rfind("not used: the images' colours disagree", 0), 0u) << rejected->photometric;
+  EXPECT_EQ(rejected->photometric.rfind("not used: the images' colours disagree", 0), 0u)
+      << rejected->photometric;
   EXPECT_GT(rejected->frames[2].photometric_rms, o.photometric_max_rms);
-  for (int i = 0; i < 4; ++i) EXPECT_EQ(rejected->frames[i].expression, landmarks_only->frames[i].expression) << "photo " << i;
+  for (int i = 0; i < 4; ++i)
+    EXPECT_EQ(rejected->frames[i].expression, landmarks_only->frames[i].expression) << "photo " << i;
 }
 
 TEST(TrackFitTest, YawPitchRollFollowTheirConvention) {
   TrackedFrame f;
   const double yaw = 0.3, pitch = -0.2, roll = 0.1;
-  f.cam_from_head.block<3, 3>(0, 0) = (Eigen::AngleAxisd(roll, Vec3d::UnitZ()) * Eigen::AngleAxisd(-pitch, Vec3d::UnitX()) *
-                                       Eigen::AngleAxisd(yaw, Vec3d::UnitY()))
-                                          .toRotationMatrix();
+  f.cam_from_head.block<3, 3>(0, 0) =
+      (Eigen::AngleAxisd(roll, Vec3d::UnitZ()) * Eigen::AngleAxisd(-pitch, Vec3d::UnitX()) *
+       Eigen::AngleAxisd(yaw, Vec3d::UnitY()))
+          .toRotationMatrix();
   const Vec3d ypr = f.YawPitchRollDeg();
   EXPECT_NEAR(ypr.x(), yaw * 180 / M_PI, 1e-9);
   EXPECT_NEAR(ypr.y(), pitch * 180 / M_PI, 1e-9);
@@ -408,10 +426,14 @@ TEST(TrackFitTest, BadInputIsAnError) {
   const face::FaceModel head(KnownShape());
   Truth truth = MakePhotos(head, 2, 0, 3);
   truth.frames[1].landmarks_2d.pop_back();
-  EXPECT_NE(FitTrack(truth.frames, ModelConvention()).status().message().find("frame 1: landmarks_2d must have 68"), std::string::npos);
+  EXPECT_NE(
+      FitTrack(truth.frames, ModelConvention()).status().message().find("frame 1: landmarks_2d must have 68"),
+      std::string::npos);
   truth = MakePhotos(head, 2, 0, 3);
   truth.frames[0].world_from_cam = Mat4d::Identity();
-  EXPECT_NE(FitTrack(truth.frames, ModelConvention()).status().message().find("known for every frame or for none"), std::string::npos);
+  EXPECT_NE(
+      FitTrack(truth.frames, ModelConvention()).status().message().find("known for every frame or for none"),
+      std::string::npos);
   truth = MakePhotos(head, 2, 0, 3);
   truth.frames[1].landmarks_2d[5].x() = NAN;
   EXPECT_FALSE(FitTrack(truth.frames, ModelConvention()).ok());

@@ -21,8 +21,8 @@ TEST(ConfigDefaultsTest, EmptyConfigBuildsEveryComponentWithItsOwnDefaults) {
   const ModelConfig& m = config.model;
   ASSERT_TRUE(config.Validate().ok());
   // icef-prior (the default method) feeds no expression into the static field.
-  EXPECT_EQ(m.StaticOptions(11), StaticFieldOptions{}) << m.StaticOptions(11).ToString() << " vs "
-                                                        << StaticFieldOptions{}.ToString();
+  EXPECT_EQ(m.StaticOptions(11), StaticFieldOptions{})
+      << m.StaticOptions(11).ToString() << " vs " << StaticFieldOptions{}.ToString();
   EXPECT_EQ(m.DeformationOptions(), DeformationFieldOptions{}) << m.DeformationOptions().ToString();
   EXPECT_EQ(m.region_mask, RegionMaskOptions{}) << m.region_mask.ToString();
   EXPECT_EQ(m.confidence, ConfidenceOptions{});

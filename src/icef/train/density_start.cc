@@ -25,10 +25,12 @@ void DensityStartTargets(const face::FaceFit& fit, float density_bias, const Den
   });
 }
 
-Result<double> SeedDensityFromFaceModel(const face::FaceFit& fit, const DensityStartOptions& options, uint64_t seed,
-                                        AvatarModel* model, const Executor& executor) {
-  if (options.steps < 0 || options.points < 1 || !(options.width > 0.f) || !(options.erosion >= 0.f) || !std::isfinite(options.inside_log_density))
-    return Status::Error("density start: steps must be >= 0, points >= 1, width > 0, erosion >= 0, inside_log_density finite");
+Result<double> SeedDensityFromFaceModel(const face::FaceFit& fit, const DensityStartOptions& options,
+                                        uint64_t seed, AvatarModel* model, const Executor& executor) {
+  if (options.steps < 0 || options.points < 1 || !(options.width > 0.f) || !(options.erosion >= 0.f) ||
+      !std::isfinite(options.inside_log_density))
+    return Status::Error(
+        "density start: steps must be >= 0, points >= 1, width > 0, erosion >= 0, inside_log_density finite");
   StaticField& field = model->static_field();
   nn::ParameterStore& store = model->store();
   nn::AdamOptions adam_options;

@@ -29,11 +29,11 @@
 namespace icef {
 
 struct DensityStartOptions {
-  int steps = 0;                 // 0 = no seeded start
-  int points = 8192;             // points per step
+  int steps = 0;                   // 0 = no seeded start
+  int points = 8192;               // points per step
   float inside_log_density = 3.f;  // log sigma the target reaches inside the eroded head
-  float width = 0.01f;           // head units over which the target crosses the eroded surface
-  float erosion = 0.04f;         // head units the seeded head lies inside the fitted surface
+  float width = 0.01f;             // head units over which the target crosses the eroded surface
+  float erosion = 0.04f;           // head units the seeded head lies inside the fitted surface
   double learning_rate_grid = 1e-2;
   double learning_rate_mlp = 1e-3;
 };
@@ -58,7 +58,7 @@ void DensityStartTargets(const face::FaceFit& fit, float density_bias, const Den
 // Fits the model's static-field density to the targets for options.steps Adam steps of its own
 // (the store's gradients are used and left zero; no other block moves). Returns the final mean
 // squared log-density error. Deterministic in `seed` and the thread count.
-Result<double> SeedDensityFromFaceModel(const face::FaceFit& fit, const DensityStartOptions& options, uint64_t seed,
-                                        AvatarModel* model, const Executor& executor);
+Result<double> SeedDensityFromFaceModel(const face::FaceFit& fit, const DensityStartOptions& options,
+                                        uint64_t seed, AvatarModel* model, const Executor& executor);
 
 }  // namespace icef

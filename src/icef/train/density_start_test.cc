@@ -49,7 +49,8 @@ TEST(DensityStartTest, TargetIsHighInsideTheErodedHeadAndLowOutsideIt) {
   // Distances are the head's: the scale of head_from_world does not change the target of a head point.
   face::FaceFit unscaled = fit;
   unscaled.head_from_world.scale = 1.0;
-  EXPECT_NEAR(Target(unscaled, o, surface + 0.005f * normal), Target(fit, o, surface + 0.005f * normal), 1e-4f);
+  EXPECT_NEAR(Target(unscaled, o, surface + 0.005f * normal), Target(fit, o, surface + 0.005f * normal),
+              1e-4f);
 }
 
 TEST(DensityStartTest, LossGradientMatchesFiniteDifferences) {

@@ -8,8 +8,8 @@ namespace icef {
 
 namespace fs = std::filesystem;
 
-Status SaveCheckpoint(const fs::path& path, const RunConfig& config, const AvatarModel& model, const nn::Adam* adam,
-                      const TrainerState& state) {
+Status SaveCheckpoint(const fs::path& path, const RunConfig& config, const AvatarModel& model,
+                      const nn::Adam* adam, const TrainerState& state) {
   CheckpointWriter w;
   const std::string config_text = config.ToJson().dump();
   w.Add("config", config_text);
@@ -45,7 +45,8 @@ Result<TrainerState> ParseTrainerSection(const std::string& trainer_text, const 
   ICEF_ASSIGN_OR_RETURN(const Json json, ParseJson(trainer_text, origin + " [trainer]"));
   ICEF_ASSIGN_OR_RETURN(const JsonObjectView tv, JsonObjectView::Make(json, origin, "trainer"));
   ICEF_ASSIGN_OR_RETURN(state.elapsed_seconds, tv.Number("elapsed_seconds"));
-  if (state.elapsed_seconds < 0) return tv.Error("elapsed_seconds", "must be >= 0, got " + json["elapsed_seconds"].dump());
+  if (state.elapsed_seconds < 0)
+    return tv.Error("elapsed_seconds", "must be >= 0, got " + json["elapsed_seconds"].dump());
   if (tv.Has("skipped_steps")) {
     ICEF_ASSIGN_OR_RETURN(state.skipped_steps, tv.Int64("skipped_steps", 0, state.step));
   }

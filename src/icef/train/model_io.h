@@ -23,9 +23,9 @@
 namespace icef {
 
 struct TrainerState {
-  int64_t step = 0;              // completed optimiser steps
-  double elapsed_seconds = 0;    // training wall time so far (over all resumed runs)
-  int64_t skipped_steps = 0;     // steps skipped for a non-finite loss or gradient (train.on_nonfinite = skip)
+  int64_t step = 0;            // completed optimiser steps
+  double elapsed_seconds = 0;  // training wall time so far (over all resumed runs)
+  int64_t skipped_steps = 0;   // steps skipped for a non-finite loss or gradient (train.on_nonfinite = skip)
   std::vector<std::string> log;  // train_log.jsonl lines so far
 };
 

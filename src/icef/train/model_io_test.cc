@@ -39,7 +39,9 @@ void RewriteSection(const fs::path& path, const std::string& name, const std::st
   ASSERT_TRUE(w.WriteAtomic(path).ok());
 }
 
-Json TrainerSection(const fs::path& path) { return Json::parse(Checkpoint::Read(path)->Section("trainer").value()); }
+Json TrainerSection(const fs::path& path) {
+  return Json::parse(Checkpoint::Read(path)->Section("trainer").value());
+}
 
 TEST(ModelIo, ValidCheckpointRoundTripsTrainerState) {
   const fs::path path = WriteTinyCheckpoint(testing::MakeTempDir("model_io_valid"), 7);
@@ -56,8 +58,12 @@ TEST(ModelIo, StepOutOfRangeIsRefusedNamingFileAndField) {
   const Json good = TrainerSection(path);
   // Each value as JSON text, and what the error must say about it.
   const std::vector<std::pair<std::string, std::string>> cases = {
-      {"-1", "got -1"},  {"1.5", "got 1.5"}, {"1e300", "got 1e+300"}, {"9007199254740993", "got 9007199254740993"},
-      {"\"ten\"", "expected a number, got a string"}, {"null", "expected a number, got null"}};
+      {"-1", "got -1"},
+      {"1.5", "got 1.5"},
+      {"1e300", "got 1e+300"},
+      {"9007199254740993", "got 9007199254740993"},
+      {"\"ten\"", "expected a number, got a string"},
+      {"null", "expected a number, got null"}};
   for (const auto& [value, why] : cases) {
     std::string text = good.dump();
     const std::string key = "\"step\":" + good["step"].dump();
@@ -76,7 +82,10 @@ TEST(ModelIo, StepOutOfRangeIsRefusedNamingFileAndField) {
   bad = good;
   bad["skipped_steps"] = 8;  // more than the 7 steps done
   RewriteSection(path, "trainer", bad.dump());
-  EXPECT_NE(LoadModel(path, Executor(1)).status().message().find("trainer.skipped_steps: expected an integer in [0, 7]"),
+  EXPECT_NE(LoadModel(path, Executor(1))
+                .status()
+                .message()
+                .find("trainer.skipped_steps: expected an integer in [0, 7]"),
             std::string::npos);
   bad = good;
   bad["step"] = 9007199254740992;  // 2^53: the largest accepted
@@ -110,11 +119,15 @@ TEST(ModelIo, ConfigHashMustMatchTheStoredConfig) {
   bad = trainer;
   bad.erase("config_hash");
   RewriteSection(path, "trainer", bad.dump());
-  EXPECT_NE(LoadModel(path, Executor(1)).status().message().find("trainer.config_hash: missing required field"),
-            std::string::npos);
+  EXPECT_NE(
+      LoadModel(path, Executor(1)).status().message().find("trainer.config_hash: missing required field"),
+      std::string::npos);
   bad["config_hash"] = -5;
   RewriteSection(path, "trainer", bad.dump());
-  EXPECT_NE(LoadModel(path, Executor(1)).status().message().find("trainer.config_hash: expected a non-negative integer"),
+  EXPECT_NE(LoadModel(path, Executor(1))
+                .status()
+                .message()
+                .find("trainer.config_hash: expected a non-negative integer"),
             std::string::npos);
 }
 

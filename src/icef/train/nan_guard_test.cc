@@ -14,6 +14,7 @@
 #include "icef/model/model_test_util.h"
 #include "icef/synth/synthesize.h"
 #include "icef/testing/tiny_dataset.h"
+#include "icef/train/test_subject.h"
 #include "icef/train/trainer.h"
 
 namespace icef {
@@ -42,33 +43,19 @@ int FindBlockContaining(const nn::ParameterStore& store, const std::string& part
 }
 
 struct GuardRun {
-  Status status;             // what Run returned
+  Status status;                        // what Run returned
   std::optional<TrainSummary> summary;  // when it succeeded
-  std::string ckpt_before;   // checkpoint bytes when the poison was injected
-  std::string ckpt_after;    // checkpoint bytes after Run returned
+  std::string ckpt_before;              // checkpoint bytes when the poison was injected
+  std::string ckpt_after;               // checkpoint bytes after Run returned
   std::filesystem::path model_dir;
 };
 
-// A small synthetic head (16x16 images, 3 training frames) shared by the tests of this file.
-const Dataset& Subject() {
-  static const Dataset* dataset = [] {
-    synth::SynthOptions o;
-    o.out_dir = testing::MakeTempDir("nan_guard_subject");
-    o.num_train = 3;
-    o.resolution = 16;
-    o.test_views = 1;
-    o.novel_per_tier = 1;
-    ICEF_CHECK(synth::SynthesizeDataset(o, Executor(1)).ok());
-    Result<Dataset> loaded = LoadDataset(o.out_dir);
-    ICEF_CHECK(loaded.ok(), loaded.status().message());
-    return new Dataset(std::move(loaded).value());
-  }();
-  return *dataset;
-}
+const Dataset& Subject() { return testing::TinySubject("nan_guard_subject"); }
 
 // Trains the tiny config; after step `poison_step` completes, `poison` corrupts the model.
 GuardRun RunWithPoison(const std::string& name, int64_t poison_step,
-                       const std::function<void(AvatarModel&)>& poison, const RunConfig& config = TinyRunConfig()) {
+                       const std::function<void(AvatarModel&)>& poison,
+                       const RunConfig& config = TinyRunConfig()) {
   const std::filesystem::path dir = testing::MakeTempDir(name);
   const Dataset& dataset = Subject();
   GuardRun run;
@@ -101,7 +88,8 @@ void ExpectCheckpointIntact(const GuardRun& run, int64_t expected_step) {
   ASSERT_TRUE(loaded.ok()) << loaded.status().message();
   EXPECT_EQ(loaded->state.step, expected_step);
   const nn::ParameterStore& store = loaded->model->store();
-  for (int64_t i = 0; i < store.size(); ++i) ASSERT_TRUE(std::isfinite(store.params()[i])) << "parameter " << i;
+  for (int64_t i = 0; i < store.size(); ++i)
+    ASSERT_TRUE(std::isfinite(store.params()[i])) << "parameter " << i;
 }
 
 TEST(NanGuard, NonFiniteLossNamesStepAndTermAndKeepsCheckpoint) {
@@ -157,23 +145,29 @@ RunConfig SkipConfig(int64_t steps) {
 TEST(NanGuard, SkipModeSkipsANonFiniteStepAndReportsIt) {
   // One infinite gradient (as in NonFiniteGradientNamesStepAndKeepsCheckpoint): with "skip" the
   // step after the poison is skipped, training goes on to the end, and the count is reported.
-  const GuardRun run = RunWithPoison("nan_guard_skip_once", 5, [](AvatarModel& model) {
-    const int block = FindBlockContaining(model.store(), "color");
-    ASSERT_GE(block, 0);
-    model.store().grads(block)[0] = std::numeric_limits<float>::infinity();
-  }, SkipConfig(8));
+  const GuardRun run = RunWithPoison(
+      "nan_guard_skip_once", 5,
+      [](AvatarModel& model) {
+        const int block = FindBlockContaining(model.store(), "color");
+        ASSERT_GE(block, 0);
+        model.store().grads(block)[0] = std::numeric_limits<float>::infinity();
+      },
+      SkipConfig(8));
   ASSERT_TRUE(run.status.ok()) << run.status.message();
   ASSERT_TRUE(run.summary.has_value());
   EXPECT_EQ(run.summary->steps, 8);
   EXPECT_EQ(run.summary->skipped_steps, 1);
-  EXPECT_NE(run.summary->BriefReport().find("steps skipped for a non-finite loss or gradient: 1"), std::string::npos) << run.summary->BriefReport();
+  EXPECT_NE(run.summary->BriefReport().find("steps skipped for a non-finite loss or gradient: 1"),
+            std::string::npos)
+      << run.summary->BriefReport();
   const Json summary = Json::parse(ReadFile(run.model_dir / "summary.json").value());
   EXPECT_EQ(summary["skipped_steps"].get<int64_t>(), 1);
   // The log marks the skipped step (the 6th); the checkpoint holds the count and finite parameters.
   const std::string log = ReadFile(run.model_dir / "train_log.jsonl").value();
   EXPECT_NE(log.find("\"step\":6,"), std::string::npos) << log;
   EXPECT_NE(log.find("\"skipped\":true"), std::string::npos) << log;
-  EXPECT_EQ(log.find("\"skipped\":true"), log.rfind("\"skipped\":true")) << "more than one skipped step: " << log;
+  EXPECT_EQ(log.find("\"skipped\":true"), log.rfind("\"skipped\":true"))
+      << "more than one skipped step: " << log;
   Result<LoadedModel> loaded = LoadModel(run.model_dir, Executor(1));
   ASSERT_TRUE(loaded.ok()) << loaded.status().message();
   EXPECT_EQ(loaded->state.step, 8);
@@ -186,11 +180,14 @@ TEST(NanGuard, SkipModeStopsAfterTooManyNonFiniteStepsInARow) {
   // NaN colour weights never go away: steps 3..12 are skipped, step 13 is the 11th non-finite step
   // in a row and stops training; no checkpoint was written after a skipped step, so the one of
   // step 2 (the last before the poison) is intact.
-  const GuardRun run = RunWithPoison("nan_guard_skip_many", 3, [](AvatarModel& model) {
-    const int block = FindBlockContaining(model.store(), "color");
-    ASSERT_GE(block, 0);
-    for (float& w : model.store().params(block)) w = kNaN;
-  }, SkipConfig(30));
+  const GuardRun run = RunWithPoison(
+      "nan_guard_skip_many", 3,
+      [](AvatarModel& model) {
+        const int block = FindBlockContaining(model.store(), "color");
+        ASSERT_GE(block, 0);
+        for (float& w : model.store().params(block)) w = kNaN;
+      },
+      SkipConfig(30));
   ASSERT_FALSE(run.status.ok()) << "training went on with NaN weights";
   const std::string& message = run.status.message();
   EXPECT_NE(message.find("step 13: loss term 'photo' is not finite"), std::string::npos) << message;

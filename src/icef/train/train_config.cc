@@ -9,108 +9,166 @@
 
 namespace icef {
 
-void TrainConfig::Bind(ConfigSchema& s) {
-  s.Int64("steps", &steps, "optimiser steps");
-  s.Number("time_budget_seconds", &time_budget_seconds, "stop after this much wall time in seconds (0 = no limit)");
-  s.Int("batch_rays", &batch_rays, "rays per step");
-  s.Number("lr_grid", &lr_grid, "Adam learning rate of the hash grid");
-  s.Number("lr_mlp", &lr_mlp, "Adam learning rate of the static field's MLPs");
-  s.Number("lr_deform", &lr_deform, "Adam learning rate of the deformation MLP");
-  s.Number("lr_final_factor", &lr_final_factor, "learning rates decay exponentially to this factor at the last step");
-  s.Number("lambda_id", &lambda_id, "weight of L_id, identity preservation outside the expression regions");
-  s.Number("lambda_id_prior", &lambda_id_prior,
-           "weight of L_id for the methods on the face-model prior (icef-prior), where it acts on the learned "
-           "residual R_phi alone: no residual warping outside mouth, eyes and brows");
-  s.Number("lambda_smooth", &lambda_smooth, "weight of L_smooth, deformation smoothness at the region boundary");
-  s.Number("lambda_mask", &lambda_mask, "weight of the alpha-mask loss (auxiliary; datasets with alpha only)");
-  s.Number("lambda_distortion", &lambda_distortion, "weight of the mip-NeRF 360 distortion loss, distances in aabb diagonals (few-shot prior; 0 = off)");
-  s.Number("lambda_occlusion", &lambda_occlusion,
-           "weight of the occlusion sparsity prior: density behind what the training rays already hit (0 = off)");
-  s.Number("lambda_occlusion_prior", &lambda_occlusion_prior,
+namespace {
+
+// The step count, the batch and the learning rates.
+void BindStepsAndRates(ConfigSchema& s, TrainConfig& c) {
+  s.Int64("steps", &c.steps, "optimiser steps");
+  s.Number("time_budget_seconds", &c.time_budget_seconds,
+           "stop after this much wall time in seconds (0 = no limit)");
+  s.Int("batch_rays", &c.batch_rays, "rays per step");
+  s.Number("lr_grid", &c.lr_grid, "Adam learning rate of the hash grid");
+  s.Number("lr_mlp", &c.lr_mlp, "Adam learning rate of the static field's MLPs");
+  s.Number("lr_deform", &c.lr_deform, "Adam learning rate of the deformation MLP");
+  s.Number("lr_final_factor", &c.lr_final_factor,
+           "learning rates decay exponentially to this factor at the last step");
+}
+
+// The weights of the loss terms and priors other than L_depth.
+void BindLossWeights(ConfigSchema& s, TrainConfig& c) {
+  s.Number("lambda_id", &c.lambda_id, "weight of L_id, identity preservation outside the expression regions");
+  s.Number(
+      "lambda_id_prior", &c.lambda_id_prior,
+      "weight of L_id for the methods on the face-model prior (icef-prior), where it acts on the learned "
+      "residual R_phi alone: no residual warping outside mouth, eyes and brows");
+  s.Number("lambda_smooth", &c.lambda_smooth,
+           "weight of L_smooth, deformation smoothness at the region boundary");
+  s.Number("lambda_mask", &c.lambda_mask,
+           "weight of the alpha-mask loss (auxiliary; datasets with alpha only)");
+  s.Number(
+      "lambda_distortion", &c.lambda_distortion,
+      "weight of the mip-NeRF 360 distortion loss, distances in aabb diagonals (few-shot prior; 0 = off)");
+  s.Number(
+      "lambda_occlusion", &c.lambda_occlusion,
+      "weight of the occlusion sparsity prior: density behind what the training rays already hit (0 = off)");
+  s.Number("lambda_occlusion_prior", &c.lambda_occlusion_prior,
            "weight of the occlusion sparsity prior for the methods on the face-model prior (icef-prior, "
            "warp-prior; 0 = off: their face-model depth prior holds the geometry, and this prior eroded the "
            "back of the head, which few training rays see)");
-  s.Bool("occlusion_prior_in_regions", &occlusion_prior_in_regions,
+  s.Bool("occlusion_prior_in_regions", &c.occlusion_prior_in_regions,
          "on the face-model prior, the occlusion sparsity prior (train.lambda_occlusion_prior) inside the "
          "expression regions (brows, eyes, mouth) alone: each sample's term weighted by the region mask M, "
          "the back of the head left alone (off: on validation identities it cost expression everywhere, "
          "the eyes included; docs/results/near_tier_variants)");
-  s.Number("lambda_symmetry", &lambda_symmetry,
+  s.Number("lambda_symmetry", &c.lambda_symmetry,
            "weight of the left-right symmetry prior: opacity (and colour) of canonical samples against their "
            "mirror images across the face's landmark symmetry plane (few-shot prior; 0 = off)");
-  s.Number("lambda_depth_prior", &lambda_depth_prior,
-           "weight of L_depth: each training ray through the expression regions (brows, eyes, mouth) pulled to "
-           "the depth at which it meets the fitted face model at its frame's expression, distances in aabb "
-           "diagonals (icef-prior, warp-prior; 0 = off)");
-  s.String("depth_prior_region", &depth_prior_region,
-           "the pixels L_depth acts on: \"expression\" (the expression region: brows, eyes, mouth and what lies "
-           "between them, as train.region_rays), \"eyes\" (each eye's landmark hull) or \"face\" (the hull of all 68 "
-           "landmarks, jaw line to brows, with the expression region)");
-  s.Number("depth_prior_window", &depth_prior_window,
+}
+
+// L_depth: its weight, pixels, window and reach, and the unseen views.
+void BindDepthPrior(ConfigSchema& s, TrainConfig& c) {
+  s.Number(
+      "lambda_depth_prior", &c.lambda_depth_prior,
+      "weight of L_depth: each training ray through the expression regions (brows, eyes, mouth) pulled to "
+      "the depth at which it meets the fitted face model at its frame's expression, distances in aabb "
+      "diagonals (icef-prior, warp-prior; 0 = off)");
+  s.String(
+      "depth_prior_region", &c.depth_prior_region,
+      "the pixels L_depth acts on: \"expression\" (the expression region: brows, eyes, mouth and what lies "
+      "between them, as train.region_rays), \"eyes\" (each eye's landmark hull) or \"face\" (the hull of all "
+      "68 "
+      "landmarks, jaw line to brows, with the expression region)");
+  s.Number("depth_prior_window", &c.depth_prior_window,
            "half-width of L_depth's window about the face model's depth, in aabb diagonals: each sample's "
            "offset from it is clamped to the window, so the weight a ray keeps far behind the face (where it "
            "leaves the head) pulls no harder than weight just past the window (0 = no window)");
-  s.Number("depth_prior_reach", &depth_prior_reach,
-           "L_depth's reach behind the face model's depth, in aabb diagonals: weight farther behind (inside the "
-           "head, and where the ray leaves it) and the light that passes through the ray count as one "
-           "termination at the reach, so the far side of the head is left alone and a hole is no way to meet "
-           "the prior (0 = no reach: every sample counts, transmitted light costs nothing)");
-  s.Int("depth_prior_views", &depth_prior_views,
-        "unseen views per training frame whose rays L_depth also pulls to the face model's depth: the frame's "
-        "camera turned about the face (by up to depth_prior_view_yaw / depth_prior_view_pitch degrees), its "
-        "expression region's pixel rays that meet the fitted face model; no colour, only depth (0 = off)");
-  s.Int("depth_prior_view_rays", &depth_prior_view_rays,
+  s.Number(
+      "depth_prior_reach", &c.depth_prior_reach,
+      "L_depth's reach behind the face model's depth, in aabb diagonals: weight farther behind (inside the "
+      "head, and where the ray leaves it) and the light that passes through the ray count as one "
+      "termination at the reach, so the far side of the head is left alone and a hole is no way to meet "
+      "the prior (0 = no reach: every sample counts, transmitted light costs nothing)");
+  s.Int(
+      "depth_prior_views", &c.depth_prior_views,
+      "unseen views per training frame whose rays L_depth also pulls to the face model's depth: the frame's "
+      "camera turned about the face (by up to depth_prior_view_yaw / depth_prior_view_pitch degrees), its "
+      "expression region's pixel rays that meet the fitted face model; no colour, only depth (0 = off)");
+  s.Int("depth_prior_view_rays", &c.depth_prior_view_rays,
         "unseen-view rays per step (train.depth_prior_views), on top of train.batch_rays");
-  s.Number("depth_prior_view_yaw", &depth_prior_view_yaw,
+  s.Number("depth_prior_view_yaw", &c.depth_prior_view_yaw,
            "largest turn (degrees) of an unseen view about the head's up axis");
-  s.Number("depth_prior_view_pitch", &depth_prior_view_pitch,
+  s.Number("depth_prior_view_pitch", &c.depth_prior_view_pitch,
            "largest turn (degrees) of an unseen view about its camera's right axis");
   s.String(
-      "depth_prior_view_region", &depth_prior_view_region,
+      "depth_prior_view_region", &c.depth_prior_view_region,
       "the unseen views' pixels: \"expression\" (the expression region of the face model's own landmarks "
       "projected into the view), \"upper\" (that region without the mouth: brows and eyes) or \"face\" (the "
       "filled hull of all 68 as well: nose, cheeks, chin)");
-  s.Number("symmetry_colour", &symmetry_colour,
+}
+
+// The settings of L_sym and L_smooth, and how the training rays are drawn.
+void BindTermSettingsAndRays(ConfigSchema& s, TrainConfig& c) {
+  s.Number("symmetry_colour", &c.symmetry_colour,
            "weight of the symmetry prior's colour part relative to its opacity part (0 = geometry only)");
-  s.Int("symmetry_max_samples", &symmetry_max_samples, "samples per step mirrored by the symmetry prior");
-  s.Number("smooth_epsilon", &smooth_epsilon, "finite-difference offset of L_smooth (half-extent units of the aabb)");
-  s.Int("smooth_max_samples", &smooth_max_samples, "boundary samples per step used by L_smooth");
-  s.Bool("random_background", &random_background,
+  s.Int("symmetry_max_samples", &c.symmetry_max_samples, "samples per step mirrored by the symmetry prior");
+  s.Number("smooth_epsilon", &c.smooth_epsilon,
+           "finite-difference offset of L_smooth (half-extent units of the aabb)");
+  s.Int("smooth_max_samples", &c.smooth_max_samples, "boundary samples per step used by L_smooth");
+  s.Bool("random_background", &c.random_background,
          "composite targets over a random colour per ray, rendered over the same (images with alpha only)");
-  s.Bool("pixel_jitter", &pixel_jitter,
+  s.Bool("pixel_jitter", &c.pixel_jitter,
          "cast each training ray through a random point of its pixel instead of its centre (off: the field "
          "then learns each pixel's average over the whole pixel, and a render at the centre averages the "
          "truth's pixel a second time: softer faces, -0.28 dB held-out on the validation identities)");
-  s.Number("region_rays", &region_rays,
-           "share of each step's rays drawn from the training frames' expression regions (brows, eyes and mouth "
-           "by their 2D landmarks, the region icef eval scores expressions in; frames without landmarks add none); "
-           "the rest over all pixels (0 = all uniform)");
-  s.Int("grid_anneal_steps", &grid_anneal_steps,
+  s.Number(
+      "region_rays", &c.region_rays,
+      "share of each step's rays drawn from the training frames' expression regions (brows, eyes and mouth "
+      "by their 2D landmarks, the region icef eval scores expressions in; frames without landmarks add "
+      "none); "
+      "the rest over all pixels (0 = all uniform)");
+}
+
+// Coarse-to-fine annealing and the start: the density start and the start trials.
+void BindStart(ConfigSchema& s, TrainConfig& c) {
+  s.Int("grid_anneal_steps", &c.grid_anneal_steps,
         "coarse-to-fine hash grid: levels beyond the 4 coarsest switch on over these steps (0 = off)");
-  s.Int("anneal_steps", &anneal_steps, "coarse-to-fine: deformation frequencies switch on over these steps (0 = off)");
-  s.Int("density_start_steps", &density_start_steps,
-        "steps of a start that fits the static field's density to the fitted face model's neutral head before "
-        "training (icef-prior, warp-prior; 0 = the uniform start)");
-  s.Number("density_start_erosion", &density_start_erosion,
-           "head units the density start's head lies inside the fitted face model's surface (the fit's jaw and "
-           "neck are not the subject's: density seeded outside the subject stays as a shell held-out views see)");
-  s.Number("density_start_log_density", &density_start_log_density,
-           "log-density the density start gives the inside of the head (the empty field's is model.static_field.density_bias)");
-  s.Int("start_trials", &start_trials,
-        "initialisations tried before training (1 = the seed's alone): each trains start_trial_steps steps and "
-        "the one with the lowest batch loss over the last quarter of them is trained from the start");
-  s.Int("start_trial_steps", &start_trial_steps, "steps each of the start_trials initialisations trains");
-  s.Int("occupancy_warmup", &occupancy_warmup, "steps before the occupancy grid starts skipping empty space");
-  s.Int("occupancy_every", &occupancy_every, "steps between occupancy grid updates");
-  s.Int("checkpoint_every", &checkpoint_every, "steps between checkpoints (0 = only at the end)");
-  s.Int("log_every", &log_every, "steps between lines of MODEL/train_log.jsonl");
-  s.Int("eval_every", &eval_every, "steps between held-out PSNR evaluations on observed-tier test frames (0 = off)");
-  s.Int64("seed", &seed, "root seed of every random draw");
-  s.Int("threads", &threads, "worker threads (0 = all cores)");
-  s.String("on_nonfinite", &on_nonfinite,
-           "a non-finite loss term or gradient: \"stop\" training with an error naming the step and term, or "
-           "\"skip\" the optimiser step (counted as skipped_steps in summary.json; the 11th non-finite step in a "
-           "row still stops training)");
+  s.Int("anneal_steps", &c.anneal_steps,
+        "coarse-to-fine: deformation frequencies switch on over these steps (0 = off)");
+  s.Int(
+      "density_start_steps", &c.density_start_steps,
+      "steps of a start that fits the static field's density to the fitted face model's neutral head before "
+      "training (icef-prior, warp-prior; 0 = the uniform start)");
+  s.Number(
+      "density_start_erosion", &c.density_start_erosion,
+      "head units the density start's head lies inside the fitted face model's surface (the fit's jaw and "
+      "neck are not the subject's: density seeded outside the subject stays as a shell held-out views see)");
+  s.Number("density_start_log_density", &c.density_start_log_density,
+           "log-density the density start gives the inside of the head (the empty field's is "
+           "model.static_field.density_bias)");
+  s.Int(
+      "start_trials", &c.start_trials,
+      "initialisations tried before training (1 = the seed's alone): each trains start_trial_steps steps and "
+      "the one with the lowest batch loss over the last quarter of them is trained from the start");
+  s.Int("start_trial_steps", &c.start_trial_steps, "steps each of the start_trials initialisations trains");
+}
+
+// The occupancy grid, checkpoints, logs, evaluation, seed, threads and the NaN guard.
+void BindBookkeeping(ConfigSchema& s, TrainConfig& c) {
+  s.Int("occupancy_warmup", &c.occupancy_warmup,
+        "steps before the occupancy grid starts skipping empty space");
+  s.Int("occupancy_every", &c.occupancy_every, "steps between occupancy grid updates");
+  s.Int("checkpoint_every", &c.checkpoint_every, "steps between checkpoints (0 = only at the end)");
+  s.Int("log_every", &c.log_every, "steps between lines of MODEL/train_log.jsonl");
+  s.Int("eval_every", &c.eval_every,
+        "steps between held-out PSNR evaluations on observed-tier test frames (0 = off)");
+  s.Int64("seed", &c.seed, "root seed of every random draw");
+  s.Int("threads", &c.threads, "worker threads (0 = all cores)");
+  s.String(
+      "on_nonfinite", &c.on_nonfinite,
+      "a non-finite loss term or gradient: \"stop\" training with an error naming the step and term, or "
+      "\"skip\" the optimiser step (counted as skipped_steps in summary.json; the 11th non-finite step in a "
+      "row still stops training)");
+}
+
+}  // namespace
+
+void TrainConfig::Bind(ConfigSchema& s) {
+  BindStepsAndRates(s, *this);
+  BindLossWeights(s, *this);
+  BindDepthPrior(s, *this);
+  BindTermSettingsAndRays(s, *this);
+  BindStart(s, *this);
+  BindBookkeeping(s, *this);
 }
 
 LossWeights TrainConfig::Losses(bool has_alpha) const {
@@ -143,37 +201,50 @@ Status TrainConfig::Validate() const {
   if (!(region_rays >= 0 && region_rays <= 1)) return Status::Error("train.region_rays must be in [0, 1]");
   if (!positive(lr_grid) || !positive(lr_mlp) || !positive(lr_deform))
     return Status::Error("train.lr_grid, lr_mlp and lr_deform must be positive");
-  if (!positive(lr_final_factor) || lr_final_factor > 1) return Status::Error("train.lr_final_factor must be in (0, 1]");
+  if (!positive(lr_final_factor) || lr_final_factor > 1)
+    return Status::Error("train.lr_final_factor must be in (0, 1]");
   if (!non_negative(lambda_id)) return Status::Error("train.lambda_id must be a finite number >= 0");
-  if (!non_negative(lambda_id_prior)) return Status::Error("train.lambda_id_prior must be a finite number >= 0");
+  if (!non_negative(lambda_id_prior))
+    return Status::Error("train.lambda_id_prior must be a finite number >= 0");
   if (!non_negative(lambda_occlusion_prior))
     return Status::Error("train.lambda_occlusion_prior must be a finite number >= 0");
   if (!non_negative(lambda_smooth)) return Status::Error("train.lambda_smooth must be a finite number >= 0");
   if (!non_negative(lambda_mask)) return Status::Error("train.lambda_mask must be a finite number >= 0");
-  if (!non_negative(lambda_distortion)) return Status::Error("train.lambda_distortion must be a finite number >= 0");
-  if (!non_negative(lambda_depth_prior)) return Status::Error("train.lambda_depth_prior must be a finite number >= 0");
-  if (!non_negative(depth_prior_window)) return Status::Error("train.depth_prior_window must be a finite number >= 0");
-  if (!non_negative(depth_prior_reach)) return Status::Error("train.depth_prior_reach must be a finite number >= 0");
+  if (!non_negative(lambda_distortion))
+    return Status::Error("train.lambda_distortion must be a finite number >= 0");
+  if (!non_negative(lambda_depth_prior))
+    return Status::Error("train.lambda_depth_prior must be a finite number >= 0");
+  if (!non_negative(depth_prior_window))
+    return Status::Error("train.depth_prior_window must be a finite number >= 0");
+  if (!non_negative(depth_prior_reach))
+    return Status::Error("train.depth_prior_reach must be a finite number >= 0");
   if (depth_prior_views < 0) return Status::Error("train.depth_prior_views must be >= 0");
   if (depth_prior_view_rays < 0) return Status::Error("train.depth_prior_view_rays must be >= 0");
   if (!non_negative(depth_prior_view_yaw) || depth_prior_view_yaw > 90)
     return Status::Error("train.depth_prior_view_yaw must be a number of degrees in [0, 90]");
   if (!non_negative(depth_prior_view_pitch) || depth_prior_view_pitch > 90)
     return Status::Error("train.depth_prior_view_pitch must be a number of degrees in [0, 90]");
-  if (!non_negative(lambda_occlusion)) return Status::Error("train.lambda_occlusion must be a finite number >= 0");
-  if (!non_negative(lambda_symmetry)) return Status::Error("train.lambda_symmetry must be a finite number >= 0");
-  if (!non_negative(symmetry_colour)) return Status::Error("train.symmetry_colour must be a finite number >= 0");
+  if (!non_negative(lambda_occlusion))
+    return Status::Error("train.lambda_occlusion must be a finite number >= 0");
+  if (!non_negative(lambda_symmetry))
+    return Status::Error("train.lambda_symmetry must be a finite number >= 0");
+  if (!non_negative(symmetry_colour))
+    return Status::Error("train.symmetry_colour must be a finite number >= 0");
   if (symmetry_max_samples < 1) return Status::Error("train.symmetry_max_samples must be >= 1");
   if (!positive(smooth_epsilon)) return Status::Error("train.smooth_epsilon must be positive");
-  if (!non_negative(density_start_erosion)) return Status::Error("train.density_start_erosion must be a finite number >= 0");
-  if (!std::isfinite(density_start_log_density)) return Status::Error("train.density_start_log_density must be finite");
+  if (!non_negative(density_start_erosion))
+    return Status::Error("train.density_start_erosion must be a finite number >= 0");
+  if (!std::isfinite(density_start_log_density))
+    return Status::Error("train.density_start_log_density must be finite");
   if (start_trials < 1 || start_trial_steps < 4)
     return Status::Error("train.start_trials must be >= 1 and train.start_trial_steps >= 4");
   if (smooth_max_samples < 1) return Status::Error("train.smooth_max_samples must be >= 1");
-  if (anneal_steps < 0 || grid_anneal_steps < 0 || density_start_steps < 0 || occupancy_warmup < 0 || occupancy_every < 1 || checkpoint_every < 0 || log_every < 1 ||
-      eval_every < 0)
-    return Status::Error("train: anneal_steps, grid_anneal_steps, density_start_steps, occupancy_warmup, checkpoint_every, eval_every must be >= 0 and "
-                         "occupancy_every, log_every >= 1");
+  if (anneal_steps < 0 || grid_anneal_steps < 0 || density_start_steps < 0 || occupancy_warmup < 0 ||
+      occupancy_every < 1 || checkpoint_every < 0 || log_every < 1 || eval_every < 0)
+    return Status::Error(
+        "train: anneal_steps, grid_anneal_steps, density_start_steps, occupancy_warmup, checkpoint_every, "
+        "eval_every must be >= 0 and "
+        "occupancy_every, log_every >= 1");
   if (threads < 0) return Status::Error("train.threads must be >= 0");
   if (depth_prior_region != "expression" && depth_prior_region != "eyes" && depth_prior_region != "face")
     return Status::Error("train.depth_prior_region must be \"expression\", \"eyes\" or \"face\", got \"" +

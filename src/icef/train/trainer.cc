@@ -1,19 +1,14 @@
 #include "icef/train/trainer.h"
 
 #include <algorithm>
-
 #include <chrono>
 #include <cmath>
 #include <sstream>
 
-#include "icef/core/rng.h"
 #include "icef/io/atomic_file.h"
-#include "icef/model/face_prior.h"
-#include "icef/model/prior_light.h"
 #include "icef/model/render_image.h"
-#include "icef/train/density_start.h"
 #include "icef/train/face_depth.h"
-#include "icef/train/visual_hull.h"
+#include "icef/train/run_setup.h"
 
 namespace icef {
 
@@ -33,8 +28,9 @@ Json TrainSummary::ToJson() const {
   j["interrupted"] = interrupted;
   j["stop_reason"] = stop_reason;
   j["mouth_cavity_colour"] =
-      mouth_cavity_colour ? Json::array({(*mouth_cavity_colour)[0], (*mouth_cavity_colour)[1], (*mouth_cavity_colour)[2]})
-                          : Json(nullptr);
+      mouth_cavity_colour
+          ? Json::array({(*mouth_cavity_colour)[0], (*mouth_cavity_colour)[1], (*mouth_cavity_colour)[2]})
+          : Json(nullptr);
   return j;
 }
 
@@ -44,7 +40,8 @@ std::string TrainSummary::BriefReport() const {
   os << method << ": " << steps << " steps in " << wall_seconds << " s (" << stop_reason << "), final loss "
      << final_loss << ", batch PSNR " << final_batch_psnr << " dB";
   if (skipped_steps > 0) os << ", steps skipped for a non-finite loss or gradient: " << skipped_steps;
-  if (psnr_observed) os << ", held-out PSNR (observed tier, " << observed_frames << " frames) " << *psnr_observed << " dB";
+  if (psnr_observed)
+    os << ", held-out PSNR (observed tier, " << observed_frames << " frames) " << *psnr_observed << " dB";
   if (mouth_cavity_colour) {
     os.precision(3);
     os << ", mouth cavity colour (" << (*mouth_cavity_colour)[0] << ", " << (*mouth_cavity_colour)[1] << ", "
@@ -67,8 +64,8 @@ Trainer::Trainer(const Dataset& dataset, fs::path model_dir, RunConfig config, T
     const std::vector<int64_t> pixels = region == "eyes"   ? EyePixels(dataset_, data_)
                                         : region == "face" ? FacePixels(dataset_, data_)
                                                            : data_.region_pixels();
-    data_.SetDepthTargets(FaceModelDepthTargets(*model_->setup().face_fit, data_, model_->setup().training_expressions,
-                                                pixels, executor_));
+    data_.SetDepthTargets(FaceModelDepthTargets(*model_->setup().face_fit, data_,
+                                                model_->setup().training_expressions, pixels, executor_));
     if (config_.train.depth_prior_views > 0 && config_.train.depth_prior_view_rays > 0) {
       ViewRayOptions views;
       views.views_per_frame = config_.train.depth_prior_views;
@@ -76,8 +73,8 @@ Trainer::Trainer(const Dataset& dataset, fs::path model_dir, RunConfig config, T
       views.max_pitch_deg = config_.train.depth_prior_view_pitch;
       views.seed = static_cast<uint64_t>(config_.train.seed);
       views.region = ViewRegionFromName(config_.train.depth_prior_view_region);
-      data_.SetViewRays(FaceModelViewRays(*model_->setup().face_fit, data_, model_->setup().training_expressions,
-                                          views, executor_));
+      data_.SetViewRays(FaceModelViewRays(*model_->setup().face_fit, data_,
+                                          model_->setup().training_expressions, views, executor_));
     }
   }
   adam_ = std::make_unique<nn::Adam>(MakeAdamOptions(), &model_->store());
@@ -104,111 +101,40 @@ static Status CheckDatasetMatches(const Dataset& dataset, const ModelSetup& setu
     return Status::Error(where + ": expression_dim " + std::to_string(dataset.expression_dim) +
                          " differs from the model's " + std::to_string(setup.expression_dim));
   if (dataset.train.size() != setup.training_expressions.size())
-    return Status::Error(where + ": the dataset's training split differs from the one the model was trained on");
+    return Status::Error(where +
+                         ": the dataset's training split differs from the one the model was trained on");
   return Status::Ok();
 }
 
 Result<std::unique_ptr<Trainer>> Trainer::Create(const Dataset& dataset, const fs::path& model_dir,
                                                  const RunConfig& config) {
   ICEF_RETURN_IF_ERROR(config.Validate());
-  const Executor executor(config.train.threads);
-  ICEF_ASSIGN_OR_RETURN(TrainingData data, TrainingData::Load(dataset));
-  ICEF_ASSIGN_OR_RETURN(ModelSetup setup, ModelSetup::FromDataset(dataset, executor));
-  if (UsesFacePrior(config.model.ParsedMethod())) {
-    face::FaceFitOptions fit_options;
-    fit_options.fit_style = config.model.prior_style;
-    ICEF_ASSIGN_OR_RETURN(setup.face_fit, FitFaceModelToDataset(dataset, fit_options));
-  }
-  std::string shading_note;
-  if (config.model.prior_shading && setup.face_fit) {
-    // Without a light (tiny images) the model trains unshaded: the shading is a refinement, and the
-    // rest of the prior still applies.
-    if (Result<PriorLightFit> light = FitPriorLight(dataset, *setup.face_fit, executor); light.ok()) {
-      setup.prior_light = light->light;
-    } else {
-      shading_note = light.status().message();
+  // train.start_trials: each trial trains a model of its own as this run would.
+  RunConfig trial_config = config;
+  trial_config.train.density_start_steps = 0;
+  const StartTrialFn run_trial = [&](std::unique_ptr<AvatarModel> model, const TrainingData& data,
+                                     int steps) -> Result<std::vector<double>> {
+    Trainer trial(dataset, model_dir, trial_config, data, std::move(model));
+    std::vector<double> losses;
+    for (int step = 0; step < steps; ++step) {
+      ICEF_ASSIGN_OR_RETURN(const LossTerms terms, trial.Step());
+      losses.push_back(terms.total);
     }
-  }
-  std::vector<uint8_t> hull_cells;
-  if (config.model.visual_hull.enabled && data.has_alpha()) {
-    std::vector<Image> alphas;
-    for (int k = 0; k < data.num_frames(); ++k) alphas.push_back(data.Alpha(k));
-    VisualHullOptions hull;
-    hull.margin_px = config.model.visual_hull.margin_px;
-    const int min_views = config.model.visual_hull.min_views;
-    hull.min_views = min_views > 0 ? min_views : (data.num_frames() + 1) / 2;
-    hull_cells = VisualHullCells(setup.aabb, config.model.occupancy.resolution, data.cameras(), alphas, hull, executor);
-  }
-  // A model initialised from `init_seed`, its occupancy carved by the visual hull.
-  auto make_model = [&](uint64_t init_seed) -> Result<std::unique_ptr<AvatarModel>> {
-    ICEF_ASSIGN_OR_RETURN(std::unique_ptr<AvatarModel> m, AvatarModel::Create(config.model, setup, executor));
-    m->Initialize(init_seed);
-    if (!hull_cells.empty()) ICEF_RETURN_IF_ERROR(m->occupancy().SetAllowed(hull_cells));
-    return m;
+    return losses;
   };
-  // train.start_trials: trial t's initialisation seed (trial 0's is the run's seed), and the
-  // trial whose batch loss over the last quarter of its steps is lowest.
-  auto trial_seed = [&](int t) {
-    return t == 0 ? static_cast<uint64_t>(config.train.seed)
-                  : Mix64(static_cast<uint64_t>(config.train.seed) ^ Mix64(StreamId("start_trial") + uint64_t(t)));
-  };
-  std::string start_trials_note;
-  int best_trial = 0;
-  if (config.train.start_trials > 1) {
-    RunConfig trial_config = config;
-    trial_config.train.density_start_steps = 0;
-    const int steps = config.train.start_trial_steps;
-    double best_loss = 0;
-    std::ostringstream os;
-    os.precision(4);
-    os << "start trials: batch loss over steps " << steps - steps / 4 << "-" << steps << " of";
-    for (int t = 0; t < config.train.start_trials; ++t) {
-      ICEF_ASSIGN_OR_RETURN(std::unique_ptr<AvatarModel> m, make_model(trial_seed(t)));
-      Trainer trial(dataset, model_dir, trial_config, data, std::move(m));
-      double sum = 0;
-      int counted = 0;
-      for (int step = 0; step < steps; ++step) {
-        Result<LossTerms> terms = trial.Step();
-        if (!terms.ok()) return terms.status().WithContext("start trial " + std::to_string(t));
-        if (step >= steps - steps / 4) {
-          sum += terms->total;
-          ++counted;
-        }
-      }
-      const double loss = counted > 0 ? sum / counted : 0;
-      os << (t ? ", " : " ") << "trial " << t << " " << loss;
-      if (t == 0 || loss < best_loss) {
-        best_loss = loss;
-        best_trial = t;
-      }
-    }
-    os << "; training starts from trial " << best_trial << "'s initialisation";
-    start_trials_note = os.str();
-  }
-  ICEF_ASSIGN_OR_RETURN(std::unique_ptr<AvatarModel> model, make_model(trial_seed(best_trial)));
-  std::string density_start_note;
-  if (config.train.density_start_steps > 0 && model->setup().face_fit) {
-    DensityStartOptions start;
-    start.steps = config.train.density_start_steps;
-    start.erosion = static_cast<float>(config.train.density_start_erosion);
-    start.inside_log_density = static_cast<float>(config.train.density_start_log_density);
-    ICEF_ASSIGN_OR_RETURN(const double mse, SeedDensityFromFaceModel(*model->setup().face_fit, start,
-                                                                      static_cast<uint64_t>(config.train.seed),
-                                                                      model.get(), executor));
-    std::ostringstream os;
-    os.precision(3);
-    os << "density start: " << start.steps << " steps on the fitted head, log-density RMS error " << std::sqrt(mse);
-    density_start_note = os.str();
-  }
+  ICEF_ASSIGN_OR_RETURN(RunSetup run, PrepareRun(dataset, config.model, RunSetupOptions::FromConfig(config),
+                                                 run_trial, Executor(config.train.threads)));
   // Only now that the data and the model are good is anything written.
   std::error_code ec;
   fs::create_directories(model_dir, ec);
-  if (!fs::is_directory(model_dir)) return Status::Error(model_dir.string() + ": cannot create the model directory");
+  if (!fs::is_directory(model_dir))
+    return Status::Error(model_dir.string() + ": cannot create the model directory");
   ICEF_RETURN_IF_ERROR(WriteFileAtomic(model_dir / "config.json", FormatJson(config.ToJson())));
-  std::unique_ptr<Trainer> trainer(new Trainer(dataset, model_dir, config, std::move(data), std::move(model)));
-  trainer->prior_shading_note_ = std::move(shading_note);
-  trainer->density_start_note_ = std::move(density_start_note);
-  trainer->start_trials_note_ = std::move(start_trials_note);
+  std::unique_ptr<Trainer> trainer(
+      new Trainer(dataset, model_dir, config, std::move(run.data), std::move(run.model)));
+  trainer->prior_shading_note_ = std::move(run.prior_shading_note);
+  trainer->density_start_note_ = std::move(run.density_start_note);
+  trainer->start_trials_note_ = std::move(run.start_trials_note);
   return trainer;
 }
 
@@ -233,13 +159,15 @@ Result<std::unique_ptr<Trainer>> Trainer::Resume(const Dataset& dataset, const f
   ICEF_ASSIGN_OR_RETURN(const RunConfig config, configure(loaded.config));
   ICEF_RETURN_IF_ERROR(config.Validate());
   if (WriteConfig(config.model) != WriteConfig(loaded.config.model))
-    return Status::Error((model_dir / kCheckpointFile).string() + ": resuming cannot change the model config");
+    return Status::Error((model_dir / kCheckpointFile).string() +
+                         ": resuming cannot change the model config");
   ICEF_ASSIGN_OR_RETURN(TrainingData data, TrainingData::Load(dataset));
   std::unique_ptr<Trainer> trainer(
       new Trainer(dataset, model_dir, config, std::move(data), std::move(loaded.model)));
   if (!loaded.adam_state.empty()) {
     std::istringstream in(loaded.adam_state);
-    ICEF_RETURN_IF_ERROR(trainer->adam_->Read(in).WithContext((model_dir / kCheckpointFile).string() + " [adam]"));
+    ICEF_RETURN_IF_ERROR(
+        trainer->adam_->Read(in).WithContext((model_dir / kCheckpointFile).string() + " [adam]"));
   }
   trainer->state_ = loaded.state;
   trainer->ApplySchedules();
@@ -247,7 +175,8 @@ Result<std::unique_ptr<Trainer>> Trainer::Resume(const Dataset& dataset, const f
 }
 
 void Trainer::ApplySchedules() {
-  if (DeformationField* d = model_->residual_field()) d->SetAnnealing(DeformationAnnealing(config_, state_.step));
+  if (DeformationField* d = model_->residual_field())
+    d->SetAnnealing(DeformationAnnealing(config_, state_.step));
   model_->static_field().SetLevelWeights(GridLevelWeights(config_, state_.step));
 }
 
@@ -281,7 +210,8 @@ Result<LossTerms> Trainer::Step() {
       for (; i < i1; ++i) sums[0] += g[i] * 0.f;
       for (float v : sums) bad[thread] |= !std::isfinite(v);
     });
-    if (std::find(bad.begin(), bad.end(), uint8_t{1}) != bad.end()) nonfinite = "a parameter gradient is not finite";
+    if (std::find(bad.begin(), bad.end(), uint8_t{1}) != bad.end())
+      nonfinite = "a parameter gradient is not finite";
   }
   const std::string step_name = "step " + std::to_string(state_.step);
   if (!nonfinite.empty() && t.on_nonfinite != "skip")
@@ -311,7 +241,8 @@ Result<LossTerms> Trainer::Step() {
 }
 
 Status Trainer::SaveCheckpoint() const {
-  ICEF_RETURN_IF_ERROR(icef::SaveCheckpoint(model_dir_ / kCheckpointFile, config_, *model_, adam_.get(), state_));
+  ICEF_RETURN_IF_ERROR(
+      icef::SaveCheckpoint(model_dir_ / kCheckpointFile, config_, *model_, adam_.get(), state_));
   std::string log;
   for (const auto& line : state_.log) log += line + "\n";
   return WriteFileAtomic(model_dir_ / "train_log.jsonl", log);
@@ -392,7 +323,8 @@ Result<TrainSummary> Trainer::Run(const ProgressFn& progress, const std::atomic<
   if (model_->has_mouth_cavity())
     summary.mouth_cavity_colour = {model_->CavityColour(0), model_->CavityColour(1), model_->CavityColour(2)};
   if (!summary.interrupted)
-    summary.psnr_observed = MeanTierPsnr(*model_, dataset_, Tier::kObserved, executor_, &summary.observed_frames);
+    summary.psnr_observed =
+        MeanTierPsnr(*model_, dataset_, Tier::kObserved, executor_, &summary.observed_frames);
   ICEF_RETURN_IF_ERROR(WriteFileAtomic(model_dir_ / "summary.json", FormatJson(summary.ToJson())));
   return summary;
 }

@@ -6,7 +6,6 @@
 #pragma once
 
 #include <array>
-
 #include <atomic>
 #include <filesystem>
 #include <functional>
@@ -23,16 +22,16 @@ namespace icef {
 
 struct TrainSummary {
   std::string method;
-  int64_t steps = 0;                  // completed steps
-  double wall_seconds = 0;            // training time (all resumed runs together)
-  double final_loss = 0;              // total loss of the last step
-  double final_batch_psnr = 0;        // PSNR of the last training batch
+  int64_t steps = 0;                    // completed steps
+  double wall_seconds = 0;              // training time (all resumed runs together)
+  double final_loss = 0;                // total loss of the last step
+  double final_batch_psnr = 0;          // PSNR of the last training batch
   std::optional<double> psnr_observed;  // mean PSNR over test frames of tier `observed`
   int observed_frames = 0;
-  double samples_per_second = 0;      // field samples per second of training time (this run)
-  int64_t skipped_steps = 0;          // steps skipped for a non-finite loss or gradient (all resumed runs)
-  bool interrupted = false;           // stopped by a signal before the end
-  std::string stop_reason;            // "steps", "time budget" or "interrupted"
+  double samples_per_second = 0;  // field samples per second of training time (this run)
+  int64_t skipped_steps = 0;      // steps skipped for a non-finite loss or gradient (all resumed runs)
+  bool interrupted = false;       // stopped by a signal before the end
+  std::string stop_reason;        // "steps", "time budget" or "interrupted"
   // The learned colour of the face model's mouth cavity (*-prior methods; model/avatar_model.h).
   std::optional<std::array<double, 3>> mouth_cavity_colour;
 
@@ -60,18 +59,21 @@ class Trainer {
 
   // Fresh run: creates model_dir, writes config.json; runs on config.train.threads threads. The
   // dataset must outlive the trainer.
-  static Result<std::unique_ptr<Trainer>> Create(const Dataset& dataset, const std::filesystem::path& model_dir,
+  static Result<std::unique_ptr<Trainer>> Create(const Dataset& dataset,
+                                                 const std::filesystem::path& model_dir,
                                                  const RunConfig& config);
   // Continues from model_dir/checkpoint.icef: its config wins, but the overrides may extend the
   // step count or time budget, or change the thread count (results are bit-identical to an
   // uninterrupted run only with the same thread count).
-  static Result<std::unique_ptr<Trainer>> Resume(const Dataset& dataset, const std::filesystem::path& model_dir,
+  static Result<std::unique_ptr<Trainer>> Resume(const Dataset& dataset,
+                                                 const std::filesystem::path& model_dir,
                                                  std::optional<int64_t> steps_override,
                                                  std::optional<double> time_budget_override,
                                                  std::optional<int> threads_override);
   // Continues from model_dir/checkpoint.icef with the config `configure` returns; the checkpoint
   // is loaded on `load_threads` threads (0 = all cores). Nothing is written here.
-  static Result<std::unique_ptr<Trainer>> Resume(const Dataset& dataset, const std::filesystem::path& model_dir,
+  static Result<std::unique_ptr<Trainer>> Resume(const Dataset& dataset,
+                                                 const std::filesystem::path& model_dir,
                                                  const ConfigureResumeFn& configure, int load_threads);
 
   // Runs to the configured step count or time budget, or until *stop becomes true (then a

@@ -48,7 +48,8 @@ Result<TrainingData> TrainingData::Load(const Dataset& dataset) {
                                             DefaultRegionDilation(img.width));
       for (int y = 0; y < img.height; ++y)
         for (int x = 0; x < img.width; ++x)
-          if (region.At(x, y, 0) > 0.f) data.region_pixels_.push_back(data.PixelIndex(static_cast<int>(k), x, y));
+          if (region.At(x, y, 0) > 0.f)
+            data.region_pixels_.push_back(data.PixelIndex(static_cast<int>(k), x, y));
     }
   }
   return data;
@@ -58,17 +59,19 @@ Image TrainingData::Alpha(int k) const {
   const Camera& cam = cameras_[k];
   Image out(cam.width(), cam.height(), 1, 1.f);
   if (has_alpha_)
-    std::copy(alpha_.begin() + frame_offset_[k], alpha_.begin() + frame_offset_[k] + out.pixels.size(), out.pixels.begin());
+    std::copy(alpha_.begin() + frame_offset_[k], alpha_.begin() + frame_offset_[k] + out.pixels.size(),
+              out.pixels.begin());
   return out;
 }
 
 void TrainingData::SetDepthTargets(std::vector<float> depth) {
-  ICEF_CHECK(depth.empty() || depth.size() == frame_of_pixel_.size(), "depth targets: one per training pixel");
+  ICEF_CHECK(depth.empty() || depth.size() == frame_of_pixel_.size(),
+             "depth targets: one per training pixel");
   depth_ = std::move(depth);
 }
 
-void TrainingData::SampleBatch(int num_rays, uint64_t seed, int64_t step, const RaySampling& how, TrainRays* batch,
-                               const Executor& executor) const {
+void TrainingData::SampleBatch(int num_rays, uint64_t seed, int64_t step, const RaySampling& how,
+                               TrainRays* batch, const Executor& executor) const {
   const int extra = view_rays_.empty() ? 0 : std::max(how.view_rays, 0);
   const int all_rays = num_rays + extra;
   batch->photo_rays = extra > 0 ? num_rays : -1;
@@ -77,7 +80,8 @@ void TrainingData::SampleBatch(int num_rays, uint64_t seed, int64_t step, const 
   batch->target_rgb.assign(3 * size_t(all_rays), 0.f);
   batch->target_alpha.assign(has_alpha_ ? all_rays : 0, 0.f);
   batch->background.resize(3 * size_t(all_rays));
-  batch->depth_target.assign(depth_.empty() && extra == 0 ? 0 : all_rays, std::numeric_limits<float>::quiet_NaN());
+  batch->depth_target.assign(depth_.empty() && extra == 0 ? 0 : all_rays,
+                             std::numeric_limits<float>::quiet_NaN());
   const bool random = how.random_background && has_alpha_;
   const bool jitter = how.jitter;
   // The draws in ray order on the caller (three streams, each consumed in order), then the rays and
@@ -92,7 +96,9 @@ void TrainingData::SampleBatch(int num_rays, uint64_t seed, int64_t step, const 
   };
   std::vector<PixelDraw> draws(num_rays);
   const int from_region =
-      region_pixels_.empty() ? 0 : static_cast<int>(std::lround(std::clamp(how.region_fraction, 0.0, 1.0) * num_rays));
+      region_pixels_.empty()
+          ? 0
+          : static_cast<int>(std::lround(std::clamp(how.region_fraction, 0.0, 1.0) * num_rays));
   for (int r = 0; r < num_rays; ++r) {
     PixelDraw& d = draws[r];
     d.pixel = r < from_region ? uint64_t(region_pixels_[rng.Below(region_pixels_.size())]) : rng.Below(total);

@@ -53,7 +53,9 @@ class TrainingData {
   const std::vector<int64_t>& region_pixels() const { return region_pixels_; }
   // The frame of global pixel p and the ray through its centre.
   int frame_of_pixel(int64_t p) const { return frame_of_pixel_[p]; }
-  Ray PixelCentreRay(int64_t p) const { return cameras_[frame_of_pixel_[p]].PixelRay(pixel_x_[p], pixel_y_[p]); }
+  Ray PixelCentreRay(int64_t p) const {
+    return cameras_[frame_of_pixel_[p]].PixelRay(pixel_x_[p], pixel_y_[p]);
+  }
   // Per-pixel depth targets [num_pixels()] (ray parameter t of the pixel-centre ray, NaN = none) that
   // SampleBatch copies into TrainRays::depth_target; empty (the default) leaves it empty.
   void SetDepthTargets(std::vector<float> depth);
@@ -62,7 +64,9 @@ class TrainingData {
   void SetViewRays(std::vector<ViewRay> rays) { view_rays_ = std::move(rays); }
   const std::vector<ViewRay>& view_rays() const { return view_rays_; }
   // The global pixel index of (frame k, x, y).
-  int64_t PixelIndex(int k, int x, int y) const { return frame_offset_[k] + int64_t(y) * cameras_[k].width() + x; }
+  int64_t PixelIndex(int k, int x, int y) const {
+    return frame_offset_[k] + int64_t(y) * cameras_[k].width() + x;
+  }
 
   // Fills `batch` with `num_rays` rays from Rng(seed, "ray_batch", step): deterministic for
   // (seed, step). The first round(region_fraction * num_rays) are drawn uniformly from
@@ -77,16 +81,16 @@ class TrainingData {
 
  private:
   std::vector<Camera> cameras_;
-  std::vector<int64_t> frame_offset_;    // [K] first global pixel of each frame
-  std::vector<int32_t> frame_of_pixel_;  // [P] global pixel -> frame
+  std::vector<int64_t> frame_offset_;       // [K] first global pixel of each frame
+  std::vector<int32_t> frame_of_pixel_;     // [P] global pixel -> frame
   std::vector<int32_t> pixel_x_, pixel_y_;  // [P]
   std::vector<float> premultiplied_;        // [P, 3] foreground colour times alpha
   std::vector<float> background_;           // [P, 3] the dataset's background behind each pixel
   std::vector<float> alpha_;                // [P] or empty
   bool has_alpha_ = false;
-  std::vector<int64_t> region_pixels_;     // see region_pixels()
-  std::vector<float> depth_;               // see SetDepthTargets()
-  std::vector<ViewRay> view_rays_;         // see SetViewRays()
+  std::vector<int64_t> region_pixels_;  // see region_pixels()
+  std::vector<float> depth_;            // see SetDepthTargets()
+  std::vector<ViewRay> view_rays_;      // see SetViewRays()
 };
 
 }  // namespace icef

@@ -10,11 +10,13 @@ namespace {
 struct ForegroundTable {
   int w = 0, h = 0;
   std::vector<int32_t> sum;
-  ForegroundTable(const Image& alpha, float threshold) : w(alpha.width), h(alpha.height), sum(size_t(w + 1) * (h + 1), 0) {
+  ForegroundTable(const Image& alpha, float threshold)
+      : w(alpha.width), h(alpha.height), sum(size_t(w + 1) * (h + 1), 0) {
     for (int y = 0; y < h; ++y)
       for (int x = 0; x < w; ++x)
-        sum[size_t(y + 1) * (w + 1) + x + 1] = (alpha.At(x, y, 0) >= threshold ? 1 : 0) + sum[size_t(y) * (w + 1) + x + 1] +
-                                               sum[size_t(y + 1) * (w + 1) + x] - sum[size_t(y) * (w + 1) + x];
+        sum[size_t(y + 1) * (w + 1) + x + 1] =
+            (alpha.At(x, y, 0) >= threshold ? 1 : 0) + sum[size_t(y) * (w + 1) + x + 1] +
+            sum[size_t(y + 1) * (w + 1) + x] - sum[size_t(y) * (w + 1) + x];
   }
   // Foreground pixels in columns [x0, x1), rows [y0, y1).
   int32_t Count(int x0, int y0, int x1, int y1) const {

@@ -19,7 +19,7 @@
 namespace icef {
 
 struct VisualHullOptions {
-  int margin_px = 2;            // footprint dilation in pixels
+  int margin_px = 2;             // footprint dilation in pixels
   float alpha_threshold = 0.5f;  // alpha at or above this is foreground
   int min_views = 1;             // cells whose centre fewer views see are carved
 };

@@ -34,7 +34,8 @@ TEST(VisualHullTest, CarvesAroundADiscSilhouette) {
   for (int z = 0; z < r; ++z)
     for (int y = 0; y < r; ++y)
       for (int x = 0; x < r; ++x) {
-        const Vec3f centre = box.min + box.Extent().cwiseProduct(Vec3f(x + 0.5f, y + 0.5f, z + 0.5f)) / float(r);
+        const Vec3f centre =
+            box.min + box.Extent().cwiseProduct(Vec3f(x + 0.5f, y + 0.5f, z + 0.5f)) / float(r);
         const uint8_t a = allowed[(size_t(z) * r + y) * r + x];
         kept += a;
         if (centre.norm() < 0.3f) EXPECT_EQ(a, 1) << "carved a cell inside the sphere";
