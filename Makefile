@@ -65,7 +65,7 @@ sanitize: deps
 	cmake --preset asan -B $(SANITIZE_BUILD_DIR) -DICEF_BUILD_BENCH=OFF >/dev/null
 	cmake --build $(SANITIZE_BUILD_DIR) -j $(JOBS) --target $(SANITIZE_TARGETS)
 	cd $(SANITIZE_BUILD_DIR) && $(SANITIZE_ENV) ctest --output-on-failure -j $(JOBS) --timeout 600 \
-		-E '_NOT_BUILT|^integration\.'
+		-E '_NOT_BUILT|^integration\.|^lint\.'
 
 # libFuzzer targets (fuzz/): each runs FUZZ_SECONDS on its committed seed corpus fuzz/corpus/NAME;
 # new inputs go to $(FUZZ_BUILD_DIR)/fuzz/corpus/NAME, crashes to $(FUZZ_BUILD_DIR)/fuzz/crash-NAME-*.

@@ -2,7 +2,7 @@
 # scripts/function_lengths.py finds the functions over the limit, and only those: braces in strings,
 # comments and initialisers, namespaces, classes and lambdas do not fool it.
 set -euo pipefail
-root=$1
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)  # ($1, $2: the tool and the clip maker, unused)
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 body() { for i in $(seq "$1"); do echo "  x += $i;  // }"; done; }

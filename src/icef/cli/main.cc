@@ -6,6 +6,7 @@
 #include <exception>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -52,49 +53,37 @@ std::string UnknownOption(CLI::App* command, int first, int argc, char** argv) {
   return "";
 }
 
-}  // namespace
+using Register = icef::cli::CommandFn (*)(CLI::App&);
+struct Command {
+  const char* name;
+  const char* description;
+  Register add;
+};
+const Command kCommands[] = {
+    {"demo", "Run the built-in demo end to end", icef::cli::RegisterDemo},
+    {"info", "Summarise and validate a dataset", icef::cli::RegisterInfo},
+    {"synth", "Render a synthetic ground-truth dataset of a procedural head", icef::cli::RegisterSynth},
+    {"sheet", "Tile a dataset into a labelled contact sheet PNG", icef::cli::RegisterSheet},
+    {"import", "Convert a NerFace / instant-ngp dataset into our format", icef::cli::RegisterImport},
+    {"train", "Train a model (icef or a baseline) on a dataset", icef::cli::RegisterTrain},
+    {"render", "Render a trained model: views, expressions, sweeps, turntables", icef::cli::RegisterRender},
+    {"config", "Print the resolved run config, or document every key (--markdown)",
+     icef::cli::RegisterConfig},
+    {"mask", "Show the expression-region mask (overlay + volume slices)", icef::cli::RegisterMask},
+    {"landmarks", "Detect 68 face landmarks (dlib) and write them into a dataset",
+     icef::cli::RegisterLandmarks},
+    {"track", "Turn photos of one person into a dataset: landmarks, face-model fit, crops, masks",
+     icef::cli::RegisterTrack},
+    {"faceid", "Face-identity descriptors of photos and their pairwise distances", icef::cli::RegisterFaceId},
+    {"eval", "Evaluate a trained model: PSNR, SSIM, LPIPS, identity consistency per tier",
+     icef::cli::RegisterEval},
+    {"bench", "Run the benchmark (synthesise, train, evaluate every method) and write the report",
+     icef::cli::RegisterBench},
+};
 
-int main(int argc, char** argv) {
-  CLI::App app{
-      "ICEF: Identity-Consistent Expression Fields. Few-shot, expression-controllable neural head "
-      "models from K = 3-10 posed photos.",
-      "icef"};
-  app.require_subcommand(1);
-  app.set_version_flag("--version", "icef 0.1.0");
-
-  using Register = icef::cli::CommandFn (*)(CLI::App&);
-  const std::pair<const char*, std::pair<const char*, Register>> commands[] = {
-      {"demo", {"Run the built-in demo end to end", icef::cli::RegisterDemo}},
-      {"info", {"Summarise and validate a dataset", icef::cli::RegisterInfo}},
-      {"synth", {"Render a synthetic ground-truth dataset of a procedural head", icef::cli::RegisterSynth}},
-      {"sheet", {"Tile a dataset into a labelled contact sheet PNG", icef::cli::RegisterSheet}},
-      {"import", {"Convert a NerFace / instant-ngp dataset into our format", icef::cli::RegisterImport}},
-      {"train", {"Train a model (icef or a baseline) on a dataset", icef::cli::RegisterTrain}},
-      {"render",
-       {"Render a trained model: views, expressions, sweeps, turntables", icef::cli::RegisterRender}},
-      {"config",
-       {"Print the resolved run config, or document every key (--markdown)", icef::cli::RegisterConfig}},
-      {"mask", {"Show the expression-region mask (overlay + volume slices)", icef::cli::RegisterMask}},
-      {"landmarks",
-       {"Detect 68 face landmarks (dlib) and write them into a dataset", icef::cli::RegisterLandmarks}},
-      {"track",
-       {"Turn photos of one person into a dataset: landmarks, face-model fit, crops, masks",
-        icef::cli::RegisterTrack}},
-      {"faceid",
-       {"Face-identity descriptors of photos and their pairwise distances", icef::cli::RegisterFaceId}},
-      {"eval",
-       {"Evaluate a trained model: PSNR, SSIM, LPIPS, identity consistency per tier",
-        icef::cli::RegisterEval}},
-      {"bench",
-       {"Run the benchmark (synthesise, train, evaluate every method) and write the report",
-        icef::cli::RegisterBench}},
-  };
-  std::map<CLI::App*, icef::cli::CommandFn> runners;
-  for (const auto& [name, entry] : commands) {
-    CLI::App* sub = app.add_subcommand(name, entry.first);
-    runners[sub] = entry.second(*sub);
-  }
-
+// The exit code for a command line that names no subcommand, an unknown one or an unknown option,
+// with its message on stderr; nullopt for one CLI11 should parse.
+std::optional<int> RejectCommandLine(CLI::App& app, int argc, char** argv) {
   // Bare `icef`: the overview of the subcommands rather than CLI11's one-line complaint.
   if (argc < 2) {
     std::cerr << app.help();
@@ -102,11 +91,11 @@ int main(int argc, char** argv) {
   }
   // A first word that is no subcommand: name it (CLI11 would only say that a subcommand is required).
   const std::string first = argv[1];
-  const bool known = std::any_of(std::begin(commands), std::end(commands),
-                                 [&](const auto& command) { return first == command.first; });
+  const bool known = std::any_of(std::begin(kCommands), std::end(kCommands),
+                                 [&](const Command& command) { return first == command.name; });
   if (first[0] != '-' && !known) {
     std::cerr << "icef: unknown subcommand '" << first << "'; the subcommands are:";
-    for (const auto& [name, entry] : commands) std::cerr << " " << name;
+    for (const Command& command : kCommands) std::cerr << " " << command.name;
     std::cerr << " (icef --help describes them)\n";
     return 1;
   }
@@ -118,15 +107,13 @@ int main(int argc, char** argv) {
     std::cerr << name << ": unknown option '" << option << "' (" << name << " --help lists the options)\n";
     return 1;
   }
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : 1;
-  }
+  return std::nullopt;
+}
 
+// Runs the parsed subcommand: 0, 1 with its error on stderr, or 2 for an internal error.
+int RunParsed(const std::map<CLI::App*, icef::cli::CommandFn>& runners) {
   try {
-    for (auto& [sub, run] : runners) {
+    for (const auto& [sub, run] : runners) {
       if (!sub->parsed()) continue;
       const icef::Status status = run();
       if (!status.ok()) {
@@ -143,4 +130,28 @@ int main(int argc, char** argv) {
     std::cerr << "icef: internal error (please report): " << e.what() << "\n";
   }
   return 2;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "ICEF: Identity-Consistent Expression Fields. Few-shot, expression-controllable neural head "
+      "models from K = 3-10 posed photos.",
+      "icef"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "icef 0.1.0");
+  std::map<CLI::App*, icef::cli::CommandFn> runners;
+  for (const Command& command : kCommands) {
+    CLI::App* sub = app.add_subcommand(command.name, command.description);
+    runners[sub] = command.add(*sub);
+  }
+  if (const std::optional<int> rejected = RejectCommandLine(app, argc, argv)) return *rejected;
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : 1;
+  }
+  return RunParsed(runners);
 }
