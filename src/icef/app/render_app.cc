@@ -10,6 +10,7 @@
 #include "icef/io/gif_writer.h"
 #include "icef/model/render_image.h"
 #include "icef/model/trained_model.h"
+#include "icef/video/video_writer.h"
 
 namespace icef {
 
@@ -260,6 +261,19 @@ Status WriteRenderedFrame(const RenderAppOptions& o, const ModelSetup& setup, Re
 }
 
 // frames.json, and a sequence's animated GIFs.
+// The image padded by repeating its last column and row to even dimensions (H.264's yuv420p needs
+// them); unchanged when both are even.
+Image EvenSized(const Image& image) {
+  const int w = image.width + image.width % 2, h = image.height + image.height % 2;
+  if (w == image.width && h == image.height) return image;
+  Image out(w, h, image.channels);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < image.channels; ++c)
+        out.At(x, y, c) = image.At(std::min(x, image.width - 1), std::min(y, image.height - 1), c);
+  return out;
+}
+
 Status WriteSequenceFiles(const RenderAppOptions& o, const std::string& method, const SequenceOutput& written,
                           std::ostream& out) {
   Json doc;
@@ -267,6 +281,14 @@ Status WriteSequenceFiles(const RenderAppOptions& o, const std::string& method, 
   doc["method"] = method;
   doc["frames"] = written.frames;
   ICEF_RETURN_IF_ERROR(WriteFileAtomic(o.out / "frames.json", FormatJson(doc)));
+  if (o.video) {
+    VideoWriteOptions video;
+    video.fps = o.fps;
+    std::vector<Image> frames;
+    for (const Image& color : written.colors) frames.push_back(EvenSized(color));
+    ICEF_RETURN_IF_ERROR(WriteVideo(*o.video, frames, video));
+    out << "video: " << o.video->string() << " (" << frames.size() << " frames at " << o.fps << " fps)\n";
+  }
   if (written.colors.size() > 1) {
     ICEF_RETURN_IF_ERROR(WriteGif(o.out / "color.gif", written.colors, o.gif_delay_cs));
     ICEF_RETURN_IF_ERROR(WriteGif(o.out / "depth.gif", written.depths, o.gif_delay_cs));
@@ -280,6 +302,11 @@ Status WriteSequenceFiles(const RenderAppOptions& o, const std::string& method, 
 }  // namespace
 
 Result<std::vector<RenderedFrameInfo>> RunRender(const RenderAppOptions& o, std::ostream& out) {
+  if (o.video) {
+    VideoWriteOptions video;
+    video.fps = o.fps;
+    if (Status valid = video.Validate(); !valid.ok()) return Status::Error("--fps: " + valid.message());
+  }
   const Executor executor(o.threads);
   ICEF_ASSIGN_OR_RETURN(const TrainedModel loaded, LoadTrainedModel(o.model, executor, o.overrides));
   const AvatarModel& model = *loaded.model;

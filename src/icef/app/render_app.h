@@ -39,6 +39,8 @@ struct RenderAppOptions {
   int sweep_frames = 16;                        // frames of a sweep
   double sweep_beyond = 1.5;                    // the sweep ends at this multiple of the target
   int gif_delay_cs = 8;                         // GIF frame delay (1/100 s)
+  std::optional<std::filesystem::path> video;   // also the colour frames as an MP4 (H.264) here
+  double fps = 25;                              // its frame rate
   int threads = 0;                              // worker threads (0 = all cores)
   std::vector<std::string> overrides;  // "model.KEY=VALUE" of inference-only keys (model/trained_model.h)
 };

@@ -8,6 +8,7 @@
 
 #include "icef/app/app_test_util.h"
 #include "icef/io/image.h"
+#include "icef/video/video_reader.h"
 
 namespace icef {
 namespace {
@@ -29,6 +30,37 @@ TEST(RenderApp, InferenceOverrideApplies) {
   ASSERT_TRUE(color.ok()) << color.status().message();
   EXPECT_EQ(color->width, 16);
   EXPECT_NE(out.str().find("frame 000: delta"), std::string::npos) << out.str();
+}
+
+// --video: the sequence's colour frames as an MP4 that the video reader reads back, frame for frame;
+// an odd image height is padded to even (H.264 needs it).
+TEST(RenderApp, OrbitVideoReadsBack) {
+  const fs::path dir = testing::MakeTempDir("render_app_video");
+  RenderAppOptions o;
+  o.model = testing_app::WriteTinyModelDir(dir / "model");
+  o.out = dir / "out";
+  o.threads = 1;
+  o.orbit = 6;
+  o.resolution = 15;
+  o.video = dir / "orbit.mp4";
+  o.fps = 12;
+  std::ostringstream out;
+  const Result<std::vector<RenderedFrameInfo>> frames = RunRender(o, out);
+  ASSERT_TRUE(frames.ok()) << frames.status().message();
+  const Result<VideoInfo> info = ProbeVideo(*o.video);
+  ASSERT_TRUE(info.ok()) << info.status().message();
+  EXPECT_EQ(info->height, 16);
+  EXPECT_EQ(info->width % 2, 0);
+  EXPECT_NEAR(info->fps, 12, 1e-6);
+  const Result<std::vector<VideoFrame>> decoded = ReadVideoFrames(*o.video, {});
+  ASSERT_TRUE(decoded.ok()) << decoded.status().message();
+  EXPECT_EQ(decoded->size(), 6u);
+  EXPECT_NE(out.str().find("video: "), std::string::npos) << out.str();
+  // A bad frame rate is refused before anything is written.
+  o.fps = 0;
+  o.video = dir / "bad.mp4";
+  EXPECT_FALSE(RunRender(o, out).ok());
+  EXPECT_FALSE(fs::exists(dir / "bad.mp4"));
 }
 
 TEST(RenderApp, ArchitectureOverrideIsRefused) {

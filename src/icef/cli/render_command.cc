@@ -10,7 +10,8 @@ namespace icef::cli {
 CommandFn RegisterRender(CLI::App& app) {
   app.description(
       "Render a trained model: colour, depth, region mask M and deformation magnitude as PNGs per frame, "
-      "animated GIFs for sequences, and frames.json with delta, kappa and the nearest observed expression of "
+      "animated GIFs for sequences (and an MP4 with --video), and frames.json with delta, kappa and the "
+      "nearest observed expression of "
       "every frame (also printed). Models on the face-model prior (icef-prior, warp-prior) also get "
       "fit_NNN.png: "
       "the fitted face model's outline at the frame's expression over the colour render.");
@@ -40,6 +41,13 @@ CommandFn RegisterRender(CLI::App& app) {
       ->check(CLI::Range(2, 1000));
   app.add_option("--sweep-beyond", o->sweep_beyond, "The sweep ends at this multiple of the target")
       ->capture_default_str();
+  auto video = std::make_shared<std::string>();
+  app.add_option(
+      "--video", *video,
+      "Also write the colour frames as an MP4 (H.264) at this path: orbits, sweeps, single frames");
+  app.add_option("--fps", o->fps, "Frame rate of --video")
+      ->capture_default_str()
+      ->check(CLI::Range(0.1, 240.0));
   app.add_option("--threads", o->threads, "Worker threads (0 = all cores)")->check(kNonNegative);
   app.add_option(
       "--set", o->overrides,
@@ -53,6 +61,7 @@ CommandFn RegisterRender(CLI::App& app) {
     if (!expression_frame->empty()) opts.expression_frame = *expression_frame;
     if (!sweep->empty()) opts.sweep = *sweep;
     if (*res > 0) opts.resolution = *res;
+    if (!video->empty()) opts.video = *video;
     if (!beta->empty()) {
       ICEF_ASSIGN_OR_RETURN(opts.beta, ParseVector(*beta));
     }
