@@ -179,6 +179,17 @@ PosedIctWarp IctWarp::Pose(std::span<const float> expression) const {
   return PosedIctWarp(*this, expression);
 }
 
+std::vector<Vec3f> IctWarp::VertexNormals(const std::vector<Vec3f>& mesh) const {
+  std::vector<Vec3f> normals(mesh.size(), Vec3f::Zero());
+  for (const auto& t : triangles_) {
+    const Vec3f n = (mesh[t[1]] - mesh[t[0]]).cross(mesh[t[2]] - mesh[t[0]]);
+    for (uint32_t v : t) normals[v] += n;
+  }
+  for (Vec3f& n : normals)
+    if (n.squaredNorm() > 0) n.normalize();
+  return normals;
+}
+
 std::string IctWarp::ToString() const {
   std::ostringstream os;
   os << "IctWarp(triangles=" << triangles_.size() << " of " << model_->triangles().size() << ", "

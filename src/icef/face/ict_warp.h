@@ -94,6 +94,9 @@ class IctWarp {
   // The warp's surface: the model's triangles (vertex indices) whose three vertices lie on the parts
   // named above, in model order.
   const std::vector<std::array<uint32_t, 3>>& triangles() const { return triangles_; }
+  // Area-weighted vertex normals of that surface on `mesh` (a mesh of the model: the neutral or a
+  // posed one), normalised: [mesh.size()], 0 at vertices off the surface.
+  std::vector<Vec3f> VertexNormals(const std::vector<Vec3f>& mesh) const;
   std::string ToString() const;
 
  private:

@@ -67,18 +67,6 @@ double BruteForceDistance(const IctWarp& warp, const std::vector<Vec3f>& mesh, c
   return best;
 }
 
-// Area-weighted vertex normals of the warp's surface on mesh: [num_vertices] (0 off the surface).
-std::vector<Vec3f> VertexNormals(const IctWarp& warp, const std::vector<Vec3f>& mesh) {
-  std::vector<Vec3f> normals(mesh.size(), Vec3f::Zero());
-  for (const auto& t : warp.triangles()) {
-    const Vec3f n = (mesh[t[1]] - mesh[t[0]]).cross(mesh[t[2]] - mesh[t[0]]);
-    for (uint32_t v : t) normals[v] += n;
-  }
-  for (Vec3f& n : normals)
-    if (n.squaredNorm() > 0) n.normalize();
-  return normals;
-}
-
 // count points x = (centroid of a random warp triangle of `part` on mesh) + distance * its normal.
 std::vector<Vec3f> PointsOverTriangles(const IctWarp& warp, const std::vector<Vec3f>& mesh,
                                        std::string_view part, float distance, int count, uint32_t seed) {
@@ -233,8 +221,8 @@ TEST(IctWarp, APointOutsideTheChinMapsOutsideTheNeutralChin) {
   ICT_WARP_OR_SKIP(w);
   const PosedIctWarp posed = w.Pose(Weights(w.model(), "jawOpen=1"));
   const int chin = w.model().landmark_vertices()[8];  // iBUG 8, the chin's tip
-  const Vec3f normal = VertexNormals(w, posed.posed())[chin];
-  const Vec3f canonical_normal = VertexNormals(w, w.neutral())[chin];
+  const Vec3f normal = w.VertexNormals(posed.posed())[chin];
+  const Vec3f canonical_normal = w.VertexNormals(w.neutral())[chin];
   const Vec3f x = posed.posed()[chin] + normal;
   const Vec3f mapped = x + Offsets(posed, {x})[0];
   const Vec3f from_chin = mapped - w.neutral()[chin];
@@ -293,7 +281,7 @@ TEST(IctWarp, FadesWithASmoothstepBetweenTheRadii) {
   const PosedIctWarp posed = w.Pose(beta), posed_full = full.Pose(beta);
   // Over the chin and lower lip, which jawOpen moves by centimetres.
   const int chin = w.model().landmark_vertices()[8];
-  const Vec3f normal = VertexNormals(w, posed.posed())[chin];
+  const Vec3f normal = w.VertexNormals(posed.posed())[chin];
   for (float distance : {0.5f, 2.f}) {
     const Vec3f x = posed.posed()[chin] + distance * normal;
     const float d = posed.Closest(x).distance;

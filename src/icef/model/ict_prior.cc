@@ -32,19 +32,6 @@ bool SameRow(const float* beta, const std::vector<float>& key) {
   return true;
 }
 
-// Area-weighted vertex normals of triangles on mesh, normalised: [mesh.size()] (0 off them).
-std::vector<Vec3f> VertexNormals(const std::vector<Vec3f>& mesh,
-                                 const std::vector<std::array<uint32_t, 3>>& triangles) {
-  std::vector<Vec3f> normals(mesh.size(), Vec3f::Zero());
-  for (const auto& t : triangles) {
-    const Vec3f n = (mesh[t[1]] - mesh[t[0]]).cross(mesh[t[2]] - mesh[t[0]]);
-    for (uint32_t v : t) normals[v] += n;
-  }
-  for (Vec3f& n : normals)
-    if (n.squaredNorm() > 0) n.normalize();
-  return normals;
-}
-
 Vec3f Interpolated(const std::vector<Vec3f>& values, const std::array<uint32_t, 3>& t, const Vec3f& b) {
   const Vec3f v = b[0] * values[t[0]] + b[1] * values[t[1]] + b[2] * values[t[2]];
   const float norm = v.norm();
@@ -229,9 +216,7 @@ bool MouthVolume::Inside(const Vec3f& x) const {
 
 struct IctPrior::Expression {
   Expression(const face::IctWarp& warp, const MouthSurface& surface, std::span<const float> beta)
-      : posed(warp.Pose(beta)),
-        mouth(surface, posed.posed()),
-        normals(VertexNormals(posed.posed(), warp.triangles())) {
+      : posed(warp.Pose(beta)), mouth(surface, posed.posed()), normals(warp.VertexNormals(posed.posed())) {
     float gap = 0;
     for (const auto& [upper, lower] : surface.inner_lips)
       gap += (posed.posed()[upper] - posed.posed()[lower]).norm();

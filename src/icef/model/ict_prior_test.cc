@@ -263,25 +263,13 @@ TEST(IctPrior, CavityIsTheOpenMouth) {
   EXPECT_LT(count, static_cast<int>(grid.size()) / 8);
 }
 
-// Area-weighted vertex normals of the warp's surface on mesh (0 off it).
-std::vector<Vec3f> VertexNormals(const face::IctWarp& warp, const std::vector<Vec3f>& mesh) {
-  std::vector<Vec3f> normals(mesh.size(), Vec3f::Zero());
-  for (const auto& t : warp.triangles()) {
-    const Vec3f n = (mesh[t[1]] - mesh[t[0]]).cross(mesh[t[2]] - mesh[t[0]]);
-    for (uint32_t v : t) normals[v] += n;
-  }
-  for (Vec3f& n : normals)
-    if (n.squaredNorm() > 0) n.normalize();
-  return normals;
-}
-
 TEST(IctPrior, NormalsAreThoseOfTheSurfaces) {
   ICT_PRIOR_OR_SKIP(p);
   const IctModel& m = *Model();
   const std::vector<float> jaw = Weights("jawOpen=1");
   const std::vector<Vec3f> posed = m.Mesh({}, jaw);
-  const std::vector<Vec3f> posed_normals = VertexNormals(p.warp(), posed);
-  const std::vector<Vec3f> neutral_normals = VertexNormals(p.warp(), m.neutral());
+  const std::vector<Vec3f> posed_normals = p.warp().VertexNormals(posed);
+  const std::vector<Vec3f> neutral_normals = p.warp().VertexNormals(m.neutral());
   const int chin = m.landmark_vertices()[8], nose = m.landmark_vertices()[30];
   const std::vector<Vec3f> points = {posed[chin] + 0.3f * posed_normals[chin],
                                      posed[nose] + 0.3f * posed_normals[nose], Vec3f(0, 0, 40)};
