@@ -10,13 +10,14 @@
 
 namespace icef::testing_app {
 
-// Writes dir/checkpoint.icef of the tiny "icef" model on the tiny setup; returns dir.
-inline std::filesystem::path WriteTinyModelDir(const std::filesystem::path& dir) {
+// Writes dir/checkpoint.icef of the tiny "icef" model on `setup` (the tiny setup by default); returns dir.
+inline std::filesystem::path WriteTinyModelDir(const std::filesystem::path& dir,
+                                               const ModelSetup& setup = testing_model::TinySetup()) {
   const Executor executor(1);
   RunConfig config;
   config.model = testing_model::TinyModelConfig("icef");
   config.train.steps = 10;
-  auto model = AvatarModel::Create(config.model, testing_model::TinySetup(), executor);
+  auto model = AvatarModel::Create(config.model, setup, executor);
   ICEF_CHECK(model.ok(), model.status().message());
   std::filesystem::create_directories(dir);
   TrainerState state;

@@ -62,6 +62,7 @@ Result<RealBenchOptions> ResolveRealBenchOptions(const BenchAppOptions& a) {
   if (!a.methods.empty()) r.methods = a.methods;
   if (a.real_test_frames) r.test_frames = *a.real_test_frames;
   if (a.video_frames) r.video_frames = *a.video_frames;
+  if (a.real_face_model) r.face_model = *a.real_face_model;
   if (a.resolution) r.resolution = *a.resolution;
   if (a.steps) r.steps = *a.steps;
   if (a.time_budget) r.time_budget_seconds = *a.time_budget;
@@ -84,8 +85,9 @@ Status RunBench(const BenchAppOptions& a, std::ostream& out) {
     ICEF_ASSIGN_OR_RETURN(const RealBenchOptions real, ResolveRealBenchOptions(a));
     return RunRealBench(real, out);
   }
-  if (a.real_test_frames || a.video_frames)
-    return Status::Error("--test and --video-frames go with --real (synthetic benches: --test-views)");
+  if (a.real_test_frames || a.video_frames || a.real_face_model)
+    return Status::Error(
+        "--test, --video-frames and --face-model go with --real (synthetic benches: --test-views)");
   ICEF_ASSIGN_OR_RETURN(const eval::BenchOptions options, ResolveBenchOptions(a));
   return eval::RunBench(options, out, a.interactive);
 }

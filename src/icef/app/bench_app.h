@@ -36,8 +36,9 @@ struct BenchAppOptions {
   // Real media instead of synthetic identities (app/real_bench_app.h): videos, photo folders or
   // datasets from icef track; the options above that apply carry over (ResolveRealBenchOptions).
   std::vector<std::filesystem::path> real;
-  std::optional<int> real_test_frames;  // with real: held-out frames per source
-  std::optional<int> video_frames;      // with real: frames tracked per video, spread over it
+  std::optional<int> real_test_frames;         // with real: held-out frames per source
+  std::optional<int> video_frames;             // with real: frames tracked per video, spread over it
+  std::optional<std::string> real_face_model;  // with real: the tracker's face model (procedural or ict)
   // Bench directories to merge into `out` (one report) instead of running (eval::MergeBench).
   std::vector<std::filesystem::path> merge;
 

@@ -77,6 +77,7 @@ Result<Dataset> TrackSource(const RealBenchOptions& o, const fs::path& source, c
   t.out = dir / "tracked";
   t.threads = o.threads;
   t.track.resolution = o.resolution;
+  t.track.face_model = *track::ParseTrackFaceModel(o.face_model);  // checked by Validate
   t.track.skip_bad = true;
   t.interactive = o.interactive;
   if (LooksLikeVideo(source)) {
@@ -214,6 +215,8 @@ Status RealBenchOptions::Validate() const {
   if (video_frames < *std::max_element(ks.begin(), ks.end()) + test_frames)
     return Status::Error("--video-frames: must be at least the largest K plus --test");
   if (steps < 1) return Status::Error("--steps: must be >= 1");
+  if (!track::ParseTrackFaceModel(face_model))
+    return Status::Error("--face-model: expected procedural or ict, got \"" + face_model + "\"");
   for (const std::string& m : methods)
     if (!ParseMethod(m).ok()) return Status::Error("--method: unknown method '" + m + "'");
   std::error_code ec;
@@ -230,7 +233,8 @@ std::string RealBenchOptions::ToString() const {
   for (size_t i = 0; i < ks.size(); ++i) os << (i ? ", " : "") << ks[i];
   os << "}, methods ";
   for (size_t i = 0; i < methods.size(); ++i) os << (i ? ", " : "") << methods[i];
-  os << ", " << test_frames << " held-out frames per source, " << video_frames << " frames tracked per video";
+  os << ", " << test_frames << " held-out frames per source, " << video_frames << " frames tracked per video"
+     << ", face model " << face_model;
   if (!overrides.empty()) os << ", " << overrides.size() << " config overrides";
   return os.str();
 }

@@ -24,18 +24,19 @@ struct RealBenchOptions {
   std::filesystem::path out_dir;               // created; sources/, runs/, report.*
   std::vector<int> ks = {3, 5, 10};            // training-frame counts (a source with fewer frames skips a K)
   std::vector<std::string> methods = {"icef-prior", "icef"};
-  int test_frames = 4;                 // held-out frames per source (a photo folder keeps >= min K to train)
-  int video_frames = 24;               // frames tracked from a video (spread over it)
-  int resolution = 256;                // tracked image side, pixels
-  int64_t steps = 1000;                // training steps per run
-  double time_budget_seconds = 0;      // training wall-clock cap per run (0 = none)
-  std::string config_path;             // base run config ("" = defaults)
-  std::vector<std::string> overrides;  // "section.key=value" for every run
-  int threads = 0;                     // worker threads (0 = all cores)
-  std::string faceid_model_dir;        // "" = default lookup
-  std::string lpips_weights;           // "" = LPIPS unavailable
-  bool keep_models = false;            // keep runs/<name>/model/
-  bool interactive = false;            // progress bars redraw in place
+  int test_frames = 4;    // held-out frames per source (a photo folder keeps >= min K to train)
+  int video_frames = 24;  // frames tracked from a video (spread over it)
+  int resolution = 256;   // tracked image side, pixels
+  std::string face_model = "procedural";  // the tracker's face model (track::TrackFaceModel's names)
+  int64_t steps = 1000;                   // training steps per run
+  double time_budget_seconds = 0;         // training wall-clock cap per run (0 = none)
+  std::string config_path;                // base run config ("" = defaults)
+  std::vector<std::string> overrides;     // "section.key=value" for every run
+  int threads = 0;                        // worker threads (0 = all cores)
+  std::string faceid_model_dir;           // "" = default lookup
+  std::string lpips_weights;              // "" = LPIPS unavailable
+  bool keep_models = false;               // keep runs/<name>/model/
+  bool interactive = false;               // progress bars redraw in place
 
   // Tiny settings for tests: K = 3, 2 held-out frames, 64 px, 20 steps, a tiny model.
   void ApplyQuick();

@@ -6,8 +6,10 @@
 
 #include "icef/app/face_outline.h"
 #include "icef/data/dataset.h"
+#include "icef/face/arkit_curves.h"
 #include "icef/io/atomic_file.h"
 #include "icef/io/gif_writer.h"
+#include "icef/model/ict_prior.h"
 #include "icef/model/render_image.h"
 #include "icef/model/trained_model.h"
 #include "icef/video/video_writer.h"
@@ -54,6 +56,35 @@ Status ApplyNamedValue(const ModelSetup& setup, const std::string& assignment, s
     return Status::Error("'" + assignment + "': value is not a finite number");
   (*beta)[index] = x;
   return Status::Ok();
+}
+
+// --expression: ARKit names, for a model in ICT-FaceKit's expression space.
+Result<std::vector<float>> ArkitExpression(const ModelSetup& setup, const std::string& text) {
+  ICEF_ASSIGN_OR_RETURN(const std::shared_ptr<const face::IctModel> ict, face::IctModel::LoadDefault());
+  if (!IsIctExpressionSpace(*ict, setup.expression_names))
+    return Status::Error(
+        "--expression: ARKit names need a model trained on a dataset in ICT-FaceKit's expressions (icef "
+        "track "
+        "--face-model ict); this model's are its own: use --set-expression NAME=VALUE");
+  Result<std::vector<float>> beta = face::ParseArkitExpression(*ict, text);
+  if (!beta.ok()) return beta.status().WithContext("--expression");
+  return beta;
+}
+
+// --expressions: the rows of a Live Link Face CSV, alone.
+Result<std::vector<std::vector<float>>> ArkitCurveExpressions(const ModelSetup& setup,
+                                                              const RenderAppOptions& o) {
+  if (o.arkit_expression || o.beta || o.expression_frame || o.sweep || !o.named.empty())
+    return Status::Error(
+        "--expressions: the CSV gives every frame's expression; leave out --expression, --beta, "
+        "--expression-frame, --set-expression and --sweep");
+  ICEF_ASSIGN_OR_RETURN(const std::shared_ptr<const face::IctModel> ict, face::IctModel::LoadDefault());
+  if (!IsIctExpressionSpace(*ict, setup.expression_names))
+    return Status::Error(
+        "--expressions: ARKit curves need a model trained on a dataset in ICT-FaceKit's expressions (icef "
+        "track --face-model ict)");
+  ICEF_ASSIGN_OR_RETURN(face::ArkitCurves curves, face::ReadArkitCurves(*ict, *o.arkit_curves));
+  return std::move(curves.weights);
 }
 
 std::vector<Camera> OrbitCameras(const ModelSetup& setup, int count, double yaw_deg, double pitch_deg,
@@ -152,6 +183,7 @@ Result<std::vector<Camera>> RenderCameras(const RenderAppOptions& o, const Model
 // from it towards --sweep's target and beyond.
 Result<std::vector<std::vector<float>>> RenderExpressions(const RenderAppOptions& o, const ModelSetup& setup,
                                                           const std::optional<Dataset>& dataset) {
+  if (o.arkit_curves) return ArkitCurveExpressions(setup, o);
   std::vector<float> base(setup.expression_dim, 0.f);
   if (o.expression_frame) {
     ICEF_ASSIGN_OR_RETURN(const Frame* f, FindFrame(*dataset, *o.expression_frame, "--expression-frame"));
@@ -162,6 +194,9 @@ Result<std::vector<std::vector<float>>> RenderExpressions(const RenderAppOptions
       return Status::Error("--beta: expected " + std::to_string(setup.expression_dim) + " values, got " +
                            std::to_string(o.beta->size()));
     base = *o.beta;
+  }
+  if (o.arkit_expression) {
+    ICEF_ASSIGN_OR_RETURN(base, ArkitExpression(setup, *o.arkit_expression));
   }
   for (const std::string& a : o.named)
     ICEF_RETURN_IF_ERROR(ApplyNamedValue(setup, a, &base).WithContext("--set-expression"));

@@ -34,14 +34,20 @@ struct RenderAppOptions {
   std::optional<int> resolution;  // orbit/default camera: image height in pixels (width by aspect)
   std::optional<std::string> expression_frame;  // expression from a dataset frame: "split:index"
   std::optional<std::vector<float>> beta;       // explicit expression vector
-  std::vector<std::string> named;               // "name=value" on top of neutral (or of beta / frame)
-  std::optional<std::string> sweep;             // "name=value": neutral -> value * sweep_beyond
-  int sweep_frames = 16;                        // frames of a sweep
-  double sweep_beyond = 1.5;                    // the sweep ends at this multiple of the target
-  int gif_delay_cs = 8;                         // GIF frame delay (1/100 s)
-  std::optional<std::filesystem::path> video;   // also the colour frames as an MP4 (H.264) here
-  double fps = 25;                              // its frame rate
-  int threads = 0;                              // worker threads (0 = all cores)
+  // ARKit-named weights "jawOpen=0.8,mouthSmileLeft=0.5" (models trained on an ICT-FaceKit dataset):
+  // the whole expression, the weights not named 0 (face::ParseArkitExpression).
+  std::optional<std::string> arkit_expression;
+  // ARKit blendshape curves in Live Link Face's CSV layout (face/arkit_curves.h): one frame per row,
+  // instead of the expressions above (same models as arkit_expression).
+  std::optional<std::filesystem::path> arkit_curves;
+  std::vector<std::string> named;              // "name=value" on top of neutral (or of beta / frame)
+  std::optional<std::string> sweep;            // "name=value": neutral -> value * sweep_beyond
+  int sweep_frames = 16;                       // frames of a sweep
+  double sweep_beyond = 1.5;                   // the sweep ends at this multiple of the target
+  int gif_delay_cs = 8;                        // GIF frame delay (1/100 s)
+  std::optional<std::filesystem::path> video;  // also the colour frames as an MP4 (H.264) here
+  double fps = 25;                             // its frame rate
+  int threads = 0;                             // worker threads (0 = all cores)
   std::vector<std::string> overrides;  // "model.KEY=VALUE" of inference-only keys (model/trained_model.h)
 };
 

@@ -4,9 +4,11 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <sstream>
 
 #include "icef/app/app_test_util.h"
+#include "icef/face/ict_model.h"
 #include "icef/io/image.h"
 #include "icef/video/video_reader.h"
 
@@ -77,6 +79,49 @@ TEST(RenderApp, ArchitectureOverrideIsRefused) {
             std::string::npos)
       << s.message();
   EXPECT_FALSE(fs::exists(o.out / "color_000.png"));
+}
+
+// --expression and --expressions (ARKit names): a model in ICT-FaceKit's expression space is driven by a
+// Live Link Face CSV, one frame per row; a model in another space refuses both, naming the option.
+TEST(RenderApp, ArkitCurvesDriveAnIctSpaceModel) {
+  const fs::path dir = testing::MakeTempDir("render_app_arkit");
+  const face::IctModel& ict = **face::IctModel::LoadDefault();
+  ModelSetup setup = testing_model::TinySetup(ict.num_expressions());
+  setup.expression_names = ict.expression_names();
+  RenderAppOptions o;
+  o.model = testing_app::WriteTinyModelDir(dir / "model", setup);
+  o.out = dir / "out";
+  o.threads = 1;
+  o.arkit_curves = dir / "curves.csv";
+  {
+    std::ofstream csv(*o.arkit_curves);
+    csv << "Timecode,BlendShapeCount,JawOpen,EyeBlinkLeft,EyeBlinkRight,MouthSmileLeft,HeadYaw\n";
+    for (int i = 0; i < 3; ++i) csv << "00:00:00:0" << i << ".000,61," << 0.4 * i << ",0,0,0.5,0\n";
+  }
+  std::ostringstream out;
+  const Result<std::vector<RenderedFrameInfo>> frames = RunRender(o, out);
+  ASSERT_TRUE(frames.ok()) << frames.status().message();
+  EXPECT_EQ(frames->size(), 3u);
+  EXPECT_TRUE(fs::exists(o.out / "color_002.png"));
+  // One expression by name; a CSV beside it is refused.
+  o.out = dir / "one";
+  o.arkit_expression = "jawOpen=1,mouthSmileLeft=0.5,mouthSmileRight=0.5";
+  EXPECT_NE(RunRender(o, out).status().message().find("--expressions: the CSV gives"), std::string::npos);
+  o.arkit_curves.reset();
+  const Result<std::vector<RenderedFrameInfo>> one = RunRender(o, out);
+  ASSERT_TRUE(one.ok()) << one.status().message();
+  EXPECT_EQ(one->size(), 1u);
+  o.arkit_expression = "jawOpen=1,noSuchShape=1";
+  EXPECT_NE(RunRender(o, out).status().message().find("unknown expression 'noSuchShape'"), std::string::npos);
+
+  // The tiny model's own expression space knows no ARKit names.
+  RenderAppOptions other;
+  other.model = testing_app::WriteTinyModelDir(dir / "other");
+  other.out = dir / "other_out";
+  other.threads = 1;
+  other.arkit_expression = "jawOpen=1";
+  EXPECT_NE(RunRender(other, out).status().message().find("--expression: ARKit names need"),
+            std::string::npos);
 }
 
 }  // namespace

@@ -39,12 +39,12 @@ Image OverChecker(const Image& rgba) {
   return out;
 }
 
-std::string ExpressionText(const std::vector<float>& beta) {
+std::string ExpressionText(const std::vector<float>& beta, const std::vector<std::string>& names) {
   std::ostringstream os;
   os << std::fixed << std::setprecision(2);
   bool any = false;
-  for (int e = 0; e < face::kNumExpressions; ++e)
-    if (beta[e] >= 0.05f) os << (any ? " " : "") << face::kExpressionNames[e] << "=" << beta[e], any = true;
+  for (size_t e = 0; e < beta.size() && e < names.size(); ++e)
+    if (beta[e] >= 0.05f) os << (any ? " " : "") << names[e] << "=" << beta[e], any = true;
   return any ? os.str() : "neutral";
 }
 
@@ -234,7 +234,8 @@ Status RunTrack(const TrackAppOptions& options, std::ostream& out) {
     out << std::fixed << std::setprecision(3) << "  " << p.name << " -> " << (p.test ? "test" : "train")
         << "[" << p.frame_index << "]: landmark RMS " << f.rms_iod << " IOD, yaw " << std::setprecision(1)
         << ypr.x() << " pitch " << ypr.y() << " roll " << ypr.z() << ", focal " << p.photo_intrinsics.fl_x
-        << " px (" << track::FocalSourceName(p.focal_source) << "), " << ExpressionText(f.expression) << "\n";
+        << " px (" << track::FocalSourceName(p.focal_source) << "), "
+        << ExpressionText(f.expression, result.dataset.expression_names) << "\n";
     out << std::setprecision(3);
     char name[64];
     std::snprintf(name, sizeof(name), "track/overlay_%03zu.png", i);
@@ -258,6 +259,12 @@ namespace {
 // --generic-style) into `o`.
 Status ApplyNamedTrackChoices(const TrackCommandOptions& c, TrackAppOptions* o) {
   using Segmentation = track::TrackOptions::Segmentation;
+  const auto face_model = track::ParseTrackFaceModel(c.face_model);
+  if (!face_model)
+    return Status::Error("--face-model: expected procedural or ict, got \"" + c.face_model + "\"");
+  o->track.face_model = *face_model;
+  if (*face_model == track::TrackFaceModel::kIct && o->keep_cameras)
+    return Status::Error("--face-model ict: not yet with --keep-cameras (photos and videos only)");
   if (c.segmentation != "selfie" && c.segmentation != "none" && c.segmentation != "selfie-only")
     return Status::Error("--segmentation: expected selfie, none or selfie-only, got \"" + c.segmentation +
                          "\"");

@@ -66,6 +66,7 @@ Status RunTrack(const TrackAppOptions& options, std::ostream& out);
 struct TrackCommandOptions {
   TrackAppOptions app;                       // photos, out, resolution, frames, ...: taken as they are
   std::optional<double> focal;               // photos' focal length, pixels (nullopt: EXIF, else 35 mm)
+  std::string face_model = "procedural";     // the model fitted: procedural or ict (track::TrackFaceModel)
   std::string segmentation = "selfie";       // the dataset's alpha mask: selfie, none or selfie-only
   std::string landmarks = "detect";          // with keep_cameras: detect, dlib or model (RetrackLandmarks)
   bool generic_style = false;                // with keep_cameras and landmarks model: no subject style

@@ -116,6 +116,16 @@ TEST(TrackCommand, BadChoicesNameTheOption) {
   c.landmarks = "model";
   c.generic_style = true;  // without --keep-cameras
   EXPECT_NE(ResolveTrackOptions(c).status().message().find("--generic-style"), std::string::npos);
+  TrackCommandOptions model;
+  model.face_model = "flame";
+  EXPECT_NE(ResolveTrackOptions(model).status().message().find("--face-model: expected procedural or ict"),
+            std::string::npos);
+  model.face_model = "ict";
+  ASSERT_TRUE(ResolveTrackOptions(model).ok());
+  EXPECT_EQ(ResolveTrackOptions(model)->track.face_model, track::TrackFaceModel::kIct);
+  model.app.keep_cameras = true;
+  EXPECT_NE(ResolveTrackOptions(model).status().message().find("not yet with --keep-cameras"),
+            std::string::npos);
   TrackCommandOptions none;  // nothing to track
   EXPECT_NE(RunTrackCommand(none, std::cout, std::cerr).message().find("give the photos"), std::string::npos);
 }

@@ -92,8 +92,14 @@ Result<TrainSummary> RunTrain(const TrainAppOptions& o, std::ostream& out) {
   if (config.train.time_budget_seconds > 0) out << " or " << config.train.time_budget_seconds << " s";
   out << (o.resume ? ", resuming at step " + std::to_string(trainer->step()) : "") << "\n";
   if (!trainer->start_trials_note().empty()) out << trainer->start_trials_note() << "\n";
-  if (const std::optional<face::FaceFit>& fit = trainer->model().setup().face_fit) {
-    out << fit->BriefReport() << "\n";
+  const ModelSetup& setup = trainer->model().setup();
+  if (setup.face_fit || setup.ict_fit) {
+    if (setup.face_fit) {
+      out << setup.face_fit->BriefReport() << "\n";
+    } else {
+      out << "ICT-FaceKit fit: landmark RMS " << setup.ict_fit->rms_iod << " IOD over the training frames, "
+          << setup.ict_fit->identity.size() << " identity coefficients\n";
+    }
     if (const std::optional<Vec3f>& light = trainer->model().prior_light())
       out << "prior shading: light [" << light->x() << ", " << light->y() << ", " << light->z()
           << "] (strength " << light->norm() << ", fitted to the training images' skin)\n";
@@ -103,10 +109,9 @@ Result<TrainSummary> RunTrain(const TrainAppOptions& o, std::ostream& out) {
           << " unseen views per training frame, " << config.train.depth_prior_view_rays << " per step\n";
     if (!trainer->prior_shading_note().empty())
       out << "prior shading: off, no light fitted (" << trainer->prior_shading_note() << ")\n";
-    if (fit->Poor())
+    if ((setup.face_fit && setup.face_fit->Poor()) || (setup.ict_fit && setup.ict_fit->rms_iod > 0.1))
       out << "warning: the face model fits the landmarks poorly (RMS above 0.1 inter-ocular distances): the "
-             "prior "
-             "will pull expressions to the wrong places; check the dataset's landmarks and expression "
+             "prior will pull expressions to the wrong places; check the dataset's landmarks and expression "
              "vectors\n";
   }
   if (config.train.lambda_symmetry > 0) {

@@ -28,6 +28,7 @@ struct BenchArgs {
   std::string merge_out;
   int real_test = RealBenchOptions().test_frames;
   int video_frames = RealBenchOptions().video_frames;
+  std::string face_model = RealBenchOptions().face_model;
 };
 
 // --out ... --time-budget: what is run and for how long.
@@ -96,6 +97,12 @@ void AddRealOptions(CLI::App& app, BenchArgs& args) {
   app.add_option("--test", args.real_test, "With --real: held-out frames per source")->capture_default_str();
   app.add_option("--video-frames", args.video_frames, "With --real: frames tracked per video, spread over it")
       ->capture_default_str();
+  app.add_option(
+         "--face-model", args.face_model,
+         "With --real: the face model the sources are tracked with and the prior stands on: procedural "
+         "or ict (ICT-FaceKit; icef track --face-model)")
+      ->check(CLI::IsMember({"procedural", "ict"}))
+      ->capture_default_str();
 }
 
 // --merge and `icef bench merge`; returns the subcommand.
@@ -123,6 +130,7 @@ BenchAppOptions ToAppOptions(const BenchArgs& args, const CLI::App& app, const C
   if (app.count("--time-budget")) options.time_budget = given.time_budget_seconds;
   if (app.count("--test")) options.real_test_frames = args.real_test;
   if (app.count("--video-frames")) options.video_frames = args.video_frames;
+  if (app.count("--face-model")) options.real_face_model = args.face_model;
   for (const std::string& d : merge.parsed() ? args.merge_inputs : args.merge) options.merge.emplace_back(d);
   if (merge.parsed()) options.out = args.merge_out;
   options.interactive = StdoutIsTerminal();

@@ -21,6 +21,8 @@ CommandFn RegisterRender(CLI::App& app) {
   auto expression_frame = std::make_shared<std::string>();
   auto beta = std::make_shared<std::string>();
   auto sweep = std::make_shared<std::string>();
+  auto arkit = std::make_shared<std::string>();
+  auto curves = std::make_shared<std::string>();
   auto res = std::make_shared<int>(0);
   app.add_option("model", o->model, "Model directory (or checkpoint file)")->required();
   app.add_option("--out", o->out, "Output directory")->required();
@@ -33,6 +35,16 @@ CommandFn RegisterRender(CLI::App& app) {
   app.add_option("--res", *res, "Image height of orbit/default cameras, pixels")->check(CLI::Range(8, 4096));
   app.add_option("--expression-frame", *expression_frame, "Expression of a dataset frame, SPLIT:INDEX");
   app.add_option("--beta", *beta, "Expression vector, comma-separated (expression_dim values)");
+  app.add_option(
+      "--expression", *arkit,
+      "The expression by ARKit blendshape names, e.g. jawOpen=0.8,mouthSmileLeft=0.5 (the weights not "
+      "named are 0), for a model trained on a dataset from icef track --face-model ict");
+  app.add_option(
+      "--expressions", *curves,
+      "Drive the avatar: ARKit blendshape curves in Live Link Face's CSV layout (Timecode, "
+      "BlendShapeCount, EyeBlinkLeft, ..., JawOpen, ...; head and eye rotations ignored), one frame "
+      "per row, for a model trained on a dataset from icef track --face-model ict (with --video: "
+      "an MP4 at --fps)");
   app.add_option("--set-expression", o->named,
                  "NAME=VALUE on top of the expression, e.g. jaw_open=0.8 (repeatable)");
   app.add_option("--sweep", *sweep, "NAME=VALUE: frames from the expression to VALUE x --sweep-beyond");
@@ -60,6 +72,8 @@ CommandFn RegisterRender(CLI::App& app) {
     if (!dataset->empty()) opts.dataset = *dataset;
     if (!expression_frame->empty()) opts.expression_frame = *expression_frame;
     if (!sweep->empty()) opts.sweep = *sweep;
+    if (!arkit->empty()) opts.arkit_expression = *arkit;
+    if (!curves->empty()) opts.arkit_curves = *curves;
     if (*res > 0) opts.resolution = *res;
     if (!video->empty()) opts.video = *video;
     if (!beta->empty()) {

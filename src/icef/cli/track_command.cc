@@ -69,6 +69,13 @@ void AddInputOptions(CLI::App& app, TrackCommandOptions& o) {
 // --segmentation ... --generic-style: the mask, and the mode that keeps a dataset's cameras.
 void AddModeOptions(CLI::App& app, TrackCommandOptions& o) {
   app.add_option(
+         "--face-model", o.face_model,
+         "The face model fitted: procedural (the built-in procedural head, its 11 expressions; fits the "
+         "landmarks, the masks' outlines and the colours; default) or ict (ICT-FaceKit, learned from "
+         "scans: 100 identity modes, 53 ARKit-named expressions; fits the landmarks; the dataset's "
+         "expressions are its 53 weights)")
+      ->check(CLI::IsMember({"procedural", "ict"}));
+  app.add_option(
          "--segmentation", o.segmentation,
          "The dataset's alpha mask: selfie (GrabCut seeded by the fitted head, with what MediaPipe's selfie "
          "segmentation calls background as sure background; default; scripts/install-deps.sh installs its "

@@ -10,6 +10,8 @@
 #include <cstring>
 #include <fstream>
 #include <limits>
+#include <map>
+#include <mutex>
 #include <sstream>
 
 namespace icef::face {
@@ -242,6 +244,18 @@ Result<IctModel> IctModel::Load(const std::filesystem::path& path) {
 std::filesystem::path IctModel::DefaultPath() {
   if (const char* env = std::getenv("ICEF_FACE_MODEL"); env != nullptr && *env != '\0') return env;
   return std::filesystem::path(ICEF_SOURCE_DIR) / "models" / "ict-facekit" / "ict_facekit.bin";
+}
+
+Result<std::shared_ptr<const IctModel>> IctModel::LoadDefault() {
+  static std::mutex mutex;
+  static std::map<std::filesystem::path, std::shared_ptr<const IctModel>> loaded;
+  const std::filesystem::path path = DefaultPath();
+  const std::lock_guard<std::mutex> lock(mutex);
+  if (const auto it = loaded.find(path); it != loaded.end()) return it->second;
+  ICEF_ASSIGN_OR_RETURN(IctModel model, Load(path));
+  auto shared = std::make_shared<const IctModel>(std::move(model));
+  loaded[path] = shared;
+  return std::shared_ptr<const IctModel>(shared);
 }
 
 int IctModel::ExpressionIndex(std::string_view name) const {

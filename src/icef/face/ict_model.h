@@ -15,6 +15,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <span>
 #include <string>
 #include <string_view>
@@ -33,6 +34,8 @@ class IctModel {
   static Result<IctModel> Load(const std::filesystem::path& path);
   // $ICEF_FACE_MODEL when set and non-empty, else the repository's models/ict-facekit/ict_facekit.bin.
   static std::filesystem::path DefaultPath();
+  // The model at DefaultPath(), read once per process (per path) and shared; thread-safe.
+  static Result<std::shared_ptr<const IctModel>> LoadDefault();
 
   int num_vertices() const { return static_cast<int>(neutral_.size()); }
   int num_identities() const { return num_identities_; }

@@ -5,6 +5,7 @@
 
 #include "icef/face/expression.h"
 #include "icef/face/face_model.h"
+#include "icef/model/ict_prior.h"
 
 namespace icef {
 
@@ -172,6 +173,15 @@ Result<face::FaceFit> FitFaceModelToDataset(const Dataset& dataset, const face::
 }
 
 Result<std::unique_ptr<DeformationPrior>> MakeFacePrior(const ModelSetup& setup) {
+  if (setup.ict_fit) {
+    ICEF_ASSIGN_OR_RETURN(std::shared_ptr<const face::IctModel> model, face::IctModel::LoadDefault());
+    if (!IsIctExpressionSpace(*model, setup.expression_names))
+      return Status::Error("model setup: an ICT-FaceKit fit, but the expressions are not ICT-FaceKit's");
+    ICEF_ASSIGN_OR_RETURN(
+        std::unique_ptr<IctPrior> prior,
+        IctPrior::Create(std::move(model), setup.ict_fit->identity, setup.ict_fit->head_from_world));
+    return std::unique_ptr<DeformationPrior>(std::move(prior));
+  }
   ICEF_RETURN_IF_ERROR(CheckFaceModelExpressions(setup.expression_names, "model setup"));
   if (!setup.face_fit)
     return Status::Error("model setup: the face-model prior needs a face-model fit (none saved)");

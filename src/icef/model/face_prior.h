@@ -23,7 +23,8 @@ Status CheckFaceModelExpressions(const std::vector<std::string>& expression_name
 // frames without landmarks, a failed fit.
 Result<face::FaceFit> FitFaceModelToDataset(const Dataset& dataset, const face::FaceFitOptions& options = {});
 
-// The prior of setup.face_fit. Errors: no face-model fit, another expression space.
+// The prior of setup.ict_fit (IctPrior) when there is one, else of setup.face_fit (the procedural
+// model's). Errors: no face-model fit, another expression space.
 Result<std::unique_ptr<DeformationPrior>> MakeFacePrior(const ModelSetup& setup);
 
 }  // namespace icef

@@ -7,6 +7,8 @@
 #include <sstream>
 #include <utility>
 
+#include "icef/face/ict_fit.h"
+
 namespace icef {
 
 namespace {
@@ -434,6 +436,38 @@ Result<face::Similarity> FitIctHeadFromWorld(const face::IctModel& model, std::s
   if (!std::isfinite(s.scale) || !(s.scale > 0) || !s.rotation.allFinite() || !s.translation.allFinite())
     return Status::Error("FitIctHeadFromWorld: the alignment failed (" + s.ToString() + ")");
   return s;
+}
+
+bool IsIctExpressionSpace(const face::IctModel& model, const std::vector<std::string>& expression_names) {
+  return expression_names == model.expression_names();
+}
+
+Result<IctFaceFit> FitIctToDataset(const face::IctModel& model, const Dataset& dataset) {
+  const std::string origin = dataset.root.string();
+  if (!IsIctExpressionSpace(model, dataset.expression_names))
+    return Status::Error(origin + ": the ICT-FaceKit prior needs the model's " +
+                         std::to_string(model.num_expressions()) +
+                         " expressions (expression_names as `icef track --face-model ict` writes them)");
+  std::vector<face::IctObservation> observations;
+  std::vector<std::vector<Vec3f>> landmarks_3d;
+  for (const Frame& f : dataset.train) {
+    if (!f.landmarks_2d || !f.landmarks_3d) continue;
+    observations.push_back(face::IctObservation{f.camera.intrinsics(), *f.landmarks_2d, {}});
+    landmarks_3d.push_back(*f.landmarks_3d);
+  }
+  if (observations.empty())
+    return Status::Error(origin +
+                         ": the ICT-FaceKit fit needs landmarks_2d and landmarks_3d on the training frames "
+                         "(`icef track --face-model ict` writes both)");
+  Result<face::IctFit> fit = face::FitIctToLandmarks(model, observations, face::IctFitOptions::ForPhotos());
+  if (!fit.ok()) return fit.status().WithContext(origin + ": ICT-FaceKit fit");
+  IctFaceFit out;
+  out.identity = fit->identity;
+  out.rms_iod = fit->rms_iod;
+  Result<face::Similarity> sim = FitIctHeadFromWorld(model, out.identity, landmarks_3d);
+  if (!sim.ok()) return sim.status().WithContext(origin);
+  out.head_from_world = *sim;
+  return out;
 }
 
 }  // namespace icef

@@ -38,10 +38,12 @@
 #include <vector>
 
 #include "icef/core/status.h"
+#include "icef/data/dataset.h"
 #include "icef/face/face_fit.h"
 #include "icef/face/ict_model.h"
 #include "icef/face/ict_warp.h"
 #include "icef/field/deformation_prior.h"
+#include "icef/model/model_setup.h"
 
 namespace icef {
 
@@ -126,5 +128,16 @@ class IctPrior final : public DeformationPrior {
 // Non-finite landmarks are skipped. Errors: no frames, a frame without 68 landmarks, too few points.
 Result<face::Similarity> FitIctHeadFromWorld(const face::IctModel& model, std::span<const float> identity,
                                              const std::vector<std::vector<Vec3f>>& landmarks_3d_world);
+
+// True when the names are the model's expressions, in its order (a dataset `icef track --face-model
+// ict` wrote).
+bool IsIctExpressionSpace(const face::IctModel& model, const std::vector<std::string>& expression_names);
+
+// ICT fitted to a dataset in its expression space: the identity from the training frames' 2D
+// landmarks and intrinsics (face::FitIctToLandmarks with IctFitOptions::ForPhotos, each frame's pose
+// and expression free), then
+// head_from_world from their world-frame landmarks_3d (FitIctHeadFromWorld). Errors name the
+// dataset: another expression space, training frames without both landmarks, a failed fit.
+Result<IctFaceFit> FitIctToDataset(const face::IctModel& model, const Dataset& dataset);
 
 }  // namespace icef

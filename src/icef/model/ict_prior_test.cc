@@ -8,6 +8,8 @@
 #include <filesystem>
 #include <random>
 
+#include "icef/model/face_prior.h"
+
 namespace icef {
 namespace {
 
@@ -312,6 +314,81 @@ TEST(IctPrior, FitIctHeadFromWorldRoundTrips) {
   EXPECT_FALSE(FitIctHeadFromWorld(m, {}, {}).ok());
   EXPECT_FALSE(FitIctHeadFromWorld(m, {}, {std::vector<Vec3f>(67, Vec3f::Zero())}).ok());
   EXPECT_FALSE(FitIctHeadFromWorld(m, {}, {std::vector<Vec3f>(68, Vec3f::Zero())}).ok());
+}
+
+// A dataset in ICT's expression space (as icef track --face-model ict writes it): an identity fit from
+// its 2D landmarks and head_from_world from its 3D ones; the setup carries the fit through JSON and
+// MakeFacePrior builds the ICT prior from it.
+TEST(IctPrior, DatasetFitBecomesThePrior) {
+  if (Model() == nullptr) GTEST_SKIP() << "no face model at " << IctModel::DefaultPath();
+  const IctModel& m = *Model();
+  const face::Similarity truth = HeadFromWorld();
+  std::vector<float> identity(10, 0.f);
+  identity[0] = 1.f;
+  identity[3] = -0.8f;
+  Dataset d;
+  d.root = "ict_dataset";
+  d.expression_names = m.expression_names();
+  d.expression_dim = m.num_expressions();
+  const char* expressions[] = {"", "jawOpen=0.4", "mouthSmileLeft=0.6,mouthSmileRight=0.6"};
+  for (int k = 0; k < 3; ++k) {
+    const std::vector<Vec3f> world = ToWorld(m.Landmarks(m.Mesh(identity, Weights(expressions[k]))));
+    Intrinsics in;
+    in.width = in.height = 512;
+    in.fl_x = in.fl_y = 900;
+    in.cx = in.cy = 256;
+    // The camera 0.6 m from the head's nose, turned about the head's up axis.
+    const Vec3d nose = world[30].cast<double>();
+    const Vec3d up = truth.rotation.transpose() * Vec3d::UnitY();
+    const Vec3d forward = truth.rotation.transpose() *
+                          Eigen::AngleAxisd((k - 1) * 0.4, Vec3d::UnitY()).toRotationMatrix() *
+                          Vec3d::UnitZ();
+    Frame f;
+    f.camera = Camera::LookAt(in, nose + 0.6 * forward, nose, up);
+    f.expression = Weights(expressions[k]);
+    std::vector<Vec2f> uv;
+    for (const Vec3f& x : world) uv.push_back(f.camera.Project(x.cast<double>())->uv.cast<float>());
+    f.landmarks_2d = uv;
+    f.landmarks_3d = world;
+    d.train.push_back(f);
+  }
+  const Result<IctFaceFit> fit = FitIctToDataset(m, d);
+  ASSERT_TRUE(fit.ok()) << fit.status().message();
+  EXPECT_LT(fit->rms_iod, 0.02);
+  EXPECT_NEAR(fit->head_from_world.scale / truth.scale, 1.0, 0.03);
+  EXPECT_LT((fit->head_from_world.rotation - truth.rotation).norm(), 0.03);
+  // The fitted head's nose tip lies where the world's does (cm).
+  const std::vector<Vec3f> fitted = m.Landmarks(m.Mesh(fit->identity, {}));
+  const Vec3d nose = fit->head_from_world.Apply(d.train[0].landmarks_3d->at(30).cast<double>());
+  EXPECT_LT((nose - fitted[30].cast<double>()).norm(), 0.5);
+
+  ModelSetup setup;
+  setup.expression_dim = d.expression_dim;
+  setup.expression_names = d.expression_names;
+  setup.ict_fit = *fit;
+  Result<std::unique_ptr<DeformationPrior>> prior = MakeFacePrior(setup);
+  ASSERT_TRUE(prior.ok()) << prior.status().message();
+  EXPECT_EQ((*prior)->expression_dims(), m.num_expressions());
+  EXPECT_NE((*prior)->ToString().find("IctPrior"), std::string::npos) << (*prior)->ToString();
+  // Through JSON.
+  setup.training_expressions = {d.train[0].expression};
+  setup.training_cameras = {d.train[0].camera};
+  setup.mask_landmarks = *d.train[0].landmarks_3d;
+  const Result<ModelSetup> back = ModelSetup::FromJson(setup.ToJson(), "setup");
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  ASSERT_TRUE(back->ict_fit.has_value());
+  EXPECT_EQ(back->ict_fit->identity, fit->identity);
+  EXPECT_NEAR(back->ict_fit->head_from_world.scale, fit->head_from_world.scale, 1e-9);
+
+  // Another expression space, or no landmarks: one line naming the dataset.
+  Dataset other = d;
+  other.expression_names[0] = "jaw_open";
+  EXPECT_NE(FitIctToDataset(m, other).status().message().find("ict_dataset: the ICT-FaceKit prior needs"),
+            std::string::npos);
+  Dataset bare = d;
+  for (Frame& f : bare.train) f.landmarks_3d.reset();
+  EXPECT_NE(FitIctToDataset(m, bare).status().message().find("needs landmarks_2d and landmarks_3d"),
+            std::string::npos);
 }
 
 // Not an assertion: prints how long 100k points take with 3 distinct expressions (rays of 64 samples).

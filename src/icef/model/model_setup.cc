@@ -23,6 +23,34 @@ Result<ModelSetup> ModelSetup::FromDataset(const Dataset& dataset, const Executo
   return s;
 }
 
+namespace {
+
+Json SimilarityToJson(const face::Similarity& sim) {
+  Json rot = Json::array();
+  for (int r = 0; r < 3; ++r) rot.push_back({sim.rotation(r, 0), sim.rotation(r, 1), sim.rotation(r, 2)});
+  return {{"scale", sim.scale},
+          {"rotation", rot},
+          {"translation", {sim.translation.x(), sim.translation.y(), sim.translation.z()}}};
+}
+
+Result<face::Similarity> SimilarityFromJson(const JsonObjectView& parent, const char* key) {
+  ICEF_ASSIGN_OR_RETURN(const JsonObjectView sim, parent.Object(key));
+  face::Similarity s;
+  ICEF_ASSIGN_OR_RETURN(s.scale, sim.Number("scale"));
+  if (!(s.scale > 0)) return sim.Error("scale", "must be > 0");
+  ICEF_ASSIGN_OR_RETURN(const auto rot, sim.NumberMatrix("rotation", 3, 3));
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) s.rotation(r, c) = rot[r][c];
+  const Mat3d& rm = s.rotation;
+  if ((rm * rm.transpose() - Mat3d::Identity()).norm() > 1e-4 || rm.determinant() < 0)
+    return sim.Error("rotation", "must be a rotation matrix");
+  ICEF_ASSIGN_OR_RETURN(const auto t, sim.NumberArray("translation", 3));
+  s.translation = Vec3d(t[0], t[1], t[2]);
+  return s;
+}
+
+}  // namespace
+
 Json ModelSetup::ToJson() const {
   Json j;
   j["aabb"] = {{aabb.min.x(), aabb.min.y(), aabb.min.z()}, {aabb.max.x(), aabb.max.y(), aabb.max.z()}};
@@ -56,22 +84,21 @@ Json ModelSetup::ToJson() const {
     Json shape = Json::object();
     const auto values = f.shape.ToArray();
     for (int i = 0; i < face::ShapeParams::kCount; ++i) shape[face::kShapeParamNames[i]] = values[i];
-    const face::Similarity& sim = f.head_from_world;
-    Json rot = Json::array();
-    for (int r = 0; r < 3; ++r) rot.push_back({sim.rotation(r, 0), sim.rotation(r, 1), sim.rotation(r, 2)});
     Json style = Json::object();
     for (const auto& [name, value] : f.style.Fields()) style[name] = value;
     j["face_fit"] = {{"shape", shape},
                      {"style", style},
-                     {"head_from_world",
-                      {{"scale", sim.scale},
-                       {"rotation", rot},
-                       {"translation", {sim.translation.x(), sim.translation.y(), sim.translation.z()}}}},
+                     {"head_from_world", SimilarityToJson(f.head_from_world)},
                      {"rms_iod", f.rms_iod},
                      {"max_iod", f.max_iod},
                      {"landmarks_used", f.landmarks_used},
                      {"landmarks_total", f.landmarks_total},
                      {"iterations", f.iterations}};
+  }
+  if (ict_fit) {
+    j["ict_fit"] = {{"identity", ict_fit->identity},
+                    {"head_from_world", SimilarityToJson(ict_fit->head_from_world)},
+                    {"rms_iod", ict_fit->rms_iod}};
   }
   return j;
 }
@@ -132,23 +159,25 @@ Result<ModelSetup> ModelSetup::FromJson(const Json& json, const std::string& ori
       }
       if (Status st = f.style.Validate(); !st.ok()) return fv.Error("style", st.message());
     }
-    ICEF_ASSIGN_OR_RETURN(const JsonObjectView sim, fv.Object("head_from_world"));
-    ICEF_ASSIGN_OR_RETURN(f.head_from_world.scale, sim.Number("scale"));
-    if (!(f.head_from_world.scale > 0)) return sim.Error("scale", "must be > 0");
-    ICEF_ASSIGN_OR_RETURN(const auto rot, sim.NumberMatrix("rotation", 3, 3));
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) f.head_from_world.rotation(r, c) = rot[r][c];
-    const Mat3d& rm = f.head_from_world.rotation;
-    if ((rm * rm.transpose() - Mat3d::Identity()).norm() > 1e-4 || rm.determinant() < 0)
-      return sim.Error("rotation", "must be a rotation matrix");
-    ICEF_ASSIGN_OR_RETURN(const auto t, sim.NumberArray("translation", 3));
-    f.head_from_world.translation = Vec3d(t[0], t[1], t[2]);
+    ICEF_ASSIGN_OR_RETURN(f.head_from_world, SimilarityFromJson(fv, "head_from_world"));
     ICEF_ASSIGN_OR_RETURN(f.rms_iod, fv.Number("rms_iod"));
     ICEF_ASSIGN_OR_RETURN(f.max_iod, fv.Number("max_iod"));
     ICEF_ASSIGN_OR_RETURN(f.landmarks_used, fv.Int("landmarks_used"));
     ICEF_ASSIGN_OR_RETURN(f.landmarks_total, fv.Int("landmarks_total"));
     ICEF_ASSIGN_OR_RETURN(f.iterations, fv.Int("iterations"));
     s.face_fit = f;
+  }
+  if (v.Has("ict_fit")) {
+    ICEF_ASSIGN_OR_RETURN(const JsonObjectView fv, v.Object("ict_fit"));
+    IctFaceFit f;
+    ICEF_ASSIGN_OR_RETURN(const std::vector<double> identity, fv.NumberArray("identity"));
+    for (const double c : identity) {
+      if (!std::isfinite(c)) return fv.Error("identity", "must be finite numbers");
+      f.identity.push_back(static_cast<float>(c));
+    }
+    ICEF_ASSIGN_OR_RETURN(f.head_from_world, SimilarityFromJson(fv, "head_from_world"));
+    ICEF_ASSIGN_OR_RETURN(f.rms_iod, fv.Number("rms_iod"));
+    s.ict_fit = std::move(f);
   }
   if (v.Has("prior_light")) {
     ICEF_ASSIGN_OR_RETURN(const auto l, v.NumberArray("prior_light", 3));

@@ -18,6 +18,13 @@
 
 namespace icef {
 
+// ICT-FaceKit fitted to a dataset in its expression space (model/ict_prior.h: FitIctToDataset).
+struct IctFaceFit {
+  std::vector<float> identity;       // coefficients of the first identity modes
+  face::Similarity head_from_world;  // dataset world frame -> ICT head frame (cm)
+  double rms_iod = 0;                // the identity fit's landmark RMS over the training frames (IOD)
+};
+
 struct ModelSetup {
   Aabb aabb;  // world frame
   int expression_dim = 0;
@@ -27,7 +34,8 @@ struct ModelSetup {
   std::string mask_source;                               // where the landmarks came from
   Vec3f background = Vec3f::Ones();
   std::vector<Camera> training_cameras;   // [K] (renders default to their intrinsics and views)
-  std::optional<face::FaceFit> face_fit;  // the fitted face model (model/face_prior.h), if any
+  std::optional<face::FaceFit> face_fit;  // the fitted procedural face model (model/face_prior.h), if any
+  std::optional<IctFaceFit> ict_fit;      // the fitted ICT-FaceKit model (model/ict_prior.h), if any
   std::optional<Vec3f> prior_light;       // the prior shading's light (model/prior_light.h), if fitted
 
   // From a loaded dataset's training split; the landmarks come from RegionMask::FromDataset's

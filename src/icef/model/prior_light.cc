@@ -7,6 +7,8 @@
 #include <sstream>
 
 #include "icef/face/face_model.h"
+#include "icef/face/ict_warp.h"
+#include "icef/face/mesh_depth.h"
 
 namespace icef {
 
@@ -103,18 +105,108 @@ std::string PriorLightFit::BriefReport() const {
   return os.str();
 }
 
-Result<PriorLightFit> FitPriorLight(const Dataset& dataset, const face::FaceFit& fit,
-                                    const Executor& executor) {
+namespace {
+
+// The skin pixels of every training frame, by `skin(frame, image, stride)`.
+template <class SkinFn>
+Result<std::vector<SkinPixel>> DatasetSkinPixels(const Dataset& dataset, SkinFn&& skin) {
   if (dataset.train.empty())
     return Status::Error(dataset.root.string() + ": no training frames to fit the light to");
-  const face::FaceModel model(fit.shape, fit.style);
   std::vector<SkinPixel> pixels;
   for (const Frame& frame : dataset.train) {
     ICEF_ASSIGN_OR_RETURN(const Image image, LoadFrameImage(dataset, frame));
     const int stride = std::max(1, frame.camera.width() / 128);
-    std::vector<SkinPixel> p = SkinPixels(frame, image, model, fit.head_from_world, stride, executor);
+    std::vector<SkinPixel> p = skin(frame, image, stride);
     pixels.insert(pixels.end(), p.begin(), p.end());
   }
+  return pixels;
+}
+
+// ICT-FaceKit's skin pixels of one frame (every `stride`-th pixel in each direction): the first hit
+// of the pixel's ray on the posed mesh (face/mesh_depth.h) is on the face part, its canonical point
+// (the same barycentric point of the neutral) inside the neutral landmarks' box as above, and the
+// interpolated vertex normal faces the camera.
+std::vector<SkinPixel> IctSkinPixels(const Frame& frame, const Image& image, const face::IctWarp& warp,
+                                     const IctFaceFit& fit, int stride) {
+  const face::IctModel& model = warp.model();
+  std::vector<float> beta(frame.expression);
+  for (float& b : beta) b = std::isfinite(b) ? std::max(b, 0.f) : 0.f;
+  beta.resize(model.num_expressions(), 0.f);
+  const std::vector<Vec3f> posed = model.Mesh(fit.identity, beta);
+  const std::vector<Vec3f> normals = warp.VertexNormals(posed);
+  const face::Similarity& s = fit.head_from_world;
+  std::vector<Vec3f> world;
+  for (const Vec3f& p : posed) world.push_back(s.ApplyInverse(p.cast<double>()).cast<float>());
+  std::vector<int32_t> hit;
+  const std::vector<float> depth = face::MeshDepthImage(world, warp.triangles(), frame.camera, &hit);
+  Vec3f face_lo = Vec3f::Constant(std::numeric_limits<float>::infinity());
+  Vec3f face_hi = -face_lo;
+  for (const Vec3f& q : model.Landmarks(warp.neutral())) {
+    face_lo = face_lo.cwiseMin(q);
+    face_hi = face_hi.cwiseMax(q);
+  }
+  const int face = model.PartIndex("face");
+  const Mat3f world_from_head = s.rotation.transpose().cast<float>();
+  std::vector<SkinPixel> out;
+  const int w = frame.camera.width(), h = frame.camera.height();
+  for (int y = 0; y < h; y += stride)
+    for (int x = 0; x < w; x += stride) {
+      const size_t i = size_t(y) * w + x;
+      if (hit[i] < 0 || (image.channels == 4 && image.At(x, y, 3) < 0.99f)) continue;
+      const auto& t = warp.triangles()[hit[i]];
+      if (model.part_labels()[t[0]] != face) continue;
+      // The hit's barycentric coordinates on the posed triangle (head frame).
+      const Ray ray = frame.camera.PixelRay(x, y);
+      const Vec3d p = s.Apply(ray.At(depth[i]).cast<double>());
+      const Vec3d a = posed[t[0]].cast<double>(), e1 = posed[t[1]].cast<double>() - a,
+                  e2 = posed[t[2]].cast<double>() - a, q = p - a;
+      const double d11 = e1.dot(e1), d12 = e1.dot(e2), d22 = e2.dot(e2), det = d11 * d22 - d12 * d12;
+      if (!(det > 0)) continue;
+      const double b1 = (d22 * q.dot(e1) - d12 * q.dot(e2)) / det,
+                   b2 = (d11 * q.dot(e2) - d12 * q.dot(e1)) / det;
+      const Vec3f b(float(1 - b1 - b2), float(b1), float(b2));
+      const Vec3f c = b[0] * warp.neutral()[t[0]] + b[1] * warp.neutral()[t[1]] + b[2] * warp.neutral()[t[2]];
+      if (c.x() < face_lo.x() || c.x() > face_hi.x() || c.y() < face_lo.y() || c.y() > face_hi.y() ||
+          c.z() < face_lo.z())
+        continue;
+      const Vec3f n_head = (b[0] * normals[t[0]] + b[1] * normals[t[1]] + b[2] * normals[t[2]]).normalized();
+      const Vec3f n = world_from_head * n_head;
+      if (-n.dot(ray.direction) < 0.3f) continue;  // grazing
+      SkinPixel sp;
+      sp.normal = n;
+      for (int ch = 0; ch < 3; ++ch) sp.color[ch] = image.At(x, y, ch);
+      out.push_back(sp);
+    }
+  return out;
+}
+
+Result<PriorLightFit> FitLightToPixels(const std::vector<SkinPixel>& pixels, const Dataset& dataset);
+
+}  // namespace
+
+Result<PriorLightFit> FitPriorLight(const Dataset& dataset, const face::FaceFit& fit,
+                                    const Executor& executor) {
+  const face::FaceModel model(fit.shape, fit.style);
+  ICEF_ASSIGN_OR_RETURN(const std::vector<SkinPixel> pixels,
+                        DatasetSkinPixels(dataset, [&](const Frame& frame, const Image& image, int stride) {
+                          return SkinPixels(frame, image, model, fit.head_from_world, stride, executor);
+                        }));
+  return FitLightToPixels(pixels, dataset);
+}
+
+Result<PriorLightFit> FitPriorLight(const Dataset& dataset, const IctFaceFit& fit) {
+  ICEF_ASSIGN_OR_RETURN(const std::shared_ptr<const face::IctModel> model, face::IctModel::LoadDefault());
+  ICEF_ASSIGN_OR_RETURN(const face::IctWarp warp, face::IctWarp::Create(*model, fit.identity));
+  ICEF_ASSIGN_OR_RETURN(const std::vector<SkinPixel> pixels,
+                        DatasetSkinPixels(dataset, [&](const Frame& frame, const Image& image, int stride) {
+                          return IctSkinPixels(frame, image, warp, fit, stride);
+                        }));
+  return FitLightToPixels(pixels, dataset);
+}
+
+namespace {
+
+Result<PriorLightFit> FitLightToPixels(const std::vector<SkinPixel>& pixels, const Dataset& dataset) {
   if (pixels.size() < kMinPixels)
     return Status::Error(dataset.root.string() + ": only " + std::to_string(pixels.size()) +
                          " training pixels show the fitted face model's face skin (fewer than " +
@@ -160,5 +252,7 @@ Result<PriorLightFit> FitPriorLight(const Dataset& dataset, const face::FaceFit&
   best.rms = std::sqrt(sq / (3.0 * pixels.size()));
   return best;
 }
+
+}  // namespace
 
 }  // namespace icef

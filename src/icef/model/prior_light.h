@@ -17,6 +17,7 @@
 #include "icef/data/dataset.h"
 #include "icef/face/face_fit.h"
 #include "icef/math/types.h"
+#include "icef/model/model_setup.h"
 
 namespace icef {
 
@@ -32,5 +33,8 @@ struct PriorLightFit {
 // trains without the prior shading and says so).
 Result<PriorLightFit> FitPriorLight(const Dataset& dataset, const face::FaceFit& fit,
                                     const Executor& executor);
+// The same through ICT-FaceKit's fit (model/ict_prior.h): the posed mesh's face skin, its
+// interpolated vertex normals. Deterministic.
+Result<PriorLightFit> FitPriorLight(const Dataset& dataset, const IctFaceFit& fit);
 
 }  // namespace icef

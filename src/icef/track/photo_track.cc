@@ -8,6 +8,7 @@
 #include <sstream>
 #include <system_error>
 
+#include "icef/core/enum_table.h"
 #include "icef/data/frame_coverage.h"
 #include "icef/face/expression.h"
 #include "icef/face/face_model.h"
@@ -15,12 +16,16 @@
 #include "icef/io/atomic_file.h"
 #include "icef/landmarks/face_mesh.h"
 #include "icef/track/dataset_retrack.h"
+#include "icef/track/ict_track.h"
 
 namespace icef::track {
 
 namespace {
 
 namespace fs = std::filesystem;
+
+// An ICT-tracked dataset's aabb around the neutral head: room for hair (world units, ~5 cm).
+constexpr float kIctAabbMargin = 0.13f;
 
 // Tier thresholds of the held-out photos (as `icef synth`'s defaults).
 constexpr double kNearThreshold = 0.35;
@@ -103,6 +108,9 @@ Intrinsics PhotoIntrinsics(const fs::path& exif_path, const Image& photo, const 
   return k;
 }
 
+// The fitted head's silhouette in a camera (world frame: the dataset's): what the mask starts from.
+using SilhouetteFn = std::function<Image(const TrackedFrame&, const Camera&)>;
+
 // A tracked photo's crop around the fitted head, its camera and its foreground mask.
 struct HeadCrop {
   CropBox box;
@@ -112,15 +120,15 @@ struct HeadCrop {
   Camera camera;  // the crop's camera (world = head frame)
 };
 
-HeadCrop CropHead(const face::FaceModel& model, const TrackedFrame& tracked, const TrackedPhoto& photo,
-                  const TrackOptions& options, const PersonSegmenter* segmenter, const Executor& executor) {
+HeadCrop CropHead(const SilhouetteFn& silhouette_of, const TrackedFrame& tracked, const TrackedPhoto& photo,
+                  const TrackOptions& options, const PersonSegmenter* segmenter) {
   HeadCrop c;
   const Camera photo_camera(photo.photo_intrinsics, Inverse(tracked.cam_from_head));
   c.box = HeadCropBox(photo_camera, options.crop_margin);
   c.rgb = CropImage(photo.photo, c.box, options.resolution, &c.outside);
   c.camera = Camera(CropIntrinsics(photo.photo_intrinsics, c.box, options.resolution),
                     Inverse(tracked.cam_from_head));
-  const Image silhouette = HeadSilhouette(model, tracked.expression, c.camera, executor);
+  const Image silhouette = silhouette_of(tracked, c.camera);
   Image person;
   if (segmenter) {
     Result<Image> p = segmenter->Run(c.rgb);
@@ -154,10 +162,9 @@ std::vector<Vec2f> SilhouettePoints(const HeadCrop& c, const TrackedPhoto& photo
 }
 
 // The dataset frame and image of one tracked photo.
-void BuildFrame(const face::FaceModel& model, const TrackedFrame& tracked, const TrackOptions& options,
-                const PersonSegmenter* segmenter, const Executor& executor, TrackedPhoto* photo,
-                Frame* frame) {
-  const HeadCrop c = CropHead(model, tracked, *photo, options, segmenter, executor);
+void BuildFrame(const SilhouetteFn& silhouette_of, const TrackedFrame& tracked, const TrackOptions& options,
+                const PersonSegmenter* segmenter, TrackedPhoto* photo, Frame* frame) {
+  const HeadCrop c = CropHead(silhouette_of, tracked, *photo, options, segmenter);
   photo->crop = c.box;
   photo->image = Image(options.resolution, options.resolution, 4);
   for (int y = 0; y < options.resolution; ++y)
@@ -174,14 +181,10 @@ void BuildFrame(const face::FaceModel& model, const TrackedFrame& tracked, const
   frame->landmarks_3d = std::vector<Vec3f>(tracked.landmarks_head.begin(), tracked.landmarks_head.end());
 }
 
-// Blinks: an eye-close weight above one half.
-bool IsBlink(const std::vector<float>& expression) {
-  return expression[face::kEyeCloseLeft] > 0.5f || expression[face::kEyeCloseRight] > 0.5f;
-}
-
 // Splits the tracked photos (TrackOptions::num_test, num_train): sets test and frame_index, and
 // drops the photos that are neither (with their fitted frames). Training frames keep input order.
-void AssignSplits(const TrackOptions& options, TrackResult* result) {
+void AssignSplits(const TrackOptions& options, const std::vector<std::string>& expression_names,
+                  TrackResult* result) {
   const int n = static_cast<int>(result->photos.size());
   std::vector<int> role(n, 0);  // 0: left out, 1: train, 2: test
   if (options.num_train <= 0) {
@@ -195,11 +198,11 @@ void AssignSplits(const TrackOptions& options, TrackResult* result) {
     std::vector<CoverageCandidate> candidates(n);
     for (int i = 0; i < n; ++i) {
       const TrackedFrame& f = result->fit.frames[i];
-      const Mat4d head_from_cam = Inverse(f.cam_from_head);
-      candidates[i].view_direction = head_from_cam.block<3, 1>(0, 3).normalized();
-      candidates[i].expression = f.expression;
+      Frame frame;  // the camera and expression CandidateOfFrame reads
+      frame.camera = Camera(result->photos[i].photo_intrinsics, Inverse(f.cam_from_head));
+      frame.expression = f.expression;
+      candidates[i] = CandidateOfFrame(frame, expression_names);
       candidates[i].sharpness = median > 0 ? sharpness[i] / median : 1;
-      candidates[i].blink = IsBlink(f.expression);
     }
     CoverageOptions co;
     co.allow_blink = options.allow_blink;
@@ -225,7 +228,63 @@ void AssignSplits(const TrackOptions& options, TrackResult* result) {
   result->fit.frames = std::move(frames);
 }
 
+// The procedural model's fit: landmarks, then (with silhouette_points) the outlines of the masks the
+// landmark fit gives, with the photometric refit in the last fit.
+Status FitProcedural(const TrackOptions& options, const Executor& executor, TrackResult* result,
+                     const std::function<void(const std::string&)>& log) {
+  std::vector<TrackFrame> frames;
+  for (const TrackedPhoto& p : result->photos)
+    frames.push_back(TrackFrame{p.detection.landmarks, p.photo_intrinsics, {}, {}, &p.photo});
+  // The images join in the last fit only (the photometric refit starts from the landmarks').
+  if (options.silhouette_points > 0)
+    for (TrackFrame& f : frames) f.photo = nullptr;
+  ICEF_ASSIGN_OR_RETURN(result->fit, FitTrack(frames, options.fit));
+  if (log) log(result->fit.BriefReport());
+  if (options.silhouette_points <= 0) return Status::Ok();
+  // Refit with the silhouettes of the masks the landmark fit gives.
+  const face::FaceModel first(result->fit.shape);
+  const SilhouetteFn silhouette_of = [&](const TrackedFrame& f, const Camera& camera) {
+    return HeadSilhouette(first, f.expression, camera, executor);
+  };
+  for (size_t i = 0; i < frames.size(); ++i) {
+    // GrabCut alone: the refit reads the mask's edge where skin lies just inside it (SkinEdges),
+    // which background GrabCut keeps rarely touches, and the fit proved sensitive to small changes
+    // of that edge (docs/tracking.md); the segmentation cleans the dataset's alpha only.
+    const HeadCrop c = CropHead(silhouette_of, result->fit.frames[i], result->photos[i], options, nullptr);
+    frames[i].silhouette = SilhouettePoints(c, result->photos[i], options.resolution,
+                                            options.silhouette_points, options.fit.silhouette_face_only);
+    frames[i].photo = &result->photos[i].photo;
+  }
+  ICEF_ASSIGN_OR_RETURN(result->fit, FitTrack(frames, options.fit));
+  if (log) log(result->fit.BriefReport() + " (refit with the masks' outlines)");
+  return Status::Ok();
+}
+
+// ICT's fit: landmarks only (track/ict_track.h).
+Status FitIct(const face::IctModel& model, const TrackOptions& options, TrackResult* result,
+              const std::function<void(const std::string&)>& log) {
+  std::vector<TrackFrame> frames;
+  for (const TrackedPhoto& p : result->photos)
+    frames.push_back(TrackFrame{p.detection.landmarks, p.photo_intrinsics, {}, {}, nullptr});
+  ICEF_ASSIGN_OR_RETURN(result->fit, FitIctTrack(model, frames, options.ict_fit));
+  std::ostringstream os;
+  os << "ICT-FaceKit fit to the landmarks of " << frames.size() << " photo" << (frames.size() == 1 ? "" : "s")
+     << ": RMS " << result->fit.rms_iod << " IOD (max " << result->fit.max_iod << "), "
+     << result->fit.iterations << " iterations";
+  if (log) log(os.str());
+  return Status::Ok();
+}
+
+constexpr std::array<EnumEntry<TrackFaceModel>, 2> kTrackFaceModelNames = {
+    {{TrackFaceModel::kProcedural, "procedural"}, {TrackFaceModel::kIct, "ict"}}};
+
 }  // namespace
+
+const char* TrackFaceModelName(TrackFaceModel model) { return EnumName(kTrackFaceModelNames, model); }
+
+std::optional<TrackFaceModel> ParseTrackFaceModel(const std::string& name) {
+  return ParseEnum(kTrackFaceModelNames, name);
+}
 
 double FaceSharpness(const Image& photo, std::span<const Vec2f> landmarks) {
   if (landmarks.empty()) return 0;
@@ -273,12 +332,17 @@ Status TrackOptions::Validate() const {
   if (!(crop_margin >= 1 && crop_margin <= 3)) return Status::Error("crop_margin must be in [1, 3]");
   if (silhouette_points < 0) return Status::Error("silhouette_points must be >= 0");
   ICEF_RETURN_IF_ERROR(fit.Validate());
+  ICEF_RETURN_IF_ERROR(ict_fit.Validate());
   return mask.Validate();
 }
 
 std::string TrackOptions::ToString() const {
   std::ostringstream os;
-  os << "TrackOptions(resolution=" << resolution << ", focal=" << (focal ? std::to_string(*focal) : "auto")
+  os << "TrackOptions(";
+  // The procedural model's options read as before ICT joined (the real bench's cached tracks stay valid).
+  if (face_model != TrackFaceModel::kProcedural)
+    os << "face_model=" << TrackFaceModelName(face_model) << ", " << ict_fit.ToString() << ", ";
+  os << "resolution=" << resolution << ", focal=" << (focal ? std::to_string(*focal) : "auto")
      << ", num_test=" << num_test << ", num_train=" << num_train << ", allow_blink=" << allow_blink
      << ", skip_bad=" << skip_bad << ", crop_margin=" << crop_margin
      << ", silhouette_points=" << silhouette_points << ", segmentation=" << static_cast<int>(segmentation)
@@ -354,31 +418,33 @@ Result<TrackResult> TrackInputs(std::vector<TrackInput> inputs, const TrackOptio
                          std::to_string(options.num_train + std::max(options.num_test, 1)) +
                          " frames with a face, got " + std::to_string(kept));
 
-  std::vector<TrackFrame> frames;
-  for (const TrackedPhoto& p : result.photos)
-    frames.push_back(TrackFrame{p.detection.landmarks, p.photo_intrinsics, {}, {}, &p.photo});
-  // The images join in the last fit only (the photometric refit starts from the landmarks').
-  if (options.silhouette_points > 0)
-    for (TrackFrame& f : frames) f.photo = nullptr;
-  ICEF_ASSIGN_OR_RETURN(result.fit, FitTrack(frames, options.fit));
-  if (log) log(result.fit.BriefReport());
-  if (options.silhouette_points > 0) {
-    // Refit with the silhouettes of the masks the landmark fit gives.
-    const face::FaceModel first(result.fit.shape);
-    for (int i = 0; i < kept; ++i) {
-      // GrabCut alone: the refit reads the mask's edge where skin lies just inside it (SkinEdges),
-      // which background GrabCut keeps rarely touches, and the fit proved sensitive to small changes
-      // of that edge (docs/tracking.md); the segmentation cleans the dataset's alpha only.
-      const HeadCrop c = CropHead(first, result.fit.frames[i], result.photos[i], options, nullptr, executor);
-      frames[i].silhouette = SilhouettePoints(c, result.photos[i], options.resolution,
-                                              options.silhouette_points, options.fit.silhouette_face_only);
-      frames[i].photo = &result.photos[i].photo;
-    }
-    ICEF_ASSIGN_OR_RETURN(result.fit, FitTrack(frames, options.fit));
-    if (log) log(result.fit.BriefReport() + " (refit with the masks' outlines)");
+  std::shared_ptr<const face::IctModel> ict;
+  if (options.face_model == TrackFaceModel::kIct) {
+    ICEF_ASSIGN_OR_RETURN(ict, face::IctModel::LoadDefault());
   }
+  ICEF_RETURN_IF_ERROR(ict ? FitIct(*ict, options, &result, log)
+                           : FitProcedural(options, executor, &result, log));
 
-  AssignSplits(options, &result);
+  Dataset& d = result.dataset;
+  SilhouetteFn silhouette_of;
+  if (ict) {
+    d.expression_names = ict->expression_names();
+    d.aabb = IctHeadBounds(*ict, result.fit.ict_identity, kIctAabbMargin);
+    silhouette_of = [&](const TrackedFrame& f, const Camera& camera) {
+      return IctSilhouette(*ict, result.fit.ict_identity, f.expression, camera);
+    };
+  } else {
+    d.expression_names = face::ExpressionNames();
+    const face::FaceModel model(result.fit.shape);
+    d.aabb = model.Bounds();
+    d.aabb.min -= Vec3f::Constant(0.1f);
+    d.aabb.max += Vec3f::Constant(0.1f);
+    silhouette_of = [&executor, model](const TrackedFrame& f, const Camera& camera) {
+      return HeadSilhouette(model, f.expression, camera, executor);
+    };
+  }
+  d.expression_dim = static_cast<int>(d.expression_names.size());
+  AssignSplits(options, d.expression_names, &result);
   const int used = static_cast<int>(result.photos.size());
   if (log && options.num_train > 0) {
     std::string line = "training frames chosen for coverage of pose and expression:";
@@ -386,14 +452,6 @@ Result<TrackResult> TrackInputs(std::vector<TrackInput> inputs, const TrackOptio
       if (!p.test) line += " " + p.name;
     log(line);
   }
-
-  Dataset& d = result.dataset;
-  d.expression_dim = face::kNumExpressions;
-  d.expression_names = face::ExpressionNames();
-  const face::FaceModel model(result.fit.shape);
-  d.aabb = model.Bounds();
-  d.aabb.min -= Vec3f::Constant(0.1f);
-  d.aabb.max += Vec3f::Constant(0.1f);
   d.background = Vec3f::Ones();
   d.tier_thresholds = std::array<double, 2>{kNearThreshold, kFarThreshold};
   d.train.resize(std::count_if(result.photos.begin(), result.photos.end(),
@@ -401,7 +459,7 @@ Result<TrackResult> TrackInputs(std::vector<TrackInput> inputs, const TrackOptio
   d.test.resize(used - d.train.size());
   for (int i = 0; i < used; ++i) {
     TrackedPhoto& p = result.photos[i];
-    BuildFrame(model, result.fit.frames[i], options, segmenter ? &*segmenter : nullptr, executor, &p,
+    BuildFrame(silhouette_of, result.fit.frames[i], options, segmenter ? &*segmenter : nullptr, &p,
                &(p.test ? d.test : d.train)[p.frame_index]);
   }
   for (Frame& f : d.test) {
@@ -421,8 +479,8 @@ Json TrackReportJson(const TrackResult& result) {
     const TrackedFrame& f = result.fit.frames[i];
     const Frame& frame = (p.test ? result.dataset.test : result.dataset.train)[p.frame_index];
     Json expression = Json::object();
-    for (int e = 0; e < face::kNumExpressions; ++e)
-      expression[face::kExpressionNames[e]] = JsonFloat(f.expression[e]);
+    for (size_t e = 0; e < f.expression.size(); ++e)
+      expression[result.dataset.expression_names[e]] = JsonFloat(f.expression[e]);
     const Vec3d ypr = f.YawPitchRollDeg();
     const Vec3d t = f.cam_from_head.block<3, 1>(0, 3);
     photos.push_back(Json{{"photo", p.source.string()},
@@ -445,17 +503,26 @@ Json TrackReportJson(const TrackResult& result) {
                           {"head_in_camera", {t.x(), t.y(), t.z()}},
                           {"expression", expression}});
   }
-  Json shape = Json::object();
-  const auto values = result.fit.shape.ToArray();
-  for (int i = 0; i < face::ShapeParams::kCount; ++i) shape[face::kShapeParamNames[i]] = JsonFloat(values[i]);
-  return Json{{"photos", photos},
-              {"skipped", result.skipped},
-              {"landmark_rms_iod", result.fit.rms_iod},
-              {"photometric_refit", result.fit.photometric},
-              {"silhouette_refit", result.fit.silhouettes},
-              {"landmark_max_iod", result.fit.max_iod},
-              {"iterations", result.fit.iterations},
-              {"shape", shape}};
+  Json out{{"photos", photos},
+           {"skipped", result.skipped},
+           {"landmark_rms_iod", result.fit.rms_iod},
+           {"photometric_refit", result.fit.photometric},
+           {"silhouette_refit", result.fit.silhouettes},
+           {"landmark_max_iod", result.fit.max_iod},
+           {"iterations", result.fit.iterations}};
+  if (result.fit.ict_identity.empty()) {
+    Json shape = Json::object();
+    const auto values = result.fit.shape.ToArray();
+    for (int i = 0; i < face::ShapeParams::kCount; ++i)
+      shape[face::kShapeParamNames[i]] = JsonFloat(values[i]);
+    out["shape"] = shape;
+  } else {
+    out["face_model"] = "ict";
+    Json identity = Json::array();
+    for (const float c : result.fit.ict_identity) identity.push_back(JsonFloat(c));
+    out["ict_identity"] = identity;
+  }
+  return out;
 }
 
 Status WriteTrackedDataset(const TrackResult& result, const fs::path& out_dir,

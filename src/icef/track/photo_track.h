@@ -20,6 +20,7 @@
 #include "icef/core/parallel.h"
 #include "icef/core/status.h"
 #include "icef/data/dataset.h"
+#include "icef/face/ict_fit.h"
 #include "icef/io/image.h"
 #include "icef/io/json_util.h"
 #include "icef/landmarks/face_landmark_detector.h"
@@ -30,7 +31,15 @@
 
 namespace icef::track {
 
+// The face model the tracker fits: the procedural head (face/face_model.h; landmarks, then the
+// masks' outlines and the colours) or ICT-FaceKit (face/ict_model.h; landmarks only, the dataset in
+// its 53 ARKit-named expressions, track/ict_track.h).
+enum class TrackFaceModel { kProcedural, kIct };
+const char* TrackFaceModelName(TrackFaceModel model);
+std::optional<TrackFaceModel> ParseTrackFaceModel(const std::string& name);
+
 struct TrackOptions {
+  TrackFaceModel face_model = TrackFaceModel::kProcedural;
   int resolution = 256;         // side of the square dataset images
   std::optional<double> focal;  // focal length in pixels of the photos (else EXIF, else the default)
   // Without num_train: the last num_test photos become test frames. With num_train > 0: that many
@@ -47,7 +56,8 @@ struct TrackOptions {
   // as sure background (default), or the person segmentation alone (PersonMask: shoulders included).
   enum class Segmentation { kNone, kSelfie, kSelfieOnly };
   Segmentation segmentation = Segmentation::kSelfie;
-  TrackFitOptions fit;
+  TrackFitOptions fit;                                             // the procedural model's fit
+  face::IctFitOptions ict_fit = face::IctFitOptions::ForPhotos();  // ICT's
   HeadMaskOptions mask;
 
   Status Validate() const;

@@ -9,6 +9,7 @@
 #include <fstream>
 
 #include "icef/face/expression.h"
+#include "icef/face/ict_model.h"
 #include "icef/io/atomic_file.h"
 #include "icef/synth/photo_set.h"
 
@@ -140,6 +141,56 @@ TEST_F(PhotoTrackTest, SyntheticPhotosBecomeADatasetInTheHeadFrame) {
   ASSERT_TRUE(again.ok());
   EXPECT_EQ(again->photos[1].image.pixels, r.photos[1].image.pixels);
   EXPECT_EQ(again->fit.frames[1].expression, r.fit.frames[1].expression);
+}
+
+// --face-model ict: the same photos (of a procedural head: a model mismatch) as a dataset in
+// ICT-FaceKit's 53 expressions, its world frame the scaled ICT head frame.
+TEST_F(PhotoTrackTest, IctFaceModelWritesADatasetInItsExpressionSpace) {
+  const Photos photos = MakePhotos(scratch_.dir, 2);
+  TrackOptions options = Options();
+  options.num_test = 1;
+  options.face_model = TrackFaceModel::kIct;
+  const Result<TrackResult> result = TrackPhotos(photos.files, options, *detector_, Executor(2));
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  const TrackResult& r = *result;
+  const face::IctModel& ict = **face::IctModel::LoadDefault();
+  EXPECT_EQ(r.dataset.expression_names, ict.expression_names());
+  EXPECT_EQ(r.dataset.expression_dim, 53);
+  EXPECT_FALSE(r.fit.ict_identity.empty());
+  for (size_t i = 0; i < 3; ++i) {
+    const TrackedPhoto& p = r.photos[i];
+    const Frame& f = (p.test ? r.dataset.test : r.dataset.train)[p.frame_index];
+    EXPECT_TRUE(ValidateRigid(f.camera.world_from_cam()).ok());
+    EXPECT_EQ(f.expression.size(), 53u);
+    const Mat3d d = f.camera.world_from_cam().block<3, 3>(0, 0).transpose() *
+                    photos.truth[i].camera.world_from_cam().block<3, 3>(0, 0);
+    EXPECT_LT(Eigen::AngleAxisd(d).angle() * 180 / M_PI, 15.0) << "photo " << i;
+    EXPECT_LT(r.fit.frames[i].rms_iod, 0.1) << "photo " << i;
+    // The model's landmarks (world frame), seen by the frame's camera, on the detected ones.
+    const std::vector<Vec2f>& lm = *f.landmarks_2d;
+    const float iod = ((lm[36] + lm[39]) * 0.5f - (lm[42] + lm[45]) * 0.5f).norm();
+    double sum2 = 0;
+    for (int j = 17; j < 68; ++j) {
+      const auto uv = f.camera.Project((*f.landmarks_3d)[j].cast<double>());
+      ASSERT_TRUE(uv.has_value());
+      sum2 += (uv->uv.cast<float>() - lm[j]).squaredNorm();
+    }
+    EXPECT_LT(std::sqrt(sum2 / 51) / iod, 0.1) << "photo " << i;
+    // Inside the dataset's box; the mask (GrabCut seeded by ICT's silhouette) on the true coverage.
+    for (const Vec3f& x : *f.landmarks_3d) EXPECT_TRUE(r.dataset.aabb.Contains(x));
+    Image mask(128, 128, 1);
+    for (int y = 0; y < 128; ++y)
+      for (int x = 0; x < 128; ++x) mask.At(x, y, 0) = p.image.At(x, y, 3);
+    EXPECT_GT(MaskIou(mask, CropTruth(photos.truth[i].alpha, p.crop, 128)), 0.8) << "photo " << i;
+  }
+  const Json report = TrackReportJson(r);
+  EXPECT_EQ(report["face_model"], "ict");
+  EXPECT_TRUE(report["photos"][0]["expression"].contains("jawOpen"));
+  const fs::path out = scratch_.dir / "ict_dataset";
+  ASSERT_TRUE(WriteTrackedDataset(r, out).ok());
+  const Result<Dataset> loaded = LoadDataset(out);
+  ASSERT_TRUE(loaded.ok()) << loaded.status().message();
+  EXPECT_EQ(loaded->expression_names, ict.expression_names());
 }
 
 // The default detector is the face mesh (its 68 points read off MediaPipe's mesh); dlib's own

@@ -129,6 +129,8 @@ struct TrackedFrame {
 
 struct TrackFit {
   face::ShapeParams shape;
+  // The ICT tracker (track/ict_track.h) only: its identity coefficients (empty for the procedural model).
+  std::vector<float> ict_identity;
   // Known cameras only: dataset world -> head frame (photos: each frame's cam_from_head instead).
   std::optional<face::Similarity> head_from_world;
   std::vector<TrackedFrame> frames;

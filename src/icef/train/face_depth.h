@@ -9,21 +9,44 @@
 // brings the renders nearer the truth's identity (docs/results/near_tier_variants).
 #pragma once
 
+#include <array>
+#include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
 #include "icef/core/parallel.h"
 #include "icef/data/dataset.h"
 #include "icef/face/face_fit.h"
+#include "icef/model/model_setup.h"
 #include "icef/train/training_data.h"
 
 namespace icef {
 
+// The fitted face model's surface in the dataset's world frame at each training frame's expression:
+// the procedural model of setup.face_fit (sphere-traced) or ICT-FaceKit of setup.ict_fit (its posed
+// mesh's skin, mouth interior, teeth and eyes, intersected exactly: face/mesh_depth.h).
+class FittedSurface {
+ public:
+  // expressions[k]: frame k's weights in the model's order (negative values act as 0). Errors: no
+  // face-model fit in the setup.
+  static Result<std::unique_ptr<FittedSurface>> Create(const ModelSetup& setup,
+                                                       const std::vector<std::vector<float>>& expressions);
+  virtual ~FittedSurface();
+  // Ray parameters t of the centre rays of the camera's `pixels` (y * width + x) where they first
+  // meet the surface at frame k's expression; NaN where they miss. Deterministic for any executor.
+  virtual std::vector<float> Depths(const Camera& camera, int k, std::span<const int64_t> pixels,
+                                    const Executor& executor) const = 0;
+  // The model's 68 landmarks at frame k's expression, world frame.
+  virtual std::array<Vec3f, 68> Landmarks(int k) const = 0;
+
+  Vec3d pivot = Vec3d::Zero();  // the neutral landmarks' centre, world frame (unseen views turn about it)
+  Vec3d up = Vec3d::UnitY();    // the head's up axis, world frame
+};
+
 // [data.num_pixels()] ray parameters t (world units along the pixel-centre ray), NaN outside
-// `pixels` (global indices) and where the ray misses the fitted surface. expressions[k] is frame
-// k's weights in the face model's order (negative values act as 0). Deterministic for any executor.
-std::vector<float> FaceModelDepthTargets(const face::FaceFit& fit, const TrainingData& data,
-                                         const std::vector<std::vector<float>>& expressions,
+// `pixels` (global indices) and where the ray misses the fitted surface. Deterministic for any executor.
+std::vector<float> FaceModelDepthTargets(const FittedSurface& surface, const TrainingData& data,
                                          const std::vector<int64_t>& pixels, const Executor& executor);
 
 // Unseen views (train.depth_prior_views): each training frame's camera turned about the fitted
@@ -46,7 +69,7 @@ struct ViewRayOptions {
 ViewRayOptions::Region ViewRegionFromName(const std::string& name);
 
 // The cameras of those views: [frame][view], intrinsics of the frame's camera.
-std::vector<std::vector<Camera>> UnseenViewCameras(const face::FaceFit& fit, const TrainingData& data,
+std::vector<std::vector<Camera>> UnseenViewCameras(const FittedSurface& surface, const TrainingData& data,
                                                    const ViewRayOptions& options);
 
 // The centre rays of the pixels of every unseen view that lie in the expression region of the
@@ -55,8 +78,7 @@ std::vector<std::vector<Camera>> UnseenViewCameras(const face::FaceFit& fit, con
 // landmarks from it or add their filled hull, LandmarkHullRegion) and meet its surface there, each with
 // the surface's ray parameter. L_depth on these reaches the geometry between the training views,
 // which no image constrains. Deterministic for any executor.
-std::vector<ViewRay> FaceModelViewRays(const face::FaceFit& fit, const TrainingData& data,
-                                       const std::vector<std::vector<float>>& expressions,
+std::vector<ViewRay> FaceModelViewRays(const FittedSurface& surface, const TrainingData& data,
                                        const ViewRayOptions& options, const Executor& executor);
 
 // The training pixels of the eyes: each eye's 2D landmark hull (iBUG 36-41, 42-47) of each frame

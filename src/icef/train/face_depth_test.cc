@@ -12,6 +12,7 @@
 
 #include "icef/data/dataset.h"
 #include "icef/face/face_model.h"
+#include "icef/face/ict_model.h"
 #include "icef/model/face_prior.h"
 #include "icef/synth/identity.h"
 #include "icef/synth/synthesize.h"
@@ -34,6 +35,16 @@ synth::SynthOptions SubjectOptions() {
   return o;
 }
 
+// The procedural fit's surface.
+std::unique_ptr<FittedSurface> Surface(const face::FaceFit& fit,
+                                       const std::vector<std::vector<float>>& expressions) {
+  ModelSetup setup;
+  setup.face_fit = fit;
+  Result<std::unique_ptr<FittedSurface>> surface = FittedSurface::Create(setup, expressions);
+  EXPECT_TRUE(surface.ok()) << surface.status().message();
+  return std::move(surface).value();
+}
+
 // A style-free subject placed off the head frame (scaled and moved), so the fit's similarity is not
 // the identity: each depth target's world point must land on the subject's own surface.
 TEST(FaceDepthTest, TargetsLieOnTheSubjectsSurfaceInsideTheExpressionRegionsOnly) {
@@ -49,10 +60,11 @@ TEST(FaceDepthTest, TargetsLieOnTheSubjectsSurfaceInsideTheExpressionRegionsOnly
   std::vector<std::vector<float>> expressions;
   for (const Frame& f : dataset->train) expressions.push_back(f.expression);
 
-  const std::vector<float> depth = FaceModelDepthTargets(*fit, *data, expressions, data->region_pixels(), ex);
+  const std::vector<float> depth =
+      FaceModelDepthTargets(*Surface(*fit, expressions), *data, data->region_pixels(), ex);
   ASSERT_EQ(int64_t(depth.size()), data->num_pixels());
   const std::vector<float> one_thread =
-      FaceModelDepthTargets(*fit, *data, expressions, data->region_pixels(), Executor(1));
+      FaceModelDepthTargets(*Surface(*fit, expressions), *data, data->region_pixels(), Executor(1));
   EXPECT_EQ(std::memcmp(depth.data(), one_thread.data(), depth.size() * sizeof(float)), 0) << "thread count";
 
   const std::vector<int64_t>& region = data->region_pixels();
@@ -115,7 +127,7 @@ TEST(FaceDepthTest, UnseenViewRaysLieOnTheSubjectsSurface) {
   options.max_yaw_deg = 25;
   options.max_pitch_deg = 12;
   options.seed = 4;
-  const auto cameras = UnseenViewCameras(*fit, *data, options);
+  const auto cameras = UnseenViewCameras(*Surface(*fit, expressions), *data, options);
   ASSERT_EQ(int(cameras.size()), data->num_frames());
   // The pivot: the fitted face's centre (its neutral landmarks' mean), in the world.
   const face::FaceModel fitted(fit->shape, fit->style);
@@ -137,8 +149,9 @@ TEST(FaceDepthTest, UnseenViewRaysLieOnTheSubjectsSurface) {
     }
   }
 
-  const std::vector<ViewRay> rays = FaceModelViewRays(*fit, *data, expressions, options, ex);
-  const std::vector<ViewRay> one_thread = FaceModelViewRays(*fit, *data, expressions, options, Executor(1));
+  const std::vector<ViewRay> rays = FaceModelViewRays(*Surface(*fit, expressions), *data, options, ex);
+  const std::vector<ViewRay> one_thread =
+      FaceModelViewRays(*Surface(*fit, expressions), *data, options, Executor(1));
   ASSERT_EQ(rays.size(), one_thread.size());
   for (size_t i = 0; i < rays.size(); ++i) {
     ASSERT_EQ(rays[i].depth, one_thread[i].depth) << i;
@@ -166,7 +179,8 @@ TEST(FaceDepthTest, UnseenViewRaysLieOnTheSubjectsSurface) {
   // chin), on the same surface.
   ViewRayOptions face_options = options;
   face_options.region = ViewRayOptions::Region::kFace;
-  const std::vector<ViewRay> face_rays = FaceModelViewRays(*fit, *data, expressions, face_options, ex);
+  const std::vector<ViewRay> face_rays =
+      FaceModelViewRays(*Surface(*fit, expressions), *data, face_options, ex);
   EXPECT_GT(face_rays.size(), rays.size() * 5 / 4);
   std::set<std::tuple<int, float, float, float>> face_set;
   for (const ViewRay& r : face_rays)
@@ -187,7 +201,8 @@ TEST(FaceDepthTest, UnseenViewRaysLieOnTheSubjectsSurface) {
   // expression region's rays also reach below it.
   ViewRayOptions upper_options = options;
   upper_options.region = ViewRayOptions::Region::kUpper;
-  const std::vector<ViewRay> upper_rays = FaceModelViewRays(*fit, *data, expressions, upper_options, ex);
+  const std::vector<ViewRay> upper_rays =
+      FaceModelViewRays(*Surface(*fit, expressions), *data, upper_options, ex);
   EXPECT_GT(upper_rays.size(), rays.size() / 4);
   EXPECT_LT(upper_rays.size(), rays.size() * 3 / 4);
   std::set<std::tuple<int, float, float, float>> expression_set;
@@ -215,7 +230,7 @@ TEST(FaceDepthTest, UnseenViewRaysLieOnTheSubjectsSurface) {
   EXPECT_EQ(ViewRegionFromName("expression"), ViewRayOptions::Region::kExpression);
 
   options.views_per_frame = 0;
-  EXPECT_TRUE(FaceModelViewRays(*fit, *data, expressions, options, ex).empty());
+  EXPECT_TRUE(FaceModelViewRays(*Surface(*fit, expressions), *data, options, ex).empty());
 }
 
 // train.depth_prior_region = "eyes": each eye's landmark hull, dilated; inside the expression region,
@@ -273,6 +288,38 @@ TEST(FaceDepthTest, FacePixelsAreTheExpressionRegionAndTheLandmarkHull) {
     EXPECT_TRUE(in_face[pixel(0.5f * (lm[14] + lm[30]))]) << "frame " << k << ": the left cheek";
     EXPECT_FALSE(in_face[data->PixelIndex(k, 0, 0)]) << "frame " << k << ": the image corner";
   }
+}
+
+// ICT-FaceKit's surface (model/ict_prior.h's fit): the depth of the pixel under the nose tip is the
+// distance to the posed mesh's nose tip; the landmarks are the posed mesh's, in the world frame.
+TEST(FaceDepthTest, IctSurfaceIsThePosedMesh) {
+  const face::IctModel& m = **face::IctModel::LoadDefault();
+  ModelSetup setup;
+  setup.ict_fit = IctFaceFit{};
+  setup.ict_fit->head_from_world.scale = 40;  // 1 world unit = 40 cm
+  setup.ict_fit->head_from_world.translation = Vec3d(0, 1, 0);
+  std::vector<float> jaw(m.num_expressions(), 0.f);
+  jaw[m.ExpressionIndex("jawOpen")] = 0.8f;
+  const Result<std::unique_ptr<FittedSurface>> surface =
+      FittedSurface::Create(setup, {std::vector<float>(m.num_expressions(), 0.f), jaw});
+  ASSERT_TRUE(surface.ok()) << surface.status().message();
+  const std::vector<Vec3f> mesh = m.Mesh({}, jaw);
+  const std::array<Vec3f, 68> lm = (*surface)->Landmarks(1);
+  const Vec3d nose = setup.ict_fit->head_from_world.ApplyInverse(m.Landmarks(mesh)[30].cast<double>());
+  EXPECT_LT((lm[30].cast<double>() - nose).norm(), 1e-5);
+  Intrinsics k;
+  k.width = k.height = 64;
+  k.fl_x = k.fl_y = 150;
+  k.cx = k.cy = 32;
+  const Camera camera = Camera::LookAt(k, nose + Vec3d(0, 0, 1.5), nose);
+  const auto uv = camera.Project(nose);
+  const int64_t pixel = int64_t(uv->uv.y()) * 64 + int64_t(uv->uv.x());
+  const std::vector<float> d = (*surface)->Depths(camera, 1, std::vector<int64_t>{pixel, 0}, Executor(1));
+  EXPECT_NEAR(d[0], 1.5, 0.01);   // within 0.4 cm: the pixel's ray passes within half a pixel of the tip
+  EXPECT_TRUE(std::isnan(d[1]));  // the corner misses the head
+  EXPECT_NEAR((*surface)->up.y(), 1.0, 1e-9);
+  // No fit: an error.
+  EXPECT_FALSE(FittedSurface::Create(ModelSetup{}, {}).ok());
 }
 
 }  // namespace

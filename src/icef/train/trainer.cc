@@ -59,13 +59,16 @@ Trainer::Trainer(const Dataset& dataset, fs::path model_dir, RunConfig config, T
       model_(std::move(model)),
       executor_(config_.train.threads) {
   // L_depth's targets: a function of the data and the fit alone, so a resumed run recomputes them.
-  if (config_.train.lambda_depth_prior > 0 && model_->setup().face_fit) {
+  const ModelSetup& setup = model_->setup();
+  if (config_.train.lambda_depth_prior > 0 && (setup.face_fit || setup.ict_fit)) {
+    const Result<std::unique_ptr<FittedSurface>> surface =
+        FittedSurface::Create(setup, setup.training_expressions);
+    ICEF_CHECK(surface.ok(), surface.status().message());  // the setup holds a fit
     const std::string& region = config_.train.depth_prior_region;
     const std::vector<int64_t> pixels = region == "eyes"   ? EyePixels(dataset_, data_)
                                         : region == "face" ? FacePixels(dataset_, data_)
                                                            : data_.region_pixels();
-    data_.SetDepthTargets(FaceModelDepthTargets(*model_->setup().face_fit, data_,
-                                                model_->setup().training_expressions, pixels, executor_));
+    data_.SetDepthTargets(FaceModelDepthTargets(**surface, data_, pixels, executor_));
     if (config_.train.depth_prior_views > 0 && config_.train.depth_prior_view_rays > 0) {
       ViewRayOptions views;
       views.views_per_frame = config_.train.depth_prior_views;
@@ -73,8 +76,7 @@ Trainer::Trainer(const Dataset& dataset, fs::path model_dir, RunConfig config, T
       views.max_pitch_deg = config_.train.depth_prior_view_pitch;
       views.seed = static_cast<uint64_t>(config_.train.seed);
       views.region = ViewRegionFromName(config_.train.depth_prior_view_region);
-      data_.SetViewRays(FaceModelViewRays(*model_->setup().face_fit, data_,
-                                          model_->setup().training_expressions, views, executor_));
+      data_.SetViewRays(FaceModelViewRays(**surface, data_, views, executor_));
     }
   }
   adam_ = std::make_unique<nn::Adam>(MakeAdamOptions(), &model_->store());

@@ -1,4 +1,4 @@
-#include "icef/track/ict_track_fit.h"
+#include "icef/face/ict_fit.h"
 
 #include <gtest/gtest.h>
 
@@ -12,7 +12,7 @@
 
 #include "icef/core/rng.h"
 
-namespace icef::track {
+namespace icef::face {
 namespace {
 
 // The model at DefaultPath(), loaded once; nullptr when the file is absent (tests skip).
@@ -346,4 +346,4 @@ TEST(IctTrackFit, OptionsValidate) {
 }
 
 }  // namespace
-}  // namespace icef::track
+}  // namespace icef::face

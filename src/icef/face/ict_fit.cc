@@ -1,4 +1,4 @@
-#include "icef/track/ict_track_fit.h"
+#include "icef/face/ict_fit.h"
 
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>
@@ -12,7 +12,7 @@
 #include <sstream>
 #include <utility>
 
-namespace icef::track {
+namespace icef::face {
 namespace {
 
 constexpr int kNumLandmarks = face::IctModel::kNumLandmarks;
@@ -460,6 +460,14 @@ std::string IctFitOptions::ToString() const {
   return os.str();
 }
 
+IctFitOptions IctFitOptions::ForPhotos() {
+  IctFitOptions o;
+  o.num_identity = 100;
+  o.identity_prior_sigma = 3;
+  o.expression_prior_laplace = 0.2;
+  return o;
+}
+
 std::string IctPhotoFit::ToString() const {
   std::ostringstream os;
   os.precision(4);
@@ -532,4 +540,4 @@ Result<IctFit> FitIctToLandmarks(const face::IctModel& model, const std::vector<
   return fit;
 }
 
-}  // namespace icef::track
+}  // namespace icef::face
