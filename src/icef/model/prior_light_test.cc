@@ -9,6 +9,8 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "icef/face/ict_warp.h"
+#include "icef/face/mesh_depth.h"
 #include "icef/model/face_prior.h"
 #include "icef/synth/synthesize.h"
 
@@ -57,6 +59,59 @@ TEST(PriorLightTest, RecoversTheKeyLightOfSyntheticHeads) {
     EXPECT_LT(fit->rms, 0.15);  // skin colour varies (cheeks, brows, freckles)
     std::printf("%s\n", fit->BriefReport().c_str());
   }
+}
+
+// ICT-FaceKit's fit: views of the posed mesh shaded as the fit models it, rho (1 + max(0, n . v)) on
+// the face (its area-weighted vertex normals), written as a dataset; the fit finds v and rho again.
+TEST(PriorLightTest, RecoversTheLightThroughTheIctMesh) {
+  const face::IctModel& m = **face::IctModel::LoadDefault();
+  const face::IctWarp warp = *face::IctWarp::Create(m, {});
+  IctFaceFit fit;
+  fit.head_from_world.scale = 40;  // 1 world unit = 40 cm
+  const Vec3f light(0.4f, 0.6f, 0.9f);
+  const Vec3f albedo(0.4f, 0.3f, 0.25f);  // unclipped: at most 0.4 x (1 + |v|) < 1
+  const fs::path dir = fs::temp_directory_path() / ("icef_prior_light_ict_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir / "images");
+  Dataset d;
+  d.root = dir;
+  d.expression_names = m.expression_names();
+  d.expression_dim = m.num_expressions();
+  const std::vector<Vec3f> normals = warp.VertexNormals(m.neutral());
+  std::vector<Vec3f> world;
+  for (const Vec3f& p : m.neutral()) world.push_back(p / 40.f);
+  for (int k = 0; k < 3; ++k) {
+    Intrinsics in;
+    in.width = in.height = 96;
+    in.fl_x = in.fl_y = 200;
+    in.cx = in.cy = 48;
+    const double yaw = (k - 1) * 0.5;
+    Frame f;
+    f.camera = Camera::LookAt(in, Vec3d(std::sin(yaw), 0.05, std::cos(yaw)), Vec3d(0, 0.05, 0.2));
+    f.expression.assign(m.num_expressions(), 0.f);
+    f.file_path = "images/" + std::to_string(k) + ".png";
+    std::vector<int32_t> hit;
+    const std::vector<float> depth = face::MeshDepthImage(world, warp.triangles(), f.camera, &hit);
+    Image image(96, 96, 4);
+    for (int y = 0; y < 96; ++y)
+      for (int x = 0; x < 96; ++x) {
+        const int32_t t = hit[size_t(y) * 96 + x];
+        if (t < 0) continue;
+        Vec3f n = Vec3f::Zero();
+        for (const uint32_t v : warp.triangles()[t]) n += normals[v];
+        const Vec3f c = albedo * (1.f + std::max(0.f, n.normalized().dot(light)));
+        for (int ch = 0; ch < 3; ++ch) image.At(x, y, ch) = std::min(c[ch], 1.f);
+        image.At(x, y, 3) = 1.f;
+      }
+    ASSERT_TRUE(WritePng(dir / f.file_path, image).ok());
+    d.train.push_back(f);
+  }
+  const Result<PriorLightFit> out = FitPriorLight(d, fit);
+  fs::remove_all(dir);
+  ASSERT_TRUE(out.ok()) << out.status().message();
+  EXPECT_LT((out->light - light).norm(), 0.1f * light.norm()) << out->BriefReport();
+  EXPECT_LT((out->albedo - albedo).norm(), 0.05f) << out->BriefReport();
+  EXPECT_GT(out->pixels, 500);
 }
 
 }  // namespace
