@@ -122,6 +122,7 @@ TEST(BenchApp, RealBenchTakesTheGivenOptions) {
   a.ks = "3,5";
   a.resolution = 96;
   a.real_test_frames = 3;
+  a.real_face_model = "ict";
   a.base.overrides = {"train.lambda_id=0.5"};
   a.base.threads = 2;
   const Result<RealBenchOptions> r = ResolveRealBenchOptions(a);
@@ -135,6 +136,7 @@ TEST(BenchApp, RealBenchTakesTheGivenOptions) {
   EXPECT_EQ(r->steps, quick.steps);                // --quick's
   EXPECT_EQ(r->video_frames, quick.video_frames);  // not given
   EXPECT_EQ(r->test_frames, 3);
+  EXPECT_EQ(r->face_model, "ict");
   EXPECT_EQ(r->threads, 2);
   ASSERT_FALSE(r->overrides.empty());
   EXPECT_EQ(r->overrides.back(), "train.lambda_id=0.5");
@@ -145,7 +147,11 @@ TEST(BenchApp, RealOnlyOptionsAndMergeWithoutOutAreRefused) {
   a.out = "b";
   a.video_frames = 10;  // without --real
   std::ostringstream log;
-  EXPECT_NE(RunBench(a, log).message().find("--video-frames go with --real"), std::string::npos);
+  EXPECT_NE(RunBench(a, log).message().find("--video-frames and --face-model go with --real"),
+            std::string::npos);
+  a.video_frames.reset();
+  a.real_face_model = "ict";
+  EXPECT_NE(RunBench(a, log).message().find("--face-model go with --real"), std::string::npos);
   BenchAppOptions merge;
   merge.merge = {"shard0", "shard1"};
   EXPECT_NE(RunBench(merge, log).message().find("--out is required"), std::string::npos);
