@@ -58,14 +58,21 @@ Status ApplyNamedValue(const ModelSetup& setup, const std::string& assignment, s
   return Status::Ok();
 }
 
+// ICT-FaceKit, for an option that takes ARKit names (`what`: "--expression: ARKit names"); an error
+// unless the model was trained in ICT-FaceKit's expression space.
+Result<std::shared_ptr<const face::IctModel>> IctModelFor(const ModelSetup& setup, const std::string& what) {
+  ICEF_ASSIGN_OR_RETURN(std::shared_ptr<const face::IctModel> ict, face::IctModel::LoadDefault());
+  if (!IsIctExpressionSpace(*ict, setup.expression_names))
+    return Status::Error(what +
+                         " need a model trained on a dataset in ICT-FaceKit's expressions (icef track "
+                         "--face-model ict); this model's are its own: use --set-expression NAME=VALUE");
+  return ict;
+}
+
 // --expression: ARKit names, for a model in ICT-FaceKit's expression space.
 Result<std::vector<float>> ArkitExpression(const ModelSetup& setup, const std::string& text) {
-  ICEF_ASSIGN_OR_RETURN(const std::shared_ptr<const face::IctModel> ict, face::IctModel::LoadDefault());
-  if (!IsIctExpressionSpace(*ict, setup.expression_names))
-    return Status::Error(
-        "--expression: ARKit names need a model trained on a dataset in ICT-FaceKit's expressions (icef "
-        "track "
-        "--face-model ict); this model's are its own: use --set-expression NAME=VALUE");
+  ICEF_ASSIGN_OR_RETURN(const std::shared_ptr<const face::IctModel> ict,
+                        IctModelFor(setup, "--expression: ARKit names"));
   Result<std::vector<float>> beta = face::ParseArkitExpression(*ict, text);
   if (!beta.ok()) return beta.status().WithContext("--expression");
   return beta;
@@ -78,11 +85,8 @@ Result<std::vector<std::vector<float>>> ArkitCurveExpressions(const ModelSetup& 
     return Status::Error(
         "--expressions: the CSV gives every frame's expression; leave out --expression, --beta, "
         "--expression-frame, --set-expression and --sweep");
-  ICEF_ASSIGN_OR_RETURN(const std::shared_ptr<const face::IctModel> ict, face::IctModel::LoadDefault());
-  if (!IsIctExpressionSpace(*ict, setup.expression_names))
-    return Status::Error(
-        "--expressions: ARKit curves need a model trained on a dataset in ICT-FaceKit's expressions (icef "
-        "track --face-model ict)");
+  ICEF_ASSIGN_OR_RETURN(const std::shared_ptr<const face::IctModel> ict,
+                        IctModelFor(setup, "--expressions: ARKit curves"));
   ICEF_ASSIGN_OR_RETURN(face::ArkitCurves curves, face::ReadArkitCurves(*ict, *o.arkit_curves));
   return std::move(curves.weights);
 }

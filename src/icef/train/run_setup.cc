@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "icef/core/rng.h"
+#include "icef/face/expression.h"
 #include "icef/model/face_prior.h"
 #include "icef/model/ict_prior.h"
 #include "icef/model/method.h"
@@ -57,16 +58,19 @@ std::string RunSetupOptions::ToString() const {
 Result<std::string> FitFacePrior(const Dataset& dataset, const RunSetupOptions& options,
                                  const Executor& executor, ModelSetup* setup) {
   if (options.fit_face) {
-    ICEF_ASSIGN_OR_RETURN(const std::shared_ptr<const face::IctModel> ict, face::IctModel::LoadDefault());
-    if (IsIctExpressionSpace(*ict, dataset.expression_names)) {
-      Result<IctFaceFit> fit = FitIctToDataset(*ict, dataset);
-      if (!fit.ok()) return fit.status().WithContext("face model fit");
-      setup->ict_fit = std::move(fit).value();
-      if (!options.fit_light) return std::string();
-      Result<PriorLightFit> light = FitPriorLight(dataset, *setup->ict_fit);
-      if (!light.ok()) return light.status().message();
-      setup->prior_light = light->light;
-      return std::string();
+    // ICT-FaceKit's model file is read only for datasets not in the procedural model's expressions.
+    if (dataset.expression_names != face::ExpressionNames()) {
+      ICEF_ASSIGN_OR_RETURN(const std::shared_ptr<const face::IctModel> ict, face::IctModel::LoadDefault());
+      if (IsIctExpressionSpace(*ict, dataset.expression_names)) {
+        Result<IctFaceFit> fit = FitIctToDataset(*ict, dataset);
+        if (!fit.ok()) return fit.status().WithContext("face model fit");
+        setup->ict_fit = std::move(fit).value();
+        if (!options.fit_light) return std::string();
+        Result<PriorLightFit> light = FitPriorLight(dataset, *setup->ict_fit);
+        if (!light.ok()) return light.status().message();
+        setup->prior_light = light->light;
+        return std::string();
+      }
     }
     face::FaceFitOptions fit_options;
     fit_options.fit_style = options.fit_style;
