@@ -12,6 +12,7 @@ PACKAGES=(
   libnanoflann-dev  # closest points on the face model's mesh (the volumetric prior warp)
   libopencv-imgproc-dev libexif-dev  # icef track: GrabCut masks, crops (OpenCV); EXIF focal lengths
   libavformat-dev libavcodec-dev libswscale-dev libavutil-dev  # icef track: video input; icef render --video
+  libtinygltf-dev libmeshoptimizer-dev  # icef export: GLB writing (tinygltf), mesh simplification
   python3-numpy python3-pil  # scripts/track_eval.py (tracking against synthetic truth; integration.track_test)
   libdlib-dev libdlib-data opencv-doc python3-skimage python-matplotlib-data  # eval: face alignment, test photos
   gnuplot-nox  # bench: report plots (PNG, SVG and PDF)
@@ -96,4 +97,30 @@ SUMS
   echo "install-deps: face-mesh and segmentation models installed in $MESH_DIR and $SELFIE_DIR"
 else
   echo "install-deps: face-mesh and segmentation models present in $MESH_DIR and $SELFIE_DIR"
+fi
+
+# The Khronos glTF validator (npm package gltf-validator@2.0.0-dev.3.10, Apache-2.0; no dependencies),
+# which the tests run on what `icef export` writes (tests/integration/export_test.sh). Unpacked into
+# a fixed place; skipped when present.
+VALIDATOR_DIR=/usr/local/share/icef/gltf-validator
+if [ ! -s "$VALIDATOR_DIR/index.js" ]; then
+  SUDO=""
+  if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+  if ! command -v npm >/dev/null; then
+    echo "install-deps: installing nodejs npm (for the glTF validator)"
+    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends nodejs npm
+  fi
+  validator_tmp=$(mktemp -d)
+  (cd "$validator_tmp" && npm pack --silent gltf-validator@2.0.0-dev.3.10 >/dev/null)
+  (cd "$validator_tmp" && sha256sum -c --quiet - <<'SUMS'
+4e03dbdc3bc0d1342afd5d2d7ae341a7e3474502ccb872b02dbbaddaee0fdec6  gltf-validator-2.0.0-dev.3.10.tgz
+SUMS
+  )
+  tar xzf "$validator_tmp/gltf-validator-2.0.0-dev.3.10.tgz" -C "$validator_tmp"
+  $SUDO mkdir -p "$VALIDATOR_DIR"
+  $SUDO cp -r "$validator_tmp/package/." "$VALIDATOR_DIR/"
+  rm -rf "$validator_tmp"
+  echo "install-deps: glTF validator installed in $VALIDATOR_DIR"
+else
+  echo "install-deps: glTF validator present in $VALIDATOR_DIR"
 fi

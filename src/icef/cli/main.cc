@@ -67,6 +67,7 @@ const Command kCommands[] = {
     {"import", "Convert a NerFace / instant-ngp dataset into our format", icef::cli::RegisterImport},
     {"train", "Train a model (icef or a baseline) on a dataset", icef::cli::RegisterTrain},
     {"render", "Render a trained model: views, expressions, sweeps, turntables", icef::cli::RegisterRender},
+    {"export", "Export a trained avatar as a GLB with ARKit-named morph targets", icef::cli::RegisterExport},
     {"config", "Print the resolved run config, or document every key (--markdown)",
      icef::cli::RegisterConfig},
     {"mask", "Show the expression-region mask (overlay + volume slices)", icef::cli::RegisterMask},

@@ -284,6 +284,22 @@ std::vector<int> IctModel::ExpressionTargets(std::string_view name) const {
   return {};
 }
 
+std::vector<std::string> IctModel::ArkitNames() const {
+  std::vector<std::string> names;
+  for (const std::string& n : expression_names_) {
+    std::string arkit = n;
+    const bool left = n.ends_with("_L"), right = n.ends_with("_R");
+    if (left || right) {
+      const std::string stem = n.substr(0, n.size() - 2);
+      const bool split = std::any_of(std::begin(kSplitPairs), std::end(kSplitPairs),
+                                     [&](std::string_view pair) { return EqualsIgnoreCase(stem, pair); });
+      arkit = split ? stem : stem + (left ? "Left" : "Right");
+    }
+    if (std::find(names.begin(), names.end(), arkit) == names.end()) names.push_back(arkit);
+  }
+  return names;
+}
+
 std::vector<Vec3f> IctModel::Mesh(std::span<const float> identity, std::span<const float> expression) const {
   ICEF_CHECK(identity.size() <= static_cast<size_t>(num_identities_),
              std::to_string(identity.size()) + " identity coefficients for " +

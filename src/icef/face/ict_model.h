@@ -52,6 +52,10 @@ class IctModel {
   // The indices a name drives: one, or both halves of a split pair (browInnerUp -> browInnerUp_L,
   // browInnerUp_R); empty when unknown.
   std::vector<int> ExpressionTargets(std::string_view name) const;
+  // The ARKit names the model covers, in the order of its expressions (mouthSmile_L ->
+  // mouthSmileLeft; a split pair once, by its unsided name): 51 for ICT-FaceKit (ARKit's 52 less
+  // tongueOut). ExpressionTargets maps each back.
+  std::vector<std::string> ArkitNames() const;
 
   // Mesh at the coefficients: [num_vertices] positions. A span shorter than the count leaves the
   // remaining coefficients at 0 (empty = all 0); a longer one fails an ICEF_CHECK. Coefficients

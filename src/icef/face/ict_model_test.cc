@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -88,6 +89,10 @@ TEST(IctModel, ExpressionsAreTheArkitNames) {
       "mouthSmileRight",   "mouthStretchLeft",   "mouthStretchRight",   "mouthUpperUpLeft",
       "mouthUpperUpRight", "noseSneerLeft",      "noseSneerRight"};
   ASSERT_EQ(arkit.size(), 51u);
+  std::vector<std::string> covered = m.ArkitNames(), expected = arkit;
+  std::sort(covered.begin(), covered.end());
+  std::sort(expected.begin(), expected.end());
+  EXPECT_EQ(covered, expected);
   std::vector<int> hits(m.num_expressions(), 0);
   for (const std::string& name : arkit) {
     const std::vector<int> targets = m.ExpressionTargets(name);
