@@ -20,7 +20,7 @@ namespace {
 constexpr int64_t kBatch = 1 << 16;   // field queries per call
 constexpr int kSolveIterations = 24;  // most fixed-point steps of the morph-target solve
 constexpr int kColorSamples = 16;     // samples of a vertex's colour ray
-constexpr float kColorReach = 2.f;    // the colour ray runs this many grid cells either side
+constexpr float kColorReach = 6.f;    // the colour ray runs this many grid cells either side
 
 std::string FormatNumber(double v) {
   std::ostringstream os;
