@@ -13,6 +13,8 @@ PACKAGES=(
   libopencv-imgproc-dev libexif-dev  # icef track: GrabCut masks, crops (OpenCV); EXIF focal lengths
   libavformat-dev libavcodec-dev libswscale-dev libavutil-dev  # icef track: video input; icef render --video
   libtinygltf-dev libmeshoptimizer-dev  # icef export: GLB writing (tinygltf), mesh simplification
+  libcpp-httplib-dev  # icef view --serve
+  chromium ffmpeg  # tests: the viewer in headless Chromium (integration.view_test); ffprobe reads the MP4s
   python3-numpy python3-pil  # scripts/track_eval.py (tracking against synthetic truth; integration.track_test)
   libdlib-dev libdlib-data opencv-doc python3-skimage python-matplotlib-data  # eval: face alignment, test photos
   gnuplot-nox  # bench: report plots (PNG, SVG and PDF)
@@ -123,4 +125,38 @@ SUMS
   echo "install-deps: glTF validator installed in $VALIDATOR_DIR"
 else
   echo "install-deps: glTF validator present in $VALIDATOR_DIR"
+fi
+
+# three.js (npm package three@0.187.0, MIT), which `icef view` copies into the viewer folders it
+# writes. Unpacked into a fixed place; skipped when present.
+THREE_DIR=/usr/local/share/icef/three
+if [ ! -s "$THREE_DIR/build/three.module.js" ]; then
+  SUDO=""
+  if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+  three_tmp=$(mktemp -d)
+  (cd "$three_tmp" && npm pack --silent three@0.187.0 >/dev/null)
+  (cd "$three_tmp" && sha256sum -c --quiet - <<'SUMS'
+ff540832ded0cfe919764d24a3d88f3e2a05f23303f876423e4f893841e90728  three-0.187.0.tgz
+SUMS
+  )
+  tar xzf "$three_tmp/three-0.187.0.tgz" -C "$three_tmp"
+  $SUDO mkdir -p "$THREE_DIR"
+  $SUDO cp -r "$three_tmp/package/." "$THREE_DIR/"
+  rm -rf "$three_tmp"
+  echo "install-deps: three.js installed in $THREE_DIR"
+else
+  echo "install-deps: three.js present in $THREE_DIR"
+fi
+
+# puppeteer-core (npm, Apache-2.0), with which the tests drive Debian's chromium
+# (tests/integration/view_browser.js). Skipped when present.
+PUPPETEER_DIR=/usr/local/share/icef/puppeteer
+if [ ! -s "$PUPPETEER_DIR/node_modules/puppeteer-core/package.json" ]; then
+  SUDO=""
+  if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+  $SUDO mkdir -p "$PUPPETEER_DIR"
+  $SUDO npm install --silent --no-audit --no-fund --prefix "$PUPPETEER_DIR" puppeteer-core@24.22.0 >/dev/null
+  echo "install-deps: puppeteer-core installed in $PUPPETEER_DIR"
+else
+  echo "install-deps: puppeteer-core present in $PUPPETEER_DIR"
 fi

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <sstream>
 
@@ -17,10 +18,13 @@ namespace icef {
 
 namespace {
 
-constexpr int64_t kBatch = 1 << 16;   // field queries per call
-constexpr int kSolveIterations = 24;  // most fixed-point steps of the morph-target solve
-constexpr int kColorSamples = 16;     // samples of a vertex's colour ray
-constexpr float kColorReach = 6.f;    // the colour ray runs this many grid cells either side
+constexpr int64_t kBatch = 1 << 16;    // field queries per call
+constexpr int kSolveIterations = 24;   // most fixed-point steps of the morph-target solve
+constexpr int kColorSamples = 16;      // samples of a vertex's colour ray
+constexpr float kColorReach = 6.f;     // the colour ray runs this many grid cells either side
+constexpr int kLevelSamples = 48;      // samples per pixel ray that SurfaceLevel reads the density on
+constexpr float kLevelWindow = 0.25f;  // their span either side of the expected depth (world units)
+constexpr int kLevelCandidates = 32;   // levels SurfaceLevel chooses among (geometric, over its densities)
 
 std::string FormatNumber(double v) {
   std::ostringstream os;
@@ -64,20 +68,38 @@ mesh::ScalarGrid DensityGrid(const AvatarModel& model, int resolution, const Exe
   return grid;
 }
 
-// Each vertex's colour: samples on a ray along -normal through it, composited front to back.
+// The direction each vertex is seen along in colour: from the training camera that faces it most (the
+// directions the view-dependent colour was trained on), else along -normal.
+std::vector<Vec3f> ViewDirections(const ModelSetup& setup, const mesh::TriangleMesh& mesh,
+                                  const std::vector<Vec3f>& normals) {
+  std::vector<Vec3f> view(mesh.positions.size());
+  for (size_t v = 0; v < view.size(); ++v) {
+    view[v] = normals[v] == Vec3f::Zero() ? Vec3f(0, 0, -1) : Vec3f(-normals[v]);
+    float best = 0.f;
+    for (const Camera& c : setup.training_cameras) {
+      const Vec3f to_camera = (c.Center().cast<float>() - mesh.positions[v]).normalized();
+      const float facing = to_camera.dot(normals[v]);
+      if (facing > best) best = facing, view[v] = -to_camera;
+    }
+  }
+  return view;
+}
+
+// Each vertex's colour: samples on a ray along -normal through it, composited front to back, their
+// colours as seen along ViewDirections.
 std::vector<Vec3f> BakeColors(const AvatarModel& model, const mesh::TriangleMesh& mesh,
                               const std::vector<Vec3f>& normals, float cell, const Executor& executor) {
   const int64_t n = static_cast<int64_t>(mesh.positions.size());
   const float step = 2.f * kColorReach * cell / kColorSamples;
+  const std::vector<Vec3f> view = ViewDirections(model.setup(), mesh, normals);
   std::vector<float> points(3 * n * kColorSamples), dirs(3 * n * kColorSamples), sigma(n * kColorSamples),
       rgb(3 * n * kColorSamples);
   for (int64_t v = 0; v < n; ++v) {
     for (int s = 0; s < kColorSamples; ++s) {
       const int64_t q = v * kColorSamples + s;
       const float t = -kColorReach * cell + (static_cast<float>(s) + 0.5f) * step;
-      Eigen::Map<Vec3f>(points.data() + 3 * q) = mesh.positions[v] - t * normals[v];
-      Eigen::Map<Vec3f>(dirs.data() + 3 * q) =
-          normals[v] == Vec3f::Zero() ? Vec3f(0, 0, -1) : Vec3f(-normals[v]);
+      Eigen::Map<Vec3f>(points.data() + 3 * q) = mesh.positions[v] + t * view[v];
+      Eigen::Map<Vec3f>(dirs.data() + 3 * q) = view[v];
     }
   }
   model.QueryStatic(executor, n * kColorSamples, points.data(), dirs.data(), nullptr, sigma.data(),
@@ -100,12 +122,41 @@ std::vector<Vec3f> BakeColors(const AvatarModel& model, const mesh::TriangleMesh
   return colors;
 }
 
+// One ray's densities [samples] (dt apart): for each level, how far (in
+// samples) the point where the density first reaches it lies from the median of where the ray ends
+// in the window (where half the window's opacity has accumulated; for an opaque surface, where the
+// transmittance falls through one half).
+void AddLevelGaps(const float* d, int samples, float dt, const std::vector<float>& levels,
+                  std::vector<std::vector<float>>* gaps) {
+  float total = 0.f;
+  for (int s = 0; s < samples; ++s) total += std::max(d[s], 0.f) * dt;
+  if (!(total > 0.f)) return;
+  const float target = -std::log(0.5f * (1.f + std::exp(-total)));  // the optical depth of half the opacity
+  float optical = 0.f, half = -1.f;
+  for (int s = 0; s < samples && half < 0; ++s) {
+    const float step = std::max(d[s], 0.f) * dt;
+    if (optical + step >= target) half = s + (target - optical) / step;
+    optical += step;
+  }
+  if (half < 0) return;
+  for (size_t c = 0; c < levels.size(); ++c) {
+    int s = 0;
+    while (s < samples && d[s] < levels[c]) ++s;
+    float at = static_cast<float>(s);  // the crossing between sample centres, linear in the density
+    if (s > 0 && s < samples) at = s - 1 + (levels[c] - d[s - 1]) / (d[s] - d[s - 1]);
+    (*gaps)[c].push_back(std::abs(at + 0.5f - half));
+  }
+}
+
 // The density at which the renders put the surface: each training camera (at 64 pixels high) renders
-// its training expression; at every pixel with opacity above one half, the expected depth's point is
-// warped to canonical space, and the median static density there is the level.
+// its training expression; every pixel with opacity above one half gets a ray of samples around its
+// expected depth, warped to canonical space; the level is the one (of kLevelCandidates spaced
+// geometrically between the 5th and 99th percentiles of the positive densities seen) whose crossing lies,
+// on average, nearest the point where the ray's transmittance falls through one half (the median
+// of where the render's ray ends; AddLevelGaps).
 Result<double> SurfaceLevel(const AvatarModel& model, const Executor& executor) {
   const ModelSetup& setup = model.setup();
-  std::vector<float> densities;
+  std::vector<float> densities;  // [rays][kLevelSamples]
   for (size_t k = 0; k < setup.training_cameras.size() && k < setup.training_expressions.size(); ++k) {
     const Camera& full = setup.training_cameras[k];
     Intrinsics in = full.intrinsics();
@@ -116,14 +167,19 @@ Result<double> SurfaceLevel(const AvatarModel& model, const Executor& executor) 
     const Camera camera(in, full.world_from_cam());
     const std::vector<float>& beta = setup.training_expressions[k];
     const RenderedImage image = RenderImage(model, camera, beta, Vec3f::Zero(), executor);
+    // Each opaque pixel's ray, kLevelSamples samples across kLevelWindow either side of its expected
+    // depth, warped into canonical space.
     std::vector<float> points, offsets, dirs, sigma, rgb;
     for (int j = 0; j < in.height; ++j)
       for (int i = 0; i < in.width; ++i) {
         if (!(image.opacity.At(i, j, 0) > 0.5f) || !(image.depth.At(i, j, 0) > 0.f)) continue;
         const Ray ray = camera.PixelRay(i, j);
-        const Vec3f x = ray.At(image.depth.At(i, j, 0));
-        points.insert(points.end(), {x.x(), x.y(), x.z()});
-        dirs.insert(dirs.end(), {ray.direction.x(), ray.direction.y(), ray.direction.z()});
+        for (int s = 0; s < kLevelSamples; ++s) {
+          const float t = image.depth.At(i, j, 0) + kLevelWindow * (2.f * (s + 0.5f) / kLevelSamples - 1.f);
+          const Vec3f x = ray.At(t);
+          points.insert(points.end(), {x.x(), x.y(), x.z()});
+          dirs.insert(dirs.end(), {ray.direction.x(), ray.direction.y(), ray.direction.z()});
+        }
       }
     const int64_t n = static_cast<int64_t>(points.size() / 3);
     if (n == 0) continue;
@@ -133,12 +189,12 @@ Result<double> SurfaceLevel(const AvatarModel& model, const Executor& executor) 
     model.QueryStatic(executor, n, points.data(), dirs.data(), nullptr, sigma.data(), rgb.data());
     densities.insert(densities.end(), sigma.begin(), sigma.end());
   }
-  if (densities.empty())
+  Result<double> level = HalfOpacityLevel(densities, kLevelSamples, 2.f * kLevelWindow / kLevelSamples);
+  if (!level.ok())
     return Status::Error(
-        "no training view of the model renders an opaque pixel to find the surface "
-        "density at; give --density");
-  std::nth_element(densities.begin(), densities.begin() + densities.size() / 2, densities.end());
-  return static_cast<double>(densities[densities.size() / 2]);
+        "no training view of the model renders an opaque pixel to find the surface density at; "
+        "give --density");
+  return level;
 }
 
 struct TargetSpec {
@@ -230,6 +286,29 @@ Status ExportAppOptions::Validate() const {
   if (density && (!(*density > 0) || !std::isfinite(*density)))
     return Status::Error("--density: a positive number");
   return Status::Ok();
+}
+
+Result<double> HalfOpacityLevel(std::span<const float> densities, int samples_per_ray, float dt) {
+  std::vector<float> positive;
+  for (float d : densities)
+    if (d > 0.f) positive.push_back(d);
+  if (positive.empty()) return Status::Error("no ray sees any density");
+  std::sort(positive.begin(), positive.end());
+  const float lo = positive[positive.size() / 20], hi = positive[positive.size() * 99 / 100];
+  std::vector<float> levels(kLevelCandidates);
+  for (int c = 0; c < kLevelCandidates; ++c) levels[c] = lo * std::pow(hi / lo, c / (kLevelCandidates - 1.f));
+  std::vector<std::vector<float>> gaps(levels.size());  // per level: |crossing - half point|, samples
+  for (size_t r = 0; r < densities.size() / samples_per_ray; ++r)
+    AddLevelGaps(densities.data() + r * samples_per_ray, samples_per_ray, dt, levels, &gaps);
+  // The level whose crossings lie nearest the half points (mean over the rays).
+  size_t best = 0;
+  double best_gap = std::numeric_limits<double>::max();
+  for (size_t c = 0; c < levels.size(); ++c) {
+    if (gaps[c].empty()) continue;
+    const double gap = std::accumulate(gaps[c].begin(), gaps[c].end(), 0.0) / gaps[c].size();
+    if (gap < best_gap) best_gap = gap, best = c;
+  }
+  return static_cast<double>(levels[best]);
 }
 
 Result<ExportSummary> RunExport(const ExportAppOptions& o, std::ostream& out) {

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <sstream>
 
@@ -118,6 +119,24 @@ TEST(ExportApp, ModelsWithoutAPriorExportAStaticMeshAndNerfaceIsRefused) {
                 "never exceeds 1e+30 inside the model's box (its largest is "),
             std::string::npos);
   EXPECT_FALSE(fs::exists(o.out));
+}
+
+// Rays through a density ramp d = a (s - s0) (s0 varying per ray): opacity accumulates as
+// a dt (s - s0)^2 / 2, so half of it is reached at s - s0 = sqrt(2 ln 2 / (a dt)), where the density is
+// sqrt(2 ln 2 a / dt): the level chosen, within the candidates' spacing; at any density scale.
+TEST(HalfOpacityLevel, IsTheDensityWhereTheRaysReachHalfOpacity) {
+  const int samples = 64;
+  const float dt = 0.01f, a = 20.f;
+  for (float scale : {1.f, 1000.f}) {
+    std::vector<float> d;
+    for (int r = 0; r < 12; ++r)
+      for (int s = 0; s < samples; ++s) d.push_back(scale * a * std::max(0.f, s + 0.5f - (10.f + r)));
+    const Result<double> level = HalfOpacityLevel(d, samples, dt / scale);
+    ASSERT_TRUE(level.ok()) << level.status().message();
+    const double expected = scale * std::sqrt(2 * std::log(2.0) * a / dt);
+    EXPECT_NEAR(*level / expected, 1.0, 0.15) << "scale " << scale << ": " << *level << " vs " << expected;
+  }
+  EXPECT_FALSE(HalfOpacityLevel(std::vector<float>(128, 0.f), samples, dt).ok());
 }
 
 }  // namespace

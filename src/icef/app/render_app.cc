@@ -80,7 +80,7 @@ Result<std::vector<float>> ArkitExpression(const ModelSetup& setup, const std::s
 
 // --expressions: the rows of a Live Link Face CSV, alone.
 Result<std::vector<std::vector<float>>> ArkitCurveExpressions(const ModelSetup& setup,
-                                                              const RenderAppOptions& o) {
+                                                              const RenderAppOptions& o, std::ostream& out) {
   if (o.arkit_expression || o.beta || o.expression_frame || o.sweep || !o.named.empty())
     return Status::Error(
         "--expressions: the CSV gives every frame's expression; leave out --expression, --beta, "
@@ -88,6 +88,16 @@ Result<std::vector<std::vector<float>>> ArkitCurveExpressions(const ModelSetup& 
   ICEF_ASSIGN_OR_RETURN(const std::shared_ptr<const face::IctModel> ict,
                         IctModelFor(setup, "--expressions: ARKit curves"));
   ICEF_ASSIGN_OR_RETURN(face::ArkitCurves curves, face::ReadArkitCurves(*ict, *o.arkit_curves));
+  out << "--expressions: " << curves.weights.size() << " frames from " << o.arkit_curves->string();
+  if (!curves.ignored_columns.empty()) {
+    out << "; columns with no blendshape of the model, ignored:";
+    for (const std::string& c : curves.ignored_columns) out << " " << c;
+  }
+  if (!curves.missing_columns.empty()) {
+    out << "; ARKit blendshapes with no column, held at 0:";
+    for (const std::string& c : curves.missing_columns) out << " " << c;
+  }
+  out << "\n";
   return std::move(curves.weights);
 }
 
@@ -186,8 +196,9 @@ Result<std::vector<Camera>> RenderCameras(const RenderAppOptions& o, const Model
 // The expressions: the base (neutral, a dataset frame's, --beta, then the named values), or a sweep
 // from it towards --sweep's target and beyond.
 Result<std::vector<std::vector<float>>> RenderExpressions(const RenderAppOptions& o, const ModelSetup& setup,
-                                                          const std::optional<Dataset>& dataset) {
-  if (o.arkit_curves) return ArkitCurveExpressions(setup, o);
+                                                          const std::optional<Dataset>& dataset,
+                                                          std::ostream& out) {
+  if (o.arkit_curves) return ArkitCurveExpressions(setup, o, out);
   std::vector<float> base(setup.expression_dim, 0.f);
   if (o.expression_frame) {
     ICEF_ASSIGN_OR_RETURN(const Frame* f, FindFrame(*dataset, *o.expression_frame, "--expression-frame"));
@@ -352,7 +363,8 @@ Result<std::vector<RenderedFrameInfo>> RunRender(const RenderAppOptions& o, std:
   const ModelSetup& setup = model.setup();
   ICEF_ASSIGN_OR_RETURN(const std::optional<Dataset> dataset, LoadRenderDataset(o, setup));
   ICEF_ASSIGN_OR_RETURN(const std::vector<Camera> cameras, RenderCameras(o, setup, dataset));
-  ICEF_ASSIGN_OR_RETURN(const std::vector<std::vector<float>> betas, RenderExpressions(o, setup, dataset));
+  ICEF_ASSIGN_OR_RETURN(const std::vector<std::vector<float>> betas,
+                        RenderExpressions(o, setup, dataset, out));
 
   std::error_code ec;
   fs::create_directories(o.out, ec);

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <iomanip>
 
+#include "icef/app/curves_app.h"
 #include "icef/app/detector_calibration.h"
 #include "icef/app/face_outline.h"
 #include "icef/core/parallel.h"
@@ -333,6 +334,7 @@ Status RunTrackCommand(const TrackCommandOptions& c, std::ostream& out, std::ost
   }
   if (options.photos.empty())
     return Status::Error("icef track: give the photos (or a dataset with --keep-cameras)");
+  if (!c.curves.empty()) return RunTrackCurves(options, c.curves, out);
   if (options.out.empty()) return Status::Error("icef track: --out DATASET is required");
   return RunTrack(options, out);
 }

@@ -76,6 +76,7 @@ struct TrackCommandOptions {
   std::optional<double> photometric_weight;  // the photometric refit's weight (nullopt: the mode's default)
   std::optional<double> landmark_sigma;      // landmark noise, inter-ocular distances (nullopt: the mode's)
   bool calibrate_detector = false;           // developer: print the detector's calibration table instead
+  std::filesystem::path curves;              // a video's ARKit curves to this CSV instead of a dataset
 };
 
 // The validation identities `--calibrate-detector` renders (app/detector_calibration.h).
@@ -87,7 +88,8 @@ const std::vector<uint64_t>& DetectorCalibrationSeeds();
 Result<TrackAppOptions> ResolveTrackOptions(const TrackCommandOptions& options);
 
 // `icef track`: resolves the options, then prints the detector's calibration table on `out` (its
-// log on `log`) with calibrate_detector, else tracks (RunTrack).
+// log on `log`) with calibrate_detector, writes a video's curves with `curves` (app/curves_app.h),
+// else tracks (RunTrack).
 Status RunTrackCommand(const TrackCommandOptions& options, std::ostream& out, std::ostream& log);
 
 }  // namespace icef

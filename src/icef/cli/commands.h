@@ -22,6 +22,7 @@ CommandFn RegisterDemo(CLI::App& app);
 CommandFn RegisterTrain(CLI::App& app);
 CommandFn RegisterRender(CLI::App& app);
 CommandFn RegisterExport(CLI::App& app);
+CommandFn RegisterView(CLI::App& app);
 CommandFn RegisterConfig(CLI::App& app);
 CommandFn RegisterSynth(CLI::App& app);
 CommandFn RegisterSheet(CLI::App& app);

@@ -68,6 +68,8 @@ const Command kCommands[] = {
     {"train", "Train a model (icef or a baseline) on a dataset", icef::cli::RegisterTrain},
     {"render", "Render a trained model: views, expressions, sweeps, turntables", icef::cli::RegisterRender},
     {"export", "Export a trained avatar as a GLB with ARKit-named morph targets", icef::cli::RegisterExport},
+    {"view", "The avatar in the browser: a folder with the GLB and a three.js viewer, optionally served",
+     icef::cli::RegisterView},
     {"config", "Print the resolved run config, or document every key (--markdown)",
      icef::cli::RegisterConfig},
     {"mask", "Show the expression-region mask (overlay + volume slices)", icef::cli::RegisterMask},

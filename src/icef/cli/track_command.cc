@@ -1,6 +1,7 @@
 // icef track PHOTOS... --out DATASET [--res N] [--focal PX] [--test N] [--skip-bad] [--threads N]
 // icef track VIDEO --frames K --test N --out DATASET [--every N | --max-frames N]
 // icef track DATASET --keep-cameras --out NEW
+// icef track VIDEO --curves CURVES.csv
 // From a handful of photos of one person to a dataset (docs/design.md §8): app/track_app.h does the work.
 #include <iostream>
 #include <memory>
@@ -28,7 +29,11 @@ constexpr const char* kTrackDescription =
     "With --keep-cameras, re-express an existing dataset (NerFace, instant-ngp, any expression space) in the "
     "face model's expressions: same cameras and images, the face model fitted to every frame's landmarks, "
     "with track/overlay_<split>_NNN.png to check the fit (every frame; at most 100, spread over a longer "
-    "sequence).";
+    "sequence).\n"
+    "With --curves, a video's expressions as ARKit curves to drive an avatar with: ICT-FaceKit fitted to "
+    "every frame's landmarks (one identity, the driving person's, kept out of the curves), written in Live "
+    "Link Face's CSV layout (Timecode, BlendShapeCount, the ARKit blendshapes, HeadYaw, HeadPitch, "
+    "HeadRoll in radians). Then: icef render MODEL --expressions CURVES.csv --video drive.mp4.";
 
 // photos ... --skip-bad: what is tracked and what the dataset holds.
 void AddInputOptions(CLI::App& app, TrackCommandOptions& o) {
@@ -36,6 +41,10 @@ void AddInputOptions(CLI::App& app, TrackCommandOptions& o) {
       "photos", o.app.photos,
       "Photos (PNG/JPEG) or directories of photos, or one video (.mp4, .mov, .mkv, .avi, .webm, .m4v)");
   app.add_option("--out", o.app.out, "Dataset directory to create (must not exist, or be empty)");
+  app.add_option("--curves", o.curves,
+                 "VIDEO: write every frame's ARKit expression weights and head rotation to this CSV (Live "
+                 "Link Face's layout) instead of a dataset; --every thins the frames, --max-frames keeps the "
+                 "first N; a frame without one face repeats the nearest tracked frame's curves");
   app.add_option("--res", o.app.track.resolution,
                  "Side of the square dataset images in pixels (default 256)");
   app.add_option(

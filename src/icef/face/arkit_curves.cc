@@ -1,5 +1,6 @@
 #include "icef/face/arkit_curves.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <fstream>
@@ -87,6 +88,14 @@ Result<ArkitCurves> ReadArkitCurves(const IctModel& model, const std::filesystem
   ArkitCurves curves;
   const std::vector<std::string> header = Cells(line);
   ICEF_ASSIGN_OR_RETURN(const Columns columns, ParseHeader(model, header, file, &curves));
+  std::vector<bool> covered(model.num_expressions(), false);
+  for (const std::vector<int>& t : columns.targets)
+    for (const int e : t) covered[e] = true;
+  for (const std::string& name : model.ArkitNames()) {
+    const std::vector<int> t = model.ExpressionTargets(name);
+    if (std::none_of(t.begin(), t.end(), [&](int e) { return covered[e]; }))
+      curves.missing_columns.push_back(name);
+  }
   for (int number = 2; std::getline(in, line); ++number) {
     if (Trimmed(line).empty()) continue;
     const std::vector<std::string> cells = Cells(line);
@@ -120,6 +129,10 @@ std::string ArkitCurves::ToString() const {
   if (!ignored_columns.empty()) {
     os << ", ignored:";
     for (const std::string& c : ignored_columns) os << " " << c;
+  }
+  if (!missing_columns.empty()) {
+    os << ", missing (held at 0):";
+    for (const std::string& c : missing_columns) os << " " << c;
   }
   os << ")";
   return os.str();

@@ -18,6 +18,7 @@ struct ArkitCurves {
   std::vector<std::string> timecodes;        // per frame, as written ("" without a Timecode column)
   std::vector<std::vector<float>> weights;   // per frame [num_expressions], the model's order
   std::vector<std::string> ignored_columns;  // header names with no ICT blendshape
+  std::vector<std::string> missing_columns;  // ARKit names the model covers with no column (held at 0)
   std::string ToString() const;
 };
 

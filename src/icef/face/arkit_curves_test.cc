@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <fstream>
 
 namespace icef::face {
@@ -38,6 +39,12 @@ TEST(ArkitCurves, ReadsLiveLinkFaceLayout) {
   ASSERT_EQ(curves->weights.size(), 2u);
   EXPECT_EQ(curves->timecodes[1], "00:00:01:01.000");
   EXPECT_EQ(curves->ignored_columns, (std::vector<std::string>{"TongueOut", "HeadYaw"}));
+  // The 51 ARKit names less the five given (BrowInnerUp covers both of ICT's halves).
+  EXPECT_EQ(curves->missing_columns.size(), 51u - 5u);
+  EXPECT_NE(std::find(curves->missing_columns.begin(), curves->missing_columns.end(), "mouthSmileRight"),
+            curves->missing_columns.end());
+  EXPECT_EQ(std::find(curves->missing_columns.begin(), curves->missing_columns.end(), "browInnerUp"),
+            curves->missing_columns.end());
   const std::vector<float>& w0 = curves->weights[0];
   ASSERT_EQ(w0.size(), size_t(m.num_expressions()));
   EXPECT_FLOAT_EQ(w0[m.ExpressionIndex("eyeBlink_L")], 0.1f);
