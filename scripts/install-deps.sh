@@ -101,49 +101,43 @@ else
   echo "install-deps: face-mesh and segmentation models present in $MESH_DIR and $SELFIE_DIR"
 fi
 
+# npm_pack_install NAME@VERSION SHA256 DIR WHAT: the npm package's tarball (unscoped NAME), checked
+# against its sha256, unpacked into DIR; Debian's nodejs and npm first where npm is missing.
+npm_pack_install() {
+  local spec="$1" sum="$2" dir="$3" what="$4" sudo="" tmp tgz
+  if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
+  if ! command -v npm >/dev/null; then
+    echo "install-deps: installing nodejs npm (for the $what)"
+    DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends nodejs npm
+  fi
+  tmp=$(mktemp -d)
+  tgz="${spec/@/-}.tgz"
+  (cd "$tmp" && npm pack --silent "$spec" >/dev/null)
+  (cd "$tmp" && echo "$sum  $tgz" | sha256sum -c --quiet -)
+  tar xzf "$tmp/$tgz" -C "$tmp"
+  $sudo mkdir -p "$dir"
+  $sudo cp -r "$tmp/package/." "$dir/"
+  rm -rf "$tmp"
+  echo "install-deps: $what installed in $dir"
+}
+
 # The Khronos glTF validator (npm package gltf-validator@2.0.0-dev.3.10, Apache-2.0; no dependencies),
-# which the tests run on what `icef export` writes (tests/integration/export_test.sh). Unpacked into
-# a fixed place; skipped when present.
+# which the tests run on what `icef export` writes (tests/integration/export_test.sh). Skipped when
+# present.
 VALIDATOR_DIR=/usr/local/share/icef/gltf-validator
 if [ ! -s "$VALIDATOR_DIR/index.js" ]; then
-  SUDO=""
-  if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
-  if ! command -v npm >/dev/null; then
-    echo "install-deps: installing nodejs npm (for the glTF validator)"
-    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends nodejs npm
-  fi
-  validator_tmp=$(mktemp -d)
-  (cd "$validator_tmp" && npm pack --silent gltf-validator@2.0.0-dev.3.10 >/dev/null)
-  (cd "$validator_tmp" && sha256sum -c --quiet - <<'SUMS'
-4e03dbdc3bc0d1342afd5d2d7ae341a7e3474502ccb872b02dbbaddaee0fdec6  gltf-validator-2.0.0-dev.3.10.tgz
-SUMS
-  )
-  tar xzf "$validator_tmp/gltf-validator-2.0.0-dev.3.10.tgz" -C "$validator_tmp"
-  $SUDO mkdir -p "$VALIDATOR_DIR"
-  $SUDO cp -r "$validator_tmp/package/." "$VALIDATOR_DIR/"
-  rm -rf "$validator_tmp"
-  echo "install-deps: glTF validator installed in $VALIDATOR_DIR"
+  npm_pack_install gltf-validator@2.0.0-dev.3.10 \
+    4e03dbdc3bc0d1342afd5d2d7ae341a7e3474502ccb872b02dbbaddaee0fdec6 "$VALIDATOR_DIR" "glTF validator"
 else
   echo "install-deps: glTF validator present in $VALIDATOR_DIR"
 fi
 
 # three.js (npm package three@0.187.0, MIT), which `icef view` copies into the viewer folders it
-# writes. Unpacked into a fixed place; skipped when present.
+# writes. Skipped when present.
 THREE_DIR=/usr/local/share/icef/three
 if [ ! -s "$THREE_DIR/build/three.module.js" ]; then
-  SUDO=""
-  if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
-  three_tmp=$(mktemp -d)
-  (cd "$three_tmp" && npm pack --silent three@0.187.0 >/dev/null)
-  (cd "$three_tmp" && sha256sum -c --quiet - <<'SUMS'
-ff540832ded0cfe919764d24a3d88f3e2a05f23303f876423e4f893841e90728  three-0.187.0.tgz
-SUMS
-  )
-  tar xzf "$three_tmp/three-0.187.0.tgz" -C "$three_tmp"
-  $SUDO mkdir -p "$THREE_DIR"
-  $SUDO cp -r "$three_tmp/package/." "$THREE_DIR/"
-  rm -rf "$three_tmp"
-  echo "install-deps: three.js installed in $THREE_DIR"
+  npm_pack_install three@0.187.0 ff540832ded0cfe919764d24a3d88f3e2a05f23303f876423e4f893841e90728 \
+    "$THREE_DIR" "three.js"
 else
   echo "install-deps: three.js present in $THREE_DIR"
 fi

@@ -15,6 +15,7 @@
 #include "icef/landmarks/face_mesh.h"
 #include "icef/track/ict_track.h"
 #include "icef/track/photo_crop.h"
+#include "icef/track/photo_track.h"
 #include "icef/video/video_decoder.h"
 #include "icef/video/video_reader.h"
 
@@ -36,8 +37,7 @@ void DetectBatch(const std::vector<Image>& images, const FaceLandmarkDetector& d
   ParallelFor(executor, static_cast<int64_t>(images.size()), [&](int64_t begin, int64_t end, int) {
     const FaceLandmarkDetector local = detector.Clone();
     for (int64_t i = begin; i < end; ++i) {
-      const Result<FaceDetection> d =
-          mesh ? DetectFaceWithMesh(local, *mesh, images[i]) : local.DetectFace(images[i], /*averaged=*/true);
+      const Result<FaceDetection> d = track::DetectTrackLandmarks(local, mesh, images[i]);
       if (d.ok() && d->num_faces == 1) out[i].landmarks = d->landmarks;
     }
   });

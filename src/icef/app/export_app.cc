@@ -85,8 +85,8 @@ std::vector<Vec3f> ViewDirections(const ModelSetup& setup, const mesh::TriangleM
   return view;
 }
 
-// Each vertex's colour: samples on a ray along -normal through it, composited front to back, their
-// colours as seen along ViewDirections.
+// Each vertex's colour: samples on a ray through it along its ViewDirections line of sight, their
+// colours queried in that direction, composited front to back.
 std::vector<Vec3f> BakeColors(const AvatarModel& model, const mesh::TriangleMesh& mesh,
                               const std::vector<Vec3f>& normals, float cell, const Executor& executor) {
   const int64_t n = static_cast<int64_t>(mesh.positions.size());
@@ -122,10 +122,9 @@ std::vector<Vec3f> BakeColors(const AvatarModel& model, const mesh::TriangleMesh
   return colors;
 }
 
-// One ray's densities [samples] (dt apart): for each level, how far (in
-// samples) the point where the density first reaches it lies from the median of where the ray ends
-// in the window (where half the window's opacity has accumulated; for an opaque surface, where the
-// transmittance falls through one half).
+// One ray's densities [samples] (dt apart): for each level, how far (in samples) the point where the
+// density first reaches it lies from the median of where the ray ends in the window (where half the window's
+// opacity has accumulated; for an opaque surface, where the transmittance falls through one half).
 void AddLevelGaps(const float* d, int samples, float dt, const std::vector<float>& levels,
                   std::vector<std::vector<float>>* gaps) {
   float total = 0.f;
@@ -313,8 +312,13 @@ Result<double> HalfOpacityLevel(std::span<const float> densities, int samples_pe
 
 Result<ExportSummary> RunExport(const ExportAppOptions& o, std::ostream& out) {
   ICEF_RETURN_IF_ERROR(o.Validate());
+  ICEF_ASSIGN_OR_RETURN(const TrainedModel loaded, LoadTrainedModel(o.model, Executor(o.threads)));
+  return ExportLoadedModel(loaded, o, out);
+}
+
+Result<ExportSummary> ExportLoadedModel(const TrainedModel& loaded, const ExportAppOptions& o,
+                                        std::ostream& out) {
   const Executor executor(o.threads);
-  ICEF_ASSIGN_OR_RETURN(const TrainedModel loaded, LoadTrainedModel(o.model, executor));
   const AvatarModel& model = *loaded.model;
   if (model.traits().entangled_beta)
     return Status::Error(o.model.string() +

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "icef/core/status.h"
+#include "icef/model/trained_model.h"
 
 namespace icef {
 
@@ -50,6 +51,10 @@ struct ExportSummary {
 };
 
 Result<ExportSummary> RunExport(const ExportAppOptions& options, std::ostream& out);
+// The same for a model already loaded (options.model names it in messages and the GLB's metadata;
+// options are not validated here).
+Result<ExportSummary> ExportLoadedModel(const TrainedModel& loaded, const ExportAppOptions& options,
+                                        std::ostream& out);
 
 // The surface level of a volume seen along rays: densities [rays][samples_per_ray], samples dt apart
 // along each ray. Among levels spaced geometrically between the 5th and 99th percentiles of the

@@ -95,23 +95,8 @@ Status FillFolder(const ViewAppOptions& o, const fs::path& tmp, std::ostream& ou
                  {"cameras", Json::array()},
                  {"curves", nullptr}};
   std::error_code ec;
-  if (o.input.extension() == ".glb") {
-    ICEF_RETURN_IF_ERROR(mesh::ReadGlbSummary(o.input).status());
-    fs::copy_file(o.input, tmp / "avatar.glb", ec);
-    if (ec) return Status::Error((tmp / "avatar.glb").string() + ": cannot write: " + ec.message());
-  } else {
-    ExportAppOptions e = o.export_options;
-    e.model = o.input;
-    e.out = tmp / "avatar.glb";
-    ICEF_ASSIGN_OR_RETURN(const ExportSummary s, RunExport(e, out));
-    out << "exported the avatar: " << s.vertices << " vertices, " << s.triangles << " triangles, "
-        << s.targets.size() << " morph targets\n";
-    if (!s.note.empty()) out << "note: " << s.note << "\n";
-    ICEF_ASSIGN_OR_RETURN(const TrainedModel loaded, LoadTrainedModel(o.input, Executor(e.threads)));
-    const ModelSetup& setup = loaded.model->setup();
-    viewer["cameras"] = CamerasJson(setup);
-    viewer["background"] = {setup.background.x(), setup.background.y(), setup.background.z()};
-  }
+  // three.js and the curves first: a missing install or a bad CSV is found before the export.
+  ICEF_RETURN_IF_ERROR(CopyThree(tmp));
   if (o.curves) {
     ICEF_ASSIGN_OR_RETURN(const std::shared_ptr<const face::IctModel> ict, face::IctModel::LoadDefault());
     ICEF_ASSIGN_OR_RETURN(const face::ArkitCurves curves, face::ReadArkitCurves(*ict, *o.curves));
@@ -120,7 +105,24 @@ Status FillFolder(const ViewAppOptions& o, const fs::path& tmp, std::ostream& ou
     viewer["curves"] = "curves.csv";
     out << "curves: " << curves.weights.size() << " frames from " << o.curves->string() << "\n";
   }
-  ICEF_RETURN_IF_ERROR(CopyThree(tmp));
+  if (o.input.extension() == ".glb") {
+    ICEF_RETURN_IF_ERROR(mesh::ReadGlbSummary(o.input).status());
+    fs::copy_file(o.input, tmp / "avatar.glb", ec);
+    if (ec) return Status::Error((tmp / "avatar.glb").string() + ": cannot write: " + ec.message());
+  } else {
+    ExportAppOptions e = o.export_options;
+    e.model = o.input;
+    e.out = tmp / "avatar.glb";
+    ICEF_RETURN_IF_ERROR(e.Validate());
+    ICEF_ASSIGN_OR_RETURN(const TrainedModel loaded, LoadTrainedModel(o.input, Executor(e.threads)));
+    ICEF_ASSIGN_OR_RETURN(const ExportSummary s, ExportLoadedModel(loaded, e, out));
+    out << "exported the avatar: " << s.vertices << " vertices, " << s.triangles << " triangles, "
+        << s.targets.size() << " morph targets\n";
+    if (!s.note.empty()) out << "note: " << s.note << "\n";
+    const ModelSetup& setup = loaded.model->setup();
+    viewer["cameras"] = CamerasJson(setup);
+    viewer["background"] = {setup.background.x(), setup.background.y(), setup.background.z()};
+  }
   ICEF_RETURN_IF_ERROR(WriteFileAtomic(tmp / "index.html", kViewerHtml));
   return WriteFileAtomic(tmp / "viewer.json", viewer.dump(1) + "\n");
 }

@@ -74,8 +74,7 @@ Result<std::vector<Detected>> DetectAll(std::vector<TrackInput>& inputs, const F
         out[i].photo = Oriented(*image, ExifOrientation(inputs[i].source));
       }
       if (out[i].photo.HasAlpha()) out[i].photo = CompositeOver(out[i].photo, Vec3f::Ones());
-      out[i].detection = mesh ? DetectFaceWithMesh(local, *mesh, out[i].photo)
-                              : local.DetectFace(out[i].photo, /*averaged=*/true);
+      out[i].detection = DetectTrackLandmarks(local, mesh, out[i].photo);
     }
   });
   for (size_t i = 0; i < inputs.size(); ++i)
@@ -284,6 +283,11 @@ const char* TrackFaceModelName(TrackFaceModel model) { return EnumName(kTrackFac
 
 std::optional<TrackFaceModel> ParseTrackFaceModel(const std::string& name) {
   return ParseEnum(kTrackFaceModelNames, name);
+}
+
+Result<FaceDetection> DetectTrackLandmarks(const FaceLandmarkDetector& detector, const FaceMesh* mesh,
+                                           const Image& photo) {
+  return mesh ? DetectFaceWithMesh(detector, *mesh, photo) : detector.DetectFace(photo, /*averaged=*/true);
 }
 
 double FaceSharpness(const Image& photo, std::span<const Vec2f> landmarks) {

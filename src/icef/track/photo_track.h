@@ -24,6 +24,7 @@
 #include "icef/io/image.h"
 #include "icef/io/json_util.h"
 #include "icef/landmarks/face_landmark_detector.h"
+#include "icef/landmarks/face_mesh.h"
 #include "icef/track/head_mask.h"
 #include "icef/track/person_segmentation.h"
 #include "icef/track/photo_crop.h"
@@ -110,6 +111,11 @@ Result<TrackResult> TrackPhotos(const std::vector<std::filesystem::path>& photos
 Result<TrackResult> TrackInputs(std::vector<TrackInput> inputs, const TrackOptions& options,
                                 const FaceLandmarkDetector& detector, const Executor& executor,
                                 const std::function<void(const std::string&)>& log = nullptr);
+
+// The face's 68 landmarks in a photo as the tracker reads them: off MediaPipe's face mesh when `mesh`
+// is given (DetectFaceWithMesh), else dlib's shape predictor averaged over shifted boxes.
+Result<FaceDetection> DetectTrackLandmarks(const FaceLandmarkDetector& detector, const FaceMesh* mesh,
+                                           const Image& photo);
 
 // Fine detail of the face in a photo: the variance of the Laplacian of the grey face (the box of
 // its landmarks, resampled to 96 x 96 pixels). Only ratios between frames of one source mean
