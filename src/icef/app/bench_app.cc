@@ -1,5 +1,7 @@
 #include "icef/app/bench_app.h"
 
+#include "icef/track/dataset_retrack.h"
+
 namespace icef {
 
 Status BenchAppOptions::Validate() const {
@@ -85,10 +87,23 @@ Status RunBench(const BenchAppOptions& a, std::ostream& out) {
     ICEF_ASSIGN_OR_RETURN(const RealBenchOptions real, ResolveRealBenchOptions(a));
     return RunRealBench(real, out);
   }
-  if (a.real_test_frames || a.video_frames || a.real_face_model)
-    return Status::Error(
-        "--test, --video-frames and --face-model go with --real (synthetic benches: --test-views)");
-  ICEF_ASSIGN_OR_RETURN(const eval::BenchOptions options, ResolveBenchOptions(a));
+  if (a.real_test_frames || a.video_frames)
+    return Status::Error("--test and --video-frames go with --real (synthetic benches: --test-views)");
+  ICEF_ASSIGN_OR_RETURN(eval::BenchOptions options, ResolveBenchOptions(a));
+  if (a.real_face_model && *a.real_face_model != "procedural") {
+    // The synthetic datasets re-expressed as `icef track --keep-cameras --face-model ict --landmarks
+    // model` would: the generator's exact landmarks, ICT fitted among the known cameras.
+    options.face_model = *a.real_face_model;
+    options.reexpress = [](const Dataset& source, const std::filesystem::path& dir) -> Result<Dataset> {
+      track::RetrackOptions ro;
+      ro.landmarks = track::RetrackLandmarks::kDatasetModel;
+      ro.face_model = track::TrackFaceModel::kIct;
+      ICEF_ASSIGN_OR_RETURN(const track::RetrackResult result,
+                            track::RetrackDataset(source, ro, Executor(0)));
+      ICEF_RETURN_IF_ERROR(track::WriteRetrackedDataset(result, dir));
+      return LoadDataset(dir);
+    };
+  }
   return eval::RunBench(options, out, a.interactive);
 }
 

@@ -140,6 +140,8 @@ Status RunRetrack(const TrackAppOptions& options, std::ostream& out) {
   ro.detector = options.track.fit.detector;
   ro.silhouette_points = options.track.silhouette_points;
   ro.fit_style = options.fit_style;
+  ro.face_model = options.track.face_model;
+  ro.ict_fit = options.track.ict_fit;
   out << "icef track --keep-cameras: " << options.photos[0].string() << " (" << source.train.size()
       << " training, " << source.test.size() << " test frames, expression_dim " << source.expression_dim
       << ")\n";
@@ -170,7 +172,7 @@ Status RunRetrack(const TrackAppOptions& options, std::ostream& out) {
   out << "head_from_world: " << result.fit.head_from_world->ToString() << "\n";
   ICEF_RETURN_IF_ERROR(track::WriteRetrackedDataset(result, options.out, overlays));
   out << "wrote " << options.out.string() << ": the same cameras and images, expressions in the face model's "
-      << face::kNumExpressions << " weights; per-frame fit in "
+      << result.dataset.expression_dim << " weights; per-frame fit in "
       << (options.out / "track" / "report.json").string() << ", " << overlays.size() << " overlay"
       << (overlays.size() == 1 ? "" : "s") << " (track/overlay_<split>_NNN.png"
       << (overlays.size() < result.fit.frames.size() ? ", frames spread over the sequence" : "") << ")\n";
@@ -264,8 +266,6 @@ Status ApplyNamedTrackChoices(const TrackCommandOptions& c, TrackAppOptions* o) 
   if (!face_model)
     return Status::Error("--face-model: expected procedural or ict, got \"" + c.face_model + "\"");
   o->track.face_model = *face_model;
-  if (*face_model == track::TrackFaceModel::kIct && o->keep_cameras)
-    return Status::Error("--face-model ict: not yet with --keep-cameras (photos and videos only)");
   if (c.segmentation != "selfie" && c.segmentation != "none" && c.segmentation != "selfie-only")
     return Status::Error("--segmentation: expected selfie, none or selfie-only, got \"" + c.segmentation +
                          "\"");

@@ -99,8 +99,10 @@ void AddRealOptions(CLI::App& app, BenchArgs& args) {
       ->capture_default_str();
   app.add_option(
          "--face-model", args.face_model,
-         "With --real: the face model the sources are tracked with and the prior stands on: procedural "
-         "or ict (ICT-FaceKit; icef track --face-model)")
+         "The face model the datasets are expressed in and the prior stands on: procedural or ict "
+         "(ICT-FaceKit). With --real: the sources are tracked with it (icef track --face-model); "
+         "synthetic: each synthesised dataset is re-expressed in it with its cameras held (icef track "
+         "--keep-cameras --face-model ict --landmarks model), a model-mismatch test")
       ->check(CLI::IsMember({"procedural", "ict"}))
       ->capture_default_str();
 }

@@ -82,7 +82,7 @@ void AddModeOptions(CLI::App& app, TrackCommandOptions& o) {
          "The face model fitted: procedural (the built-in procedural head, its 11 expressions; fits the "
          "landmarks, the masks' outlines and the colours; default) or ict (ICT-FaceKit, learned from "
          "scans: 100 identity modes, 53 ARKit-named expressions; fits the landmarks; the dataset's "
-         "expressions are its 53 weights)")
+         "expressions are its 53 weights; with --keep-cameras, one head pose among the dataset's cameras)")
       ->check(CLI::IsMember({"procedural", "ict"}));
   app.add_option(
          "--segmentation", o.segmentation,

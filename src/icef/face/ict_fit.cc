@@ -189,6 +189,84 @@ class LandmarkCost : public ceres::CostFunction {
   double scale_;
 };
 
+// The landmark residuals of one photo with a known camera (rigid cam_from_world, world units) and
+// the head placed by one similarity for all photos, world_from_head: x_world = exp(log_scale) R
+// x_head + t. Blocks: identity [N], expression [E], angle-axis of R [3], t [3] (world units),
+// log_scale [1]. The projection does not see the camera frame's units, so the residuals are
+// LandmarkCost's for the camera-frame point Rc (s R head + t) + tc.
+class KnownCameraLandmarkCost : public ceres::CostFunction {
+ public:
+  KnownCameraLandmarkCost(const LandmarkBasis* basis, const PhotoData* photo, const Mat4d& cam_from_world,
+                          double sigma_iod)
+      : basis_(basis),
+        photo_(photo),
+        cam_rotation_(cam_from_world.block<3, 3>(0, 0)),
+        cam_translation_(cam_from_world.block<3, 1>(0, 3)),
+        scale_(1.0 / (sigma_iod * photo->iod_px)) {
+    set_num_residuals(2 * kNumLandmarks);
+    *mutable_parameter_block_sizes() = {basis->num_identity(), basis->num_expressions(), 3, 3, 1};
+  }
+
+  bool Evaluate(double const* const* params, double* residuals, double** jacobians) const override {
+    const int n = basis_->num_identity(), ne = basis_->num_expressions();
+    Mat3d r;
+    std::array<Mat3d, 3> dr;
+    RotationAndDerivatives(params[2], &r, &dr);
+    const Vec3d t(params[3][0], params[3][1], params[3][2]);
+    const double scale = std::exp(params[4][0]);
+    const VecXd x = basis_->Positions(params[0], params[1]);
+    const int sizes[5] = {n, ne, 3, 3, 1};
+    for (int b = 0; b < 5; ++b)
+      if (jacobians && jacobians[b]) std::fill_n(jacobians[b], 2 * kNumLandmarks * sizes[b], 0.0);
+    const Mat3d cam_head = scale * cam_rotation_ * r;  // d cam / d head
+    for (int i = 0; i < kNumLandmarks; ++i) {
+      residuals[2 * i] = residuals[2 * i + 1] = 0;
+      if (photo_->weight[i] == 0) continue;
+      const Vec3d head = x.segment<3>(3 * i);
+      const Vec3d cam = cam_head * head + cam_rotation_ * t + cam_translation_;
+      if (cam.z() >= 0) return false;  // at or behind the camera: the step fails
+      Eigen::Matrix<double, 2, 3> d_cam;
+      const double s = scale_ * photo_->weight[i];
+      const Vec2d e = s * (ProjectCam(photo_->intrinsics, cam, &d_cam) - photo_->observed[i]);
+      residuals[2 * i] = e.x();
+      residuals[2 * i + 1] = e.y();
+      if (!jacobians) continue;
+      const Eigen::Matrix<double, 2, 3> d_head = s * d_cam * cam_head;
+      if (jacobians[0])
+        Eigen::Map<RowMatrix>(jacobians[0], 2 * kNumLandmarks, n).middleRows<2>(2 * i) =
+            d_head * basis_->identity.middleRows<3>(3 * i);
+      if (jacobians[1])
+        Eigen::Map<RowMatrix>(jacobians[1], 2 * kNumLandmarks, ne).middleRows<2>(2 * i) =
+            d_head * basis_->expression.middleRows<3>(3 * i);
+      for (int k = 0; k < 3 && jacobians[2]; ++k) {
+        const Vec2d d = s * d_cam * (scale * cam_rotation_ * (dr[k] * head));
+        jacobians[2][6 * i + k] = d.x();
+        jacobians[2][6 * i + 3 + k] = d.y();
+      }
+      if (jacobians[3]) {
+        const Eigen::Matrix<double, 2, 3> d_t = s * d_cam * cam_rotation_;
+        for (int k = 0; k < 3; ++k) {
+          jacobians[3][6 * i + k] = d_t(0, k);
+          jacobians[3][6 * i + 3 + k] = d_t(1, k);
+        }
+      }
+      if (jacobians[4]) {
+        const Vec2d d = s * d_cam * (cam_head * head);
+        jacobians[4][2 * i] = d.x();
+        jacobians[4][2 * i + 1] = d.y();
+      }
+    }
+    return true;
+  }
+
+ private:
+  const LandmarkBasis* basis_;
+  const PhotoData* photo_;
+  Mat3d cam_rotation_;
+  Vec3d cam_translation_;
+  double scale_;
+};
+
 // A Gaussian prior toward 0 on one block: residuals x / sigma.
 class GaussianPrior : public ceres::CostFunction {
  public:
@@ -407,11 +485,13 @@ Status RunSolver(ceres::Problem& problem, int max_iterations, const IctFitOption
   ceres::Solver::Options so;
   so.minimizer_type = ceres::TRUST_REGION;
   so.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
-  so.linear_solver_type = ceres::DENSE_SCHUR;
+  so.linear_solver_type = eliminate.empty() ? ceres::DENSE_QR : ceres::DENSE_SCHUR;
   so.max_num_iterations = max_iterations;
   so.function_tolerance = o.function_tolerance;
   so.check_gradients = o.check_gradients;
-  so.gradient_check_relative_precision = 1e-4;  // entries of ~1e-9 differ by ~1e-5 relative
+  // Entries of ~1e-9 (landmarks a blendshape hardly moves) differ from central differences by
+  // ~3e-13 absolute, up to ~2e-4 relative; a wrong derivative is off by its own size.
+  so.gradient_check_relative_precision = 1e-3;
   so.parameter_tolerance = 1e-10;
   so.gradient_tolerance = 1e-14;
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
@@ -419,11 +499,114 @@ Status RunSolver(ceres::Problem& problem, int max_iterations, const IctFitOption
   problem.GetParameterBlocks(&blocks);
   for (double* block : blocks) ordering->AddElementToGroup(block, 1);
   for (double* block : eliminate) ordering->AddElementToGroup(block, 0);
-  so.linear_solver_ordering = ordering;
+  if (!eliminate.empty()) so.linear_solver_ordering = ordering;
   so.num_threads = 1;  // deterministic
   so.logging_type = ceres::SILENT;
   ceres::Solve(so, &problem, summary);
   if (!summary->IsSolutionUsable()) return Status::Error("ict fit: the solver failed: " + summary->message);
+  return Status::Ok();
+}
+
+// The shared head pose (world_from_head: angle-axis, translation, log scale) that agrees best with
+// per-photo poses cam_from_head (cm) and the known cameras: the head's origin seen from camera k lies
+// at c_k + s d_k (c_k the camera's centre, d_k its cm offset turned into the world, s world units per
+// cm), so s is the least-squares scale that makes those points coincide; the rotation is the
+// projection onto SO(3) of the mean of the photos' head-to-world rotations.
+Status InitialSharedPose(const std::vector<Mat4d>& cam_from_world, const std::vector<Mat4d>& cam_from_head,
+                         double* pose) {
+  const size_t n = cam_from_world.size();
+  std::vector<Vec3d> c(n), d(n);
+  Vec3d c_mean = Vec3d::Zero(), d_mean = Vec3d::Zero();
+  Mat3d rotation_sum = Mat3d::Zero();
+  for (size_t k = 0; k < n; ++k) {
+    const Mat3d rc = cam_from_world[k].block<3, 3>(0, 0);
+    c[k] = -rc.transpose() * cam_from_world[k].block<3, 1>(0, 3);
+    d[k] = rc.transpose() * cam_from_head[k].block<3, 1>(0, 3);
+    c_mean += c[k] / static_cast<double>(n);
+    d_mean += d[k] / static_cast<double>(n);
+    rotation_sum += rc.transpose() * cam_from_head[k].block<3, 3>(0, 0);
+  }
+  double num = 0, den = 0;
+  for (size_t k = 0; k < n; ++k) {
+    num -= (c[k] - c_mean).dot(d[k] - d_mean);
+    den += (d[k] - d_mean).squaredNorm();
+  }
+  // The offsets must differ by a real fraction of their length: else the views do not tell the
+  // scale (one photo, or cameras on one line through the head).
+  if (!(den > 1e-4 * d_mean.squaredNorm() * static_cast<double>(n)) || !(num / den > 0))
+    return Status::Error(
+        "ict fit: the known cameras do not determine the head's scale (they must see it from at least two "
+        "places not on one line with it)");
+  const double scale = num / den;
+  const Eigen::JacobiSVD<Mat3d> svd(rotation_sum, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Mat3d u = svd.matrixU();
+  if ((u * svd.matrixV().transpose()).determinant() < 0) u.col(2) *= -1;
+  const Mat3d r = u * svd.matrixV().transpose();
+  ceres::RotationMatrixToAngleAxis(r.data(), pose);
+  const Vec3d t = c_mean + scale * d_mean;
+  std::copy_n(t.data(), 3, pose + 3);
+  pose[6] = std::log(scale);
+  return Status::Ok();
+}
+
+// A photo's cam_from_head (rigid, cm) from its known camera and the shared world_from_head pose,
+// written as PhotoParams' angle-axis and translation.
+void PhotoPoseFromShared(const Mat4d& cam_from_world, const double* pose, const PhotoParams& p) {
+  const Mat3d rc = cam_from_world.block<3, 3>(0, 0);
+  const double scale = std::exp(pose[6]);
+  const Mat3d r = rc * RotationOf(pose);
+  const Vec3d t = (rc * Vec3d(pose[3], pose[4], pose[5]) + cam_from_world.block<3, 1>(0, 3)) / scale;
+  ceres::RotationMatrixToAngleAxis(r.data(), p.rotation);
+  std::copy_n(t.data(), 3, p.translation);
+}
+
+// The known-camera solve: the shared pose started from the per-photo poses in u (a rigid solve of
+// their own), then solved alone, then with everything but the cameras. Leaves each photo's pose in
+// u as its camera composed with the shared pose, and fit->head_from_world.
+Status SolveKnownCameras(const LandmarkBasis& b, const std::vector<PhotoData>& data,
+                         const std::vector<Mat4d>& cam_from_world, const IctFitOptions& o, Unknowns* u,
+                         IctFit* fit) {
+  const int n = static_cast<int>(data.size());
+  std::vector<Mat4d> cam_from_head(n, Mat4d::Identity());
+  for (int k = 0; k < n; ++k) {
+    const PhotoParams p = u->photo(k);
+    cam_from_head[k].block<3, 3>(0, 0) = RotationOf(p.rotation);
+    cam_from_head[k].block<3, 1>(0, 3) = Vec3d(p.translation[0], p.translation[1], p.translation[2]);
+  }
+  std::array<double, 7> pose{};  // angle-axis, translation, log scale
+  ICEF_RETURN_IF_ERROR(InitialSharedPose(cam_from_world, cam_from_head, pose.data()));
+  ceres::Problem problem;
+  double* identity = u->identity();
+  problem.AddResidualBlock(new GaussianPrior(b.num_identity(), o.identity_prior_sigma), nullptr, identity);
+  std::vector<double*> expressions;
+  for (int k = 0; k < n; ++k) {
+    double* expression = u->photo(k).expression;
+    expressions.push_back(expression);
+    problem.AddResidualBlock(
+        new KnownCameraLandmarkCost(&b, &data[k], cam_from_world[k], o.landmark_sigma_iod), nullptr, identity,
+        expression, pose.data(), pose.data() + 3, pose.data() + 6);
+    problem.AddResidualBlock(new ExpressionPrior(&b, o), nullptr, expression);
+    for (int e = 0; e < b.num_expressions(); ++e) {
+      problem.SetParameterLowerBound(expression, e, 0.0);
+      problem.SetParameterUpperBound(expression, e, 1.0);
+    }
+  }
+  ceres::Solver::Summary summary;
+  SetShapeConstant(u, true, &problem);
+  ICEF_RETURN_IF_ERROR(RunSolver(problem, std::max(o.rigid_iterations, 30), o, {}, &summary));
+  fit->iterations += summary.num_successful_steps + summary.num_unsuccessful_steps;
+  SetShapeConstant(u, false, &problem);
+  ICEF_RETURN_IF_ERROR(RunSolver(problem, o.max_iterations, o, expressions, &summary));
+  fit->iterations += summary.num_successful_steps + summary.num_unsuccessful_steps;
+  fit->final_cost = summary.final_cost;
+  for (int k = 0; k < n; ++k) PhotoPoseFromShared(cam_from_world[k], pose.data(), u->photo(k));
+  // head_from_world, the inverse of world_from_head: x_head = R^T (x_world - t) / s.
+  const double scale = std::exp(pose[6]);
+  Similarity head_from_world;
+  head_from_world.scale = 1.0 / scale;
+  head_from_world.rotation = RotationOf(pose.data()).transpose();
+  head_from_world.translation = -(head_from_world.rotation * Vec3d(pose[3], pose[4], pose[5])) / scale;
+  fit->head_from_world = head_from_world;
   return Status::Ok();
 }
 
@@ -507,6 +690,19 @@ Result<IctFit> FitIctToLandmarks(const face::IctModel& model, const std::vector<
     data.push_back(std::move(d));
   }
   const int n = static_cast<int>(photos.size());
+  const auto known = [](const IctObservation& o) { return o.cam_from_world.has_value(); };
+  const bool known_cameras = std::all_of(photos.begin(), photos.end(), known);
+  if (!known_cameras && std::any_of(photos.begin(), photos.end(), known))
+    return Status::Error("ict fit: some photos have a known camera and some do not (all or none)");
+  std::vector<Mat4d> cam_from_world;
+  for (int k = 0; known_cameras && k < n; ++k) {
+    const Mat4d& m = *photos[k].cam_from_world;
+    const Mat3d r = m.block<3, 3>(0, 0);
+    if (!m.allFinite() || !(r.transpose() * r).isApprox(Mat3d::Identity(), 1e-6) || !(r.determinant() > 0))
+      return Status::Error("ict fit: photo " + std::to_string(k) +
+                           ": cam_from_world is not a rigid transform");
+    cam_from_world.push_back(m);
+  }
   Unknowns u(basis.num_identity(), basis.num_expressions(), n);
   for (int k = 0; k < n; ++k) InitialPose(basis, &data[k], u.photo(k));
   ceres::Problem problem;
@@ -516,15 +712,22 @@ Result<IctFit> FitIctToLandmarks(const face::IctModel& model, const std::vector<
   std::vector<double*> rotations, expressions;  // the blocks each stage eliminates
   for (int k = 0; k < n; ++k) rotations.push_back(u.photo(k).rotation);
   for (int k = 0; k < n; ++k) expressions.push_back(u.photo(k).expression);
-  if (options.rigid_iterations > 0) {  // the poses of the mean neutral head first
+  // The poses of the mean neutral head first (with known cameras, they start the shared pose).
+  const int rigid_iterations =
+      known_cameras ? std::max(options.rigid_iterations, 30) : options.rigid_iterations;
+  if (rigid_iterations > 0) {
     SetShapeConstant(&u, true, &problem);
-    ICEF_RETURN_IF_ERROR(RunSolver(problem, options.rigid_iterations, options, rotations, &summary));
+    ICEF_RETURN_IF_ERROR(RunSolver(problem, rigid_iterations, options, rotations, &summary));
     fit.iterations += summary.num_successful_steps + summary.num_unsuccessful_steps;
     SetShapeConstant(&u, false, &problem);
   }
-  ICEF_RETURN_IF_ERROR(RunSolver(problem, options.max_iterations, options, expressions, &summary));
-  fit.iterations += summary.num_successful_steps + summary.num_unsuccessful_steps;
-  fit.final_cost = summary.final_cost;
+  if (known_cameras) {
+    ICEF_RETURN_IF_ERROR(SolveKnownCameras(basis, data, cam_from_world, options, &u, &fit));
+  } else {
+    ICEF_RETURN_IF_ERROR(RunSolver(problem, options.max_iterations, options, expressions, &summary));
+    fit.iterations += summary.num_successful_steps + summary.num_unsuccessful_steps;
+    fit.final_cost = summary.final_cost;
+  }
 
   fit.identity.assign(u.identity(), u.identity() + basis.num_identity());
   double sum2 = 0;

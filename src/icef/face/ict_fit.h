@@ -11,10 +11,12 @@
 // face/ict_model.h's; landmarks are the iBUG 68 in the model's order (landmark_vertices()).
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "icef/core/status.h"
+#include "icef/face/face_fit.h"
 #include "icef/face/ict_model.h"
 #include "icef/math/camera.h"
 #include "icef/math/types.h"
@@ -28,6 +30,11 @@ struct IctObservation {
   // [68] or empty (all 1): each landmark's weight, multiplying its residual; 0 = missing (its
   // position is then ignored and may be anything, NaN included).
   std::vector<float> weights;
+  // The camera, when known: camera-from-world, rigid, in the world's units (math/camera.h's camera
+  // frame). Either every photo has one or none does. With them, the fit solves one head pose for
+  // all photos, the similarity head_from_world (IctFit::head_from_world), instead of a pose per photo:
+  // the dataset's cameras stay as they are and the head is placed among them.
+  std::optional<Mat4d> cam_from_world;
 };
 
 struct IctFitOptions {
@@ -75,7 +82,10 @@ struct IctPhotoFit {
 struct IctFit {
   std::vector<float> identity;      // [num_identity] coefficients of the first modes (~N(0, 1))
   std::vector<IctPhotoFit> photos;  // one per observation, in order
-  double rms_iod = 0;               // over all photos' landmarks used
+  // With known cameras (IctObservation::cam_from_world): the world frame -> head frame (cm) the fit
+  // placed the head at; each photo's cam_from_head is then its camera composed with it, in cm.
+  std::optional<Similarity> head_from_world;
+  double rms_iod = 0;  // over all photos' landmarks used
   double max_iod = 0;
   int iterations = 0;     // Levenberg-Marquardt iterations, both stages
   double final_cost = 0;  // Ceres' cost (half the sum of squared scaled residuals)
@@ -83,7 +93,9 @@ struct IctFit {
   std::string ToString() const;
 };
 
-// Errors (one line naming the photo): invalid options; no observations; a photo with invalid
+// Errors (one line naming the photo): invalid options; no observations; known cameras for some
+// photos but not all, or known cameras that do not determine the scale (fewer than two camera
+// positions, or none not on one line with the head); a photo with invalid
 // intrinsics, without 68 landmarks (or weights), with a negative or non-finite weight, a
 // non-finite landmark of weight > 0, or fewer than 6 landmarks of weight > 0; a solve that fails.
 Result<IctFit> FitIctToLandmarks(const face::IctModel& model, const std::vector<IctObservation>& photos,

@@ -207,6 +207,110 @@ TEST(IctTrackFit, JacobiansMatchFiniteDifferences) {
   EXPECT_TRUE(fit.ok()) << fit.status().message();
 }
 
+// The truth's world frame for the known-camera fit: world_from_head with 0.026 world units per cm
+// (the trackers' scale), a turn and a shift; cam_from_world of each photo so that it sees the head
+// as the truth's cam_from_head does (the camera frame in world units).
+face::Similarity TruthHeadFromWorld() {
+  face::Similarity s;  // head_from_world: x_head = s R x_world + t
+  s.scale = 1 / 0.026;
+  s.rotation = Eigen::AngleAxisd(0.4, Vec3d(0.3, 1, -0.2).normalized()).toRotationMatrix();
+  s.translation = Vec3d(1.5, -4, 2);
+  return s;
+}
+
+std::vector<IctObservation> WithKnownCameras(const Truth& t, std::vector<IctObservation> photos) {
+  const face::Similarity h = TruthHeadFromWorld();
+  for (size_t k = 0; k < photos.size(); ++k) {
+    // camera (world units) = (1 / scale) cam_from_head(head_from_world(x)).
+    Mat4d head_from_world = Mat4d::Identity();
+    head_from_world.block<3, 3>(0, 0) = h.rotation;
+    head_from_world.block<3, 1>(0, 3) = h.translation / h.scale;
+    Mat4d m = t.cam_from_head[k] * head_from_world;  // rotation, and the translation in cm / scale
+    m.block<3, 1>(0, 3) = t.cam_from_head[k].block<3, 3>(0, 0) * h.translation / h.scale +
+                          t.cam_from_head[k].block<3, 1>(0, 3) / h.scale;
+    photos[k].cam_from_world = m;
+  }
+  return photos;
+}
+
+// Known cameras: one head pose for all photos. It comes back as the truth's similarity, the
+// expressions as the truth's, and each photo's cam_from_head as its camera composed with it.
+TEST(IctTrackFit, KnownCamerasPlaceOneHead) {
+  ICT_MODEL_OR_SKIP(m);
+  const Truth truth = MakeTruth(m, 5, 21);
+  const std::vector<IctObservation> photos = WithKnownCameras(truth, Observe(m, truth, 0.5, 22));
+  // The cameras are right: the truth's landmarks in the world project onto the observations.
+  const face::Similarity h = TruthHeadFromWorld();
+  const std::vector<Vec3f> lm = m.Landmarks(m.Mesh(truth.identity, truth.expression[1]));
+  const Camera camera(photos[1].intrinsics, photos[1].cam_from_world->inverse());
+  EXPECT_LT(
+      (camera.Project(h.ApplyInverse(lm[30].cast<double>()))->uv - photos[1].landmarks[30].cast<double>())
+          .norm(),
+      3.0);
+  const Result<IctFit> fit = FitIctToLandmarks(m, photos, IctFitOptions::ForPhotos());
+  ASSERT_TRUE(fit.ok()) << fit.status().message();
+  ASSERT_TRUE(fit->head_from_world.has_value());
+  const face::Similarity& got = *fit->head_from_world;
+  std::printf("[ known cameras ] %s; truth %s\n", fit->BriefReport().c_str(), h.ToString().c_str());
+  // The scale trades against the identity's size (a larger head farther off): a few percent.
+  EXPECT_NEAR(got.scale / h.scale, 1.0, 0.08);
+  EXPECT_LT(Eigen::AngleAxisd(got.rotation.transpose() * h.rotation).angle() * 180 / M_PI, 1.5);
+  // The fitted head lands where the truth's is, in the world: every landmark of every photo within
+  // 0.01 world units (4 mm) RMS.
+  double sum2 = 0;
+  int count = 0;
+  for (size_t k = 0; k < photos.size(); ++k) {
+    const std::vector<Vec3f> fitted = m.Landmarks(m.Mesh(fit->identity, fit->photos[k].expression));
+    const std::vector<Vec3f> true_lm = m.Landmarks(m.Mesh(truth.identity, truth.expression[k]));
+    for (int i = 17; i < 68; ++i, ++count)
+      sum2 += (got.ApplyInverse(fitted[i].cast<double>()) - h.ApplyInverse(true_lm[i].cast<double>()))
+                  .squaredNorm();
+  }
+  const double world_rms = std::sqrt(sum2 / count);
+  std::printf("[ known cameras ] inner landmarks in the world: RMS %.4f units (%.2f cm)\n", world_rms,
+              world_rms * h.scale);
+  EXPECT_LT(world_rms, 0.01);
+  EXPECT_LT(fit->rms_iod, 0.01);
+  EXPECT_LT(ExpressionError(m, truth, *fit, "jawOpen"), 0.1);
+  EXPECT_LT(ExpressionError(m, truth, *fit, "mouthSmile"), 0.15);
+  for (size_t k = 0; k < photos.size(); ++k) {
+    Mat4d head_from_world_m = Mat4d::Identity();
+    head_from_world_m.block<3, 3>(0, 0) = got.rotation * got.scale;
+    head_from_world_m.block<3, 1>(0, 3) = got.translation;
+    // cam_from_head (cm) = (1 / scale of world per cm) camera o world_from_head: compare directions.
+    EXPECT_LT(RotationErrorDeg(fit->photos[k].cam_from_head, truth.cam_from_head[k]), 1.0) << k;
+  }
+}
+
+TEST(IctTrackFit, KnownCameraJacobiansMatchFiniteDifferences) {
+  ICT_MODEL_OR_SKIP(m);
+  const Truth truth = MakeTruth(m, 3, 27);
+  IctFitOptions options;
+  options.num_identity = 10;
+  options.check_gradients = true;
+  options.rigid_iterations = 2;
+  options.max_iterations = 3;
+  const Result<IctFit> fit =
+      FitIctToLandmarks(m, WithKnownCameras(truth, Observe(m, truth, 0.5, 24)), options);
+  EXPECT_TRUE(fit.ok()) << fit.status().message();
+}
+
+TEST(IctTrackFit, KnownCamerasMustBeAllAndTellTheScale) {
+  ICT_MODEL_OR_SKIP(m);
+  const Truth truth = MakeTruth(m, 3, 25);
+  std::vector<IctObservation> photos = WithKnownCameras(truth, Observe(m, truth, 0.5, 26));
+  std::vector<IctObservation> some = photos;
+  some[1].cam_from_world.reset();
+  EXPECT_NE(FitIctToLandmarks(m, some).status().message().find("all or none"), std::string::npos);
+  const std::vector<IctObservation> one = {photos[0]};
+  EXPECT_NE(FitIctToLandmarks(m, one).status().message().find("do not determine the head's scale"),
+            std::string::npos);
+  some = photos;
+  (*some[2].cam_from_world)(0, 0) = 2;
+  EXPECT_NE(FitIctToLandmarks(m, some).status().message().find("photo 2: cam_from_world is not a rigid"),
+            std::string::npos);
+}
+
 // Missing landmarks (weight 0, NaN positions), a whole eye among them: the inter-ocular distance
 // then comes from the initial pose.
 TEST(IctTrackFit, IgnoresMissingLandmarks) {

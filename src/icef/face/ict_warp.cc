@@ -382,8 +382,9 @@ IctWarpClosest PosedIctWarp::Closest(const Vec3f& x) const {
   return search.Result();
 }
 
-Vec3f PosedIctWarp::Offset(const Vec3f& x) const {
-  const IctWarpClosest closest = Closest(x);
+Vec3f PosedIctWarp::Offset(const Vec3f& x) const { return OffsetAt(x, Closest(x)); }
+
+Vec3f PosedIctWarp::OffsetAt(const Vec3f& x, const IctWarpClosest& closest) const {
   if (closest.triangle < 0) return Vec3f::Zero();
   const IctWarpOptions& options = warp_->options_;
   const float weight = Falloff(closest.distance, options.inner_radius, options.outer_radius);

@@ -123,6 +123,8 @@ class PosedIctWarp {
   Vec3f Offset(const Vec3f& x) const;
   // The closest point of x on the posed surface, when within outer_radius.
   IctWarpClosest Closest(const Vec3f& x) const;
+  // P(x) - x given x's closest point (Closest(x)): Offset(x) without a second search.
+  Vec3f OffsetAt(const Vec3f& x, const IctWarpClosest& closest) const;
 
   const IctWarp& warp() const { return *warp_; }
   const std::vector<float>& expression() const { return expression_; }

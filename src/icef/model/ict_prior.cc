@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "icef/face/ict_fit.h"
+#include "icef/model/lazy_grid.h"
 
 namespace icef {
 
@@ -216,27 +217,95 @@ bool MouthVolume::Inside(const Vec3f& x) const {
 
 }  // namespace
 
+// The grid's channels: offset (cm), observed normal, canonical normal; head frame.
+constexpr int kGridChannels = 9;
+
 struct IctPrior::Expression {
-  Expression(const face::IctWarp& warp, const MouthSurface& surface, std::span<const float> beta)
-      : posed(warp.Pose(beta)), mouth(surface, posed.posed()), normals(warp.VertexNormals(posed.posed())) {
+  Expression(const face::IctWarp& warp, const MouthSurface& surface,
+             const std::vector<Vec3f>* neutral_normals, std::span<const float> beta,
+             const IctPriorOptions& options)
+      : posed(warp.Pose(beta)),
+        mouth(surface, posed.posed()),
+        normals(warp.VertexNormals(posed.posed())),
+        canonical_normals(neutral_normals != nullptr ? *neutral_normals : normals) {
     float gap = 0;
     for (const auto& [upper, lower] : surface.inner_lips)
       gap += (posed.posed()[upper] - posed.posed()[lower]).norm();
     open = gap / 3.f > kOpenLipGap;
+    if (options.grid_cell <= 0.f) return;
+    // The box: the posed surface and outer_radius around it (beyond, nothing moves and no normal).
+    Vec3f lo = Vec3f::Constant(INFINITY), hi = Vec3f::Constant(-INFINITY);
+    for (const auto& t : warp.triangles())
+      for (uint32_t v : t) lo = lo.cwiseMin(posed.posed()[v]), hi = hi.cwiseMax(posed.posed()[v]);
+    const Vec3f margin = Vec3f::Constant(warp.options().outer_radius + options.grid_cell);
+    LazyGrid::Options grid_options;
+    grid_options.cell = options.grid_cell;
+    grid_options.tolerance.assign(kGridChannels, options.normal_tolerance);
+    std::fill_n(grid_options.tolerance.begin(), 3, options.offset_tolerance);
+    grid = std::make_unique<LazyGrid>(
+        lo - margin, hi + margin, std::move(grid_options),
+        [this](const Vec3f& x, float* values, Vec3f* anchor) { return Exact(x, values, anchor); });
+  }
+
+  // values[kGridChannels] at x (head frame); the anchor is x's closest surface point, if any.
+  bool Exact(const Vec3f& x, float* values, Vec3f* anchor) const {
+    const face::IctWarpClosest closest = posed.Closest(x);
+    Eigen::Map<Vec3f> offset(values), observed(values + 3), canonical(values + 6);
+    offset = posed.OffsetAt(x, closest);
+    if (closest.triangle < 0) {
+      observed.setZero(), canonical.setZero();
+      return false;
+    }
+    const std::array<uint32_t, 3>& t = posed.warp().triangles()[closest.triangle];
+    const Vec3f& b = closest.barycentric;
+    observed = Interpolated(normals, t, b);
+    canonical = Interpolated(canonical_normals, t, b);
+    const std::vector<Vec3f>& mesh = posed.posed();
+    *anchor = b[0] * mesh[t[0]] + b[1] * mesh[t[1]] + b[2] * mesh[t[2]];
+    return true;
+  }
+
+  // Offset and normals at x (head frame): the grid's where there is one.
+  void Sample(const Vec3f& x, float* values) const {
+    if (grid != nullptr) {
+      grid->At(x, values);
+      return;
+    }
+    Vec3f anchor;
+    Exact(x, values, &anchor);
   }
 
   face::PosedIctWarp posed;
   MouthVolume mouth;
-  std::vector<Vec3f> normals;  // of the posed warp surface: [num_vertices], head frame
-  bool open = false;           // the inner lips are parted (kOpenLipGap)
+  std::vector<Vec3f> normals;                   // of the posed warp surface: [num_vertices], head frame
+  const std::vector<Vec3f>& canonical_normals;  // of the neutral (beta = 0)
+  bool open = false;                            // the inner lips are parted (kOpenLipGap)
+  std::unique_ptr<LazyGrid> grid;               // nullptr: grid_cell = 0
 };
+
+Status IctPriorOptions::Validate() const {
+  ICEF_RETURN_IF_ERROR(warp.Validate());
+  if (!std::isfinite(grid_cell) || grid_cell < 0.f)
+    return Status::Error("grid_cell must be a finite number >= 0 (cm), got " + std::to_string(grid_cell));
+  if (!std::isfinite(offset_tolerance) || offset_tolerance < 0.f || !std::isfinite(normal_tolerance) ||
+      normal_tolerance < 0.f)
+    return Status::Error("offset_tolerance and normal_tolerance must be finite numbers >= 0");
+  return Status::Ok();
+}
+
+std::string IctPriorOptions::ToString() const {
+  std::ostringstream os;
+  os << "IctPriorOptions(" << warp.ToString() << ", grid_cell=" << grid_cell
+     << ", offset_tolerance=" << offset_tolerance << ", normal_tolerance=" << normal_tolerance << ")";
+  return os.str();
+}
 
 IctPrior::~IctPrior() = default;
 
 Result<std::unique_ptr<IctPrior>> IctPrior::Create(std::shared_ptr<const face::IctModel> model,
                                                    std::span<const float> identity,
                                                    const face::Similarity& head_from_world,
-                                                   const face::IctWarpOptions& options) {
+                                                   const IctPriorOptions& options) {
   if (model == nullptr) return Status::Error("IctPrior: no face model");
   const face::Similarity& s = head_from_world;
   const bool finite = std::isfinite(s.scale) && s.rotation.allFinite() && s.translation.allFinite();
@@ -244,13 +313,16 @@ Result<std::unique_ptr<IctPrior>> IctPrior::Create(std::shared_ptr<const face::I
       !(s.rotation.determinant() > 0))
     return Status::Error("IctPrior: head_from_world is not a similarity (finite scale > 0, a rotation): " +
                          s.ToString());
-  Result<face::IctWarp> warp = face::IctWarp::Create(*model, identity, options);
+  ICEF_RETURN_IF_ERROR(options.Validate().WithContext("IctPrior"));
+  Result<face::IctWarp> warp = face::IctWarp::Create(*model, identity, options.warp);
   if (!warp.ok()) return warp.status().WithContext("IctPrior");
   std::unique_ptr<IctPrior> prior(new IctPrior());
   prior->warp_ = std::make_unique<const face::IctWarp>(std::move(warp).value());
   Result<MouthSurface> surface = MouthSurface::Build(*prior->warp_);
   if (!surface.ok()) return surface.status().WithContext("IctPrior");
   prior->mouth_surface_ = std::make_unique<const MouthSurface>(std::move(surface).value());
+  prior->options_ = options;
+  prior->neutral_normals_ = prior->warp_->VertexNormals(prior->warp_->neutral());
   prior->model_ = std::move(model);
   prior->identity_.assign(identity.begin(), identity.end());
   prior->head_from_world_ = s;
@@ -263,7 +335,7 @@ Result<std::unique_ptr<IctPrior>> IctPrior::Create(std::shared_ptr<const face::I
 }
 
 std::shared_ptr<const IctPrior::Expression> IctPrior::Pose(const std::vector<float>& key) const {
-  return std::make_shared<const Expression>(*warp_, *mouth_surface_, key);
+  return std::make_shared<const Expression>(*warp_, *mouth_surface_, &neutral_normals_, key, options_);
 }
 
 IctPrior::Batch IctPrior::Prepare(const Executor& executor, int64_t n, const float* betas) const {
@@ -345,7 +417,9 @@ void IctPrior::ForEachSample(const Executor& executor, int64_t n, const float* p
 void IctPrior::Offsets(const Executor& executor, int64_t n, const float* positions, const float* betas,
                        float* offsets) const {
   ForEachSample(executor, n, positions, betas, [&](int64_t i, const Expression& e, const Vec3f& x) {
-    Eigen::Map<Vec3f>(offsets + 3 * i) = world_from_head_linear_ * e.posed.Offset(x);
+    float values[kGridChannels];
+    e.Sample(x, values);
+    Eigen::Map<Vec3f>(offsets + 3 * i) = world_from_head_linear_ * Eigen::Map<const Vec3f>(values);
   });
 }
 
@@ -373,15 +447,16 @@ void IctPrior::Cavity(const Executor& executor, int64_t n, const float* position
 bool IctPrior::Normals(const Executor& executor, int64_t n, const float* positions, const float* betas,
                        float* observed, float* canonical) const {
   ForEachSample(executor, n, positions, betas, [&](int64_t i, const Expression& e, const Vec3f& x) {
-    const face::IctWarpClosest closest = e.posed.Closest(x);
-    Vec3f n_observed = Vec3f::Zero(), n_canonical = Vec3f::Zero();
-    if (closest.triangle >= 0) {
-      const std::array<uint32_t, 3>& t = warp_->triangles()[closest.triangle];
-      n_observed = world_from_head_rotation_ * Interpolated(e.normals, t, closest.barycentric);
-      n_canonical = world_from_head_rotation_ * Interpolated(rest_->normals, t, closest.barycentric);
-    }
-    Eigen::Map<Vec3f>(observed + 3 * i) = n_observed;
-    Eigen::Map<Vec3f>(canonical + 3 * i) = n_canonical;
+    float values[kGridChannels];
+    e.Sample(x, values);
+    // Unit normals, or 0 where there is no surface (interpolated ones are renormalised).
+    const auto unit = [](const float* v) {
+      const Vec3f n = Eigen::Map<const Vec3f>(v);
+      const float norm = n.norm();
+      return norm > 1e-6f ? Vec3f(n / norm) : Vec3f::Zero();
+    };
+    Eigen::Map<Vec3f>(observed + 3 * i) = world_from_head_rotation_ * unit(values + 3);
+    Eigen::Map<Vec3f>(canonical + 3 * i) = world_from_head_rotation_ * unit(values + 6);
   });
   return true;
 }
@@ -395,8 +470,18 @@ std::string IctPrior::ToString() const {
   std::ostringstream os;
   os << "IctPrior(model=" << model_->path().string() << ", identity=" << identities << " of "
      << model_->num_identities() << " coefficients non-zero, head_from_world=" << head_from_world_.ToString()
-     << ", " << warp_->options().ToString() << ", mouth_surface=" << mouth_surface_->triangles.size()
-     << " triangles, cached=" << cache_.size() << "/" << kCacheCapacity << " expressions)";
+     << ", " << options_.ToString() << ", mouth_surface=" << mouth_surface_->triangles.size()
+     << " triangles, cached=" << cache_.size() << "/" << kCacheCapacity << " expressions";
+  LazyGrid::Counts grid;
+  for (const CacheEntry& entry : cache_) {
+    if (entry.expression->grid == nullptr) continue;
+    const LazyGrid::Counts c = entry.expression->grid->counts();
+    grid.bricks += c.bricks, grid.cells += c.cells, grid.interpolated += c.interpolated;
+  }
+  if (grid.cells > 0)
+    os << ", their grids: " << grid.bricks << " bricks, " << grid.interpolated << "/" << grid.cells
+       << " cells interpolated";
+  os << ")";
   return os.str();
 }
 

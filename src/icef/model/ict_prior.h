@@ -27,6 +27,17 @@
 // where the warp maps that point (within inner_radius P keeps the signed distance along it). Both
 // are 0 where no surface lies within outer_radius (the prior's shading is then neutral).
 //
+// Grid (IctPriorOptions::grid_cell): the closest-point search costs microseconds a point, and a
+// training step asks it of every sample at a handful of expressions. Each posed expression therefore
+// caches its offsets and both normals on a LazyGrid in the head frame (built brick by brick where
+// points are asked), interpolated where the exact warp is smooth across a cell and exact elsewhere:
+// between the lips, at the lids' margins, where the warp fades out. Offsets then differ from the
+// exact warp by about offset_tolerance (IctPrior.GridMatchesTheExactWarp: 99.9 % of points within
+// 0.02 cm). Measured on a real subject's 300-step training (smirk-dafoe, ICT K = 5, 2 threads):
+// 0.68 s a step exact, 0.39 s with the grid (71 % of the samples interpolated), the same losses to
+// four digits. Cost: a grid over the whole head's box takes ~3.4 s to build on 2 threads and ~80 MB
+// per expression (bricks are built only where points are asked).
+//
 // Thread safety: const methods may be called concurrently (the cache is guarded by a mutex).
 #pragma once
 
@@ -47,6 +58,21 @@
 
 namespace icef {
 
+class LazyGrid;
+
+struct IctPriorOptions {
+  face::IctWarpOptions warp;
+  // cm: cell of the grid that caches each posed expression's warp and normals (LazyGrid: trilinear
+  // where that reproduces the exact warp within the tolerances below, the exact warp elsewhere);
+  // 0: always the exact warp.
+  float grid_cell = 0.25f;
+  float offset_tolerance = 0.01f;  // cm: a grid cell's largest offset error at its centre
+  float normal_tolerance = 0.1f;   // a grid cell's largest normal error (per component) at its centre
+
+  Status Validate() const;
+  std::string ToString() const;
+};
+
 class IctPrior final : public DeformationPrior {
  public:
   static constexpr int kCacheCapacity = 16;  // posed expressions kept between calls
@@ -58,7 +84,7 @@ class IctPrior final : public DeformationPrior {
   static Result<std::unique_ptr<IctPrior>> Create(std::shared_ptr<const face::IctModel> model,
                                                   std::span<const float> identity,
                                                   const face::Similarity& head_from_world,
-                                                  const face::IctWarpOptions& options = {});
+                                                  const IctPriorOptions& options = {});
   ~IctPrior() override;
   IctPrior(const IctPrior&) = delete;
   IctPrior& operator=(const IctPrior&) = delete;
@@ -100,6 +126,7 @@ class IctPrior final : public DeformationPrior {
                      Fn&& fn) const;
   std::shared_ptr<const Expression> Pose(const std::vector<float>& key) const;
 
+  IctPriorOptions options_;
   std::shared_ptr<const face::IctModel> model_;
   std::unique_ptr<const face::IctWarp> warp_;  // heap-held: posed warps point to it
   std::unique_ptr<const MouthSurface> mouth_surface_;
@@ -109,6 +136,7 @@ class IctPrior final : public DeformationPrior {
   Mat3f world_from_head_linear_;    // R^T / scale
   Mat3f world_from_head_rotation_;  // R^T (normals)
   Vec3f translation_;
+  std::vector<Vec3f> neutral_normals_;      // of the warp surface at beta = 0, head frame
   std::shared_ptr<const Expression> rest_;  // beta = 0, always at hand
 
   struct CacheEntry {

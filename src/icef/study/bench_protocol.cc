@@ -121,6 +121,7 @@ Json BenchOptions::ToJson() const {
   } else {
     j["scenes"] = "classic";
   }
+  if (face_model != "procedural") j["face_model"] = face_model;
   j["test_views"] = test_views;
   j["novel_per_tier"] = novel_per_tier;
   j["steps"] = steps;
@@ -217,6 +218,24 @@ Result<Dataset> EnsureDataset(const BenchOptions& o, uint64_t seed, int k, const
   ICEF_RETURN_IF_ERROR(synth::SynthesizeDataset(so, executor, &bar, &dataset));
   ICEF_RETURN_IF_ERROR(WriteFileAtomic(stamp, want));
   return LoadDataset(so.out_dir);
+}
+
+// EnsureDataset, re-expressed in the bench's face model when it is not the procedural one (cached
+// beside it as <name>_<face_model>, redone when the synthesised dataset was).
+Result<Dataset> EnsureBenchDataset(const BenchOptions& o, uint64_t seed, int k, const Executor& executor,
+                                   std::ostream& log, bool interactive) {
+  ICEF_ASSIGN_OR_RETURN(const Dataset source, EnsureDataset(o, seed, k, executor, log, interactive));
+  if (o.face_model == "procedural") return source;
+  if (!o.reexpress) return Status::Error("bench: no re-expression for face model " + o.face_model);
+  const fs::path dir = source.root.string() + "_" + o.face_model;
+  std::error_code ec;
+  const bool fresh = fs::exists(dir / "transforms_test.json", ec) &&
+                     fs::last_write_time(dir / "transforms_test.json", ec) >=
+                         fs::last_write_time(source.root / "synth_options.txt", ec);
+  if (fresh) return LoadDataset(dir);
+  fs::remove_all(dir, ec);
+  log << "bench: re-expressing " << source.root.filename().string() << " in " << o.face_model << "\n";
+  return o.reexpress(source, dir);
 }
 
 Result<RunConfig> MakeRunConfig(const BenchOptions& o, const RunId& id) {
@@ -351,7 +370,8 @@ Status RunBench(const BenchOptions& o, std::ostream& log, bool interactive) {
     if (it == datasets.end()) {
       // Only one identity x K dataset is held at a time (runs are identity/K-major).
       datasets.clear();
-      ICEF_ASSIGN_OR_RETURN(Dataset d, EnsureDataset(o, id.identity_seed, id.k, executor, log, interactive));
+      ICEF_ASSIGN_OR_RETURN(Dataset d,
+                            EnsureBenchDataset(o, id.identity_seed, id.k, executor, log, interactive));
       it = datasets.emplace(std::make_pair(id.identity_seed, id.k), std::move(d)).first;
     }
     ICEF_ASSIGN_OR_RETURN(const RunRecord record,

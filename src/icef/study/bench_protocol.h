@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -83,6 +84,12 @@ struct BenchOptions {
   // (up to kMaxValidationResolution) instead of `resolution`.
   bool diverse = false;
   bool draw_resolution = false;
+  // The face model the datasets are expressed in: "procedural" (as synthesised) or "ict": each
+  // synthesised dataset is re-expressed by `reexpress` (set by the app: icef track --keep-cameras
+  // --face-model ict --landmarks model) into data/<name>_ict/ and the runs train and score on it,
+  // against the procedural renders: a model-mismatch test.
+  std::string face_model = "procedural";
+  std::function<Result<Dataset>(const Dataset& source, const std::filesystem::path& out_dir)> reexpress;
 
   // The --validation settings: validation seeds 101..106, K = 5, diverse scenes with a drawn
   // resolution, methods icef and icef-prior, `icef train`'s default steps with no time cap (a pure

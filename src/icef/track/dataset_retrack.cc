@@ -1,7 +1,9 @@
 #include "icef/track/dataset_retrack.h"
 
 #include <cmath>
+#include <memory>
 #include <set>
+#include <sstream>
 #include <system_error>
 
 #include "icef/core/enum_table.h"
@@ -11,6 +13,7 @@
 #include "icef/io/image.h"
 #include "icef/landmarks/landmark_detection.h"
 #include "icef/track/head_mask.h"
+#include "icef/track/ict_track.h"
 
 namespace icef::track {
 
@@ -66,6 +69,7 @@ double RetrackLandmarkSigma(RetrackLandmarks landmarks) {
 }
 
 Status RetrackOptions::Validate() const {
+  if (face_model == TrackFaceModel::kIct) ICEF_RETURN_IF_ERROR(ict_fit.Validate());
   TrackFitOptions resolved = fit;
   if (resolved.photometric_weight < 0) resolved.photometric_weight = RetrackPhotometricWeight(landmarks);
   if (resolved.landmark_sigma_iod < 0) resolved.landmark_sigma_iod = RetrackLandmarkSigma(landmarks);
@@ -78,8 +82,42 @@ std::string RetrackOptions::ToString() const {
          ", silhouette_points=" + std::to_string(silhouette_points) +
          ", detector=" + LandmarkDetectorName(detector) +
          ", predictor=" + (predictor_path.empty() ? std::string("default") : predictor_path.string()) +
-         ", fit_style=" + std::to_string(fit_style) + ", " + fit.ToString() + ")";
+         ", fit_style=" + std::to_string(fit_style) + ", face_model=" + TrackFaceModelName(face_model) +
+         ", " + (face_model == TrackFaceModel::kIct ? ict_fit.ToString() : fit.ToString()) + ")";
 }
+
+namespace {
+
+// The ICT fit of RetrackDataset: the frames' landmarks with their known cameras (FitIctTrack), the
+// dataset in ICT's expressions with the fitted mesh's landmarks (world frame).
+Status RetrackIct(const std::vector<TrackFrame>& track_frames, const std::vector<Frame*>& order,
+                  const RetrackOptions& options, const std::function<void(const std::string&)>& log,
+                  RetrackResult* result) {
+  ICEF_ASSIGN_OR_RETURN(const std::shared_ptr<const face::IctModel> model, face::IctModel::LoadDefault());
+  Result<TrackFit> fit = FitIctTrack(*model, track_frames, options.ict_fit);
+  if (!fit.ok()) return fit.status().WithContext("ICT-FaceKit fit");
+  result->fit = std::move(fit).value();
+  if (log) {
+    std::ostringstream os;
+    os << "ICT-FaceKit fitted to the landmarks of " << order.size() << " frames with their cameras held: RMS "
+       << result->fit.rms_iod << " IOD (max " << result->fit.max_iod << "), " << result->fit.iterations
+       << " iterations";
+    log(os.str());
+  }
+  for (size_t k = 0; k < order.size(); ++k) {
+    Frame& f = *order[k];
+    f.expression = result->fit.frames[k].expression;
+    f.landmarks_3d = std::vector<Vec3f>(result->fit.frames[k].landmarks_head.begin(),
+                                        result->fit.frames[k].landmarks_head.end());
+    f.neutral_landmarks_2d.reset();  // in the source's terms; the neutral image is kept
+    f.neutral_landmarks_3d.reset();
+  }
+  result->dataset.expression_dim = model->num_expressions();
+  result->dataset.expression_names = model->expression_names();
+  return Status::Ok();
+}
+
+}  // namespace
 
 Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions& options,
                                      const Executor& executor,
@@ -148,6 +186,10 @@ Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions
       order.push_back(&f);
       result.frame_names.push_back(FrameName(split, static_cast<int>(i), f));
     }
+  }
+  if (options.face_model == TrackFaceModel::kIct) {
+    ICEF_RETURN_IF_ERROR(RetrackIct(track_frames, order, options, log, &result));
+    return result;
   }
   TrackFitOptions fit_options = options.fit;
   const bool default_weight = fit_options.photometric_weight < 0;
@@ -300,11 +342,12 @@ Result<RetrackResult> RetrackDataset(const Dataset& source, const RetrackOptions
 
 Json RetrackReportJson(const RetrackResult& result) {
   Json frames = Json::array();
+  const std::vector<std::string>& names = result.dataset.expression_names;
   for (size_t k = 0; k < result.fit.frames.size(); ++k) {
     const TrackedFrame& f = result.fit.frames[k];
     Json expression = Json::object();
-    for (int e = 0; e < face::kNumExpressions; ++e)
-      expression[face::kExpressionNames[e]] = JsonFloat(f.expression[e]);
+    for (size_t e = 0; e < f.expression.size() && e < names.size(); ++e)
+      expression[names[e]] = JsonFloat(f.expression[e]);
     frames.push_back(Json{{"frame", result.frame_names[k]},
                           {"landmark_rms_iod", f.rms_iod},
                           {"landmark_max_iod", f.max_iod},
@@ -331,19 +374,27 @@ Json RetrackReportJson(const RetrackResult& result) {
                  {"landmark_rms_iod", result.style_fit->rms_iod},
                  {"generic_landmark_rms_iod", result.style_fit->generic_style_rms_iod}};
   }
-  return Json{{"frames", frames},
-              {"skipped", result.skipped},
-              {"expression_style", style},
-              {"landmark_rms_iod", result.fit.rms_iod},
-              {"photometric_refit", result.fit.photometric},
-              {"silhouette_refit", result.fit.silhouettes},
-              {"landmark_max_iod", result.fit.max_iod},
-              {"iterations", result.fit.iterations},
-              {"head_from_world",
-               {{"scale", s.scale},
-                {"rotation", rotation},
-                {"translation", {s.translation.x(), s.translation.y(), s.translation.z()}}}},
-              {"shape", shape}};
+  Json out{{"frames", frames},
+           {"skipped", result.skipped},
+           {"expression_style", style},
+           {"landmark_rms_iod", result.fit.rms_iod},
+           {"photometric_refit", result.fit.photometric},
+           {"silhouette_refit", result.fit.silhouettes},
+           {"landmark_max_iod", result.fit.max_iod},
+           {"iterations", result.fit.iterations},
+           {"head_from_world",
+            {{"scale", s.scale},
+             {"rotation", rotation},
+             {"translation", {s.translation.x(), s.translation.y(), s.translation.z()}}}},
+           {"shape", shape}};
+  if (!result.fit.ict_identity.empty()) {  // ICT: its identity instead of the procedural shape
+    Json identity = Json::array();
+    for (const float c : result.fit.ict_identity) identity.push_back(JsonFloat(c));
+    out["face_model"] = "ict";
+    out["ict_identity"] = identity;
+    out.erase("shape");
+  }
+  return out;
 }
 
 Status WriteRetrackedDataset(const RetrackResult& result, const fs::path& out_dir,

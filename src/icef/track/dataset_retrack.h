@@ -18,6 +18,7 @@
 #include "icef/core/parallel.h"
 #include "icef/core/status.h"
 #include "icef/data/dataset.h"
+#include "icef/face/ict_fit.h"
 #include "icef/io/image.h"
 #include "icef/io/json_util.h"
 #include "icef/track/track_fit.h"
@@ -107,6 +108,11 @@ struct RetrackOptions {
   // fit finds the style again. False: every weight in the generic style (dlib's and the face mesh's
   // landmarks always are: they are too coarse to tell a style from a weight).
   bool fit_style = true;
+  // kIct: ICT-FaceKit fitted to the landmarks with the cameras held (track/ict_track.h: one head
+  // pose among them; silhouettes, colours and style are not used), the dataset written in its 53
+  // ARKit-named expressions with the fitted mesh's landmarks_3d.
+  TrackFaceModel face_model = TrackFaceModel::kProcedural;
+  face::IctFitOptions ict_fit = face::IctFitOptions::ForPhotos();  // with face_model kIct
   Status Validate() const;
   std::string ToString() const;
 };

@@ -23,26 +23,40 @@ face::Similarity WorldFromIctHead() {
 Result<TrackFit> FitIctTrack(const face::IctModel& model, std::span<const TrackFrame> frames,
                              const face::IctFitOptions& options) {
   std::vector<face::IctObservation> observations;
-  for (const TrackFrame& f : frames)
-    observations.push_back(face::IctObservation{f.intrinsics, f.landmarks_2d, {}});
+  for (const TrackFrame& f : frames) {
+    observations.push_back(face::IctObservation{f.intrinsics, f.landmarks_2d, {}, std::nullopt});
+    if (f.world_from_cam) observations.back().cam_from_world = f.world_from_cam->inverse();
+  }
   ICEF_ASSIGN_OR_RETURN(const face::IctFit fit, face::FitIctToLandmarks(model, observations, options));
+  // The head in the world: the known cameras' world with the fitted head_from_world, else the
+  // fixed WorldFromIctHead with each camera placed around it.
   const face::Similarity world = WorldFromIctHead();
+  const auto to_world = [&](const Vec3f& head) {
+    return fit.head_from_world ? fit.head_from_world->ApplyInverse(head.cast<double>()).cast<float>()
+                               : ToWorld(head);
+  };
   TrackFit out;
   out.ict_identity = fit.identity;
   out.rms_iod = fit.rms_iod;
   out.max_iod = fit.max_iod;
   out.iterations = fit.iterations;
-  for (const face::IctPhotoFit& p : fit.photos) {
+  out.head_from_world = fit.head_from_world;
+  for (size_t k = 0; k < fit.photos.size(); ++k) {
+    const face::IctPhotoFit& p = fit.photos[k];
     TrackedFrame f;
-    // cam_from_ict = [R | T] (cm); the camera centre in the world: scale * (-R^T T) + t.
-    const Mat3d r = p.cam_from_head.block<3, 3>(0, 0);
-    const Vec3d centre_ict = -r.transpose() * p.cam_from_head.block<3, 1>(0, 3);
-    const Vec3d centre = world.Apply(centre_ict);
-    f.cam_from_head.block<3, 3>(0, 0) = r;
-    f.cam_from_head.block<3, 1>(0, 3) = -r * centre;
+    if (frames[k].world_from_cam) {
+      f.cam_from_head = *observations[k].cam_from_world;
+    } else {
+      // cam_from_ict = [R | T] (cm); the camera centre in the world: scale * (-R^T T) + t.
+      const Mat3d r = p.cam_from_head.block<3, 3>(0, 0);
+      const Vec3d centre_ict = -r.transpose() * p.cam_from_head.block<3, 1>(0, 3);
+      const Vec3d centre = world.Apply(centre_ict);
+      f.cam_from_head.block<3, 3>(0, 0) = r;
+      f.cam_from_head.block<3, 1>(0, 3) = -r * centre;
+    }
     f.expression = p.expression;
     const std::vector<Vec3f> landmarks = model.Landmarks(model.Mesh(fit.identity, p.expression));
-    for (int i = 0; i < face::IctModel::kNumLandmarks; ++i) f.landmarks_head[i] = ToWorld(landmarks[i]);
+    for (int i = 0; i < face::IctModel::kNumLandmarks; ++i) f.landmarks_head[i] = to_world(landmarks[i]);
     f.projected = p.projected;
     f.rms_iod = p.rms_iod;
     f.max_iod = p.max_iod;

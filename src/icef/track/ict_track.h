@@ -30,12 +30,16 @@ constexpr double kWorldPerCm = 0.026;
 // x_world = kWorldPerCm * x_ict + WorldFromIctHead().translation.
 face::Similarity WorldFromIctHead();
 
-// ICT fitted to the frames' landmarks_2d with their intrinsics (known camera poses, silhouettes and
-// photos are not used). In the result, frames[i].cam_from_head is the camera from the dataset's
-// world frame (rigid, world units), expression the 53 weights in the model's order,
-// landmarks_head the fitted model's 68 landmarks in the world frame, projected / rms_iod / max_iod /
-// landmarks_used the fit's (all 68 landmarks, no outliers dropped); ict_identity the identity
-// coefficients; shape stays the procedural default. Errors: those of FitIctToLandmarks.
+// ICT fitted to the frames' landmarks_2d with their intrinsics (silhouettes and photos are not
+// used). Without camera poses, each frame's head pose is its own and the world frame is
+// WorldFromIctHead's; when every frame has world_from_cam (a dataset's known cameras), one head
+// pose is fitted among them (face::IctObservation::cam_from_world), the world frame is the
+// dataset's and head_from_world the fitted similarity. In the result, frames[i].cam_from_head is
+// the camera from the world frame (rigid, world units; the known camera as it was), expression the
+// 53 weights in the model's order, landmarks_head the fitted model's 68 landmarks in the world
+// frame, projected / rms_iod / max_iod / landmarks_used the fit's (all 68 landmarks, no outliers
+// dropped); ict_identity the identity coefficients; shape stays the procedural default. Errors:
+// those of FitIctToLandmarks.
 Result<TrackFit> FitIctTrack(const face::IctModel& model, std::span<const TrackFrame> frames,
                              const face::IctFitOptions& options = {});
 

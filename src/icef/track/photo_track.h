@@ -32,13 +32,6 @@
 
 namespace icef::track {
 
-// The face model the tracker fits: the procedural head (face/face_model.h; landmarks, then the
-// masks' outlines and the colours) or ICT-FaceKit (face/ict_model.h; landmarks only, the dataset in
-// its 53 ARKit-named expressions, track/ict_track.h).
-enum class TrackFaceModel { kProcedural, kIct };
-const char* TrackFaceModelName(TrackFaceModel model);
-std::optional<TrackFaceModel> ParseTrackFaceModel(const std::string& name);
-
 struct TrackOptions {
   TrackFaceModel face_model = TrackFaceModel::kProcedural;
   int resolution = 256;         // side of the square dataset images

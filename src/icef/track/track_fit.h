@@ -27,6 +27,13 @@
 
 namespace icef::track {
 
+// The face model the tracker fits: the procedural head (face/face_model.h; landmarks, then the
+// masks' outlines and the colours) or ICT-FaceKit (face/ict_model.h; landmarks only, the dataset in
+// its 53 ARKit-named expressions, track/ict_track.h). Name and parser in photo_track.cc.
+enum class TrackFaceModel { kProcedural, kIct };
+const char* TrackFaceModelName(TrackFaceModel model);
+std::optional<TrackFaceModel> ParseTrackFaceModel(const std::string& name);
+
 // One image: its 68 detected landmarks and its camera (intrinsics; the pose only when known).
 struct TrackFrame {
   std::vector<Vec2f> landmarks_2d;  // [68] pixels
