@@ -17,9 +17,11 @@
 #include <memory>
 
 #include "icef/eval/evaluate.h"
+#include "icef/face/ict_model.h"
 #include "icef/model/render_image.h"
 #include "icef/model/trained_model.h"
 #include "icef/synth/synthesize.h"
+#include "icef/track/dataset_retrack.h"
 #include "icef/train/trainer.h"
 
 namespace {
@@ -177,6 +179,46 @@ BENCHMARK(BM_TrainStep)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MinTime(3.0);
+
+// BM_TrainStep's default step (bf16, composited) on the ICT prior: the subject's dataset
+// re-expressed in ICT-FaceKit with its cameras held (icef track --keep-cameras --face-model ict
+// --landmarks model; `icef bench --face-model ict` trains on such datasets), warmed up the same way.
+// Compare steps/s with BM_TrainStep/bf16:1/composited:1 of the same run: the ICT prior's cost per
+// step (the warp's closest points, cached per expression on model/lazy_grid.h's grid).
+void BM_TrainStepIct(benchmark::State& state) {
+  const Subject& s = TrainedSubject();
+  if (!s.error.empty()) return state.SkipWithError(s.error.c_str());
+  if (!std::filesystem::exists(icef::face::IctModel::DefaultPath()))
+    return state.SkipWithError("no ICT-FaceKit model installed");
+  icef::track::RetrackOptions ro;
+  ro.landmarks = icef::track::RetrackLandmarks::kDatasetModel;
+  ro.face_model = icef::track::TrackFaceModel::kIct;
+  const icef::Result<icef::track::RetrackResult> ict =
+      icef::track::RetrackDataset(s.dataset, ro, icef::Executor(2));
+  if (!ict.ok()) return state.SkipWithError(ict.status().message().c_str());
+  icef::RunConfig config;
+  config.train.steps = 1000000;
+  config.train.threads = 2;
+  config.train.checkpoint_every = 0;
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("icef_train_ict_bench_" + std::to_string(::getpid()));
+  auto trainer = icef::Trainer::Create(ict->dataset, dir, config);
+  if (!trainer.ok()) return state.SkipWithError(trainer.status().message().c_str());
+  for (int i = 0; i < config.train.occupancy_warmup + 44; ++i)
+    if (!(*trainer)->Step().ok()) return state.SkipWithError("warm-up step failed");
+  int64_t samples = 0;
+  for (auto _ : state) {
+    const icef::Result<icef::LossTerms> terms = (*trainer)->Step();
+    if (!terms.ok()) return state.SkipWithError(terms.status().message().c_str());
+    samples += terms->samples;
+  }
+  const double steps = static_cast<double>(state.iterations());
+  state.counters["steps/s"] = benchmark::Counter(steps, benchmark::Counter::kIsRate);
+  state.counters["samples/s"] = benchmark::Counter(static_cast<double>(samples), benchmark::Counter::kIsRate);
+  trainer->reset();
+  std::filesystem::remove_all(dir);
+}
+BENCHMARK(BM_TrainStepIct)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
 
 // The start of a run, which BM_TrainStep leaves out: a fresh trainer's first
 // train.occupancy_warmup + 44 steps (the steps BM_TrainStep takes before it times), on 2 threads.

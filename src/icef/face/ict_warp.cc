@@ -110,15 +110,14 @@ Mat3f RotationOfSum(const Vec4f& q) {
   return Eigen::Quaternionf(n[3], n[0], n[1], n[2]).toRotationMatrix();
 }
 
-// 1 up to inner, a smoothstep down to 0 at outer, 0 beyond.
-float Falloff(float distance, float inner, float outer) {
-  if (distance <= inner) return 1.f;
-  if (distance >= outer) return 0.f;
-  const float s = (outer - distance) / (outer - inner);
+}  // namespace
+
+float IctWarpOptions::Weight(float distance) const {
+  if (distance <= inner_radius) return 1.f;
+  if (distance >= outer_radius) return 0.f;
+  const float s = (outer_radius - distance) / (outer_radius - inner_radius);
   return s * s * (3.f - 2.f * s);
 }
-
-}  // namespace
 
 Status IctWarpOptions::Validate() const {
   if (!std::isfinite(inner_radius) || !(inner_radius >= 0))
@@ -387,7 +386,7 @@ Vec3f PosedIctWarp::Offset(const Vec3f& x) const { return OffsetAt(x, Closest(x)
 Vec3f PosedIctWarp::OffsetAt(const Vec3f& x, const IctWarpClosest& closest) const {
   if (closest.triangle < 0) return Vec3f::Zero();
   const IctWarpOptions& options = warp_->options_;
-  const float weight = Falloff(closest.distance, options.inner_radius, options.outer_radius);
+  const float weight = options.Weight(closest.distance);
   if (weight == 0.f) return Vec3f::Zero();
   const std::array<uint32_t, 3>& triangle = warp_->triangles_[closest.triangle];
   const Vec3f& b = closest.barycentric;

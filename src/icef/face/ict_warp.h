@@ -58,6 +58,10 @@ struct IctWarpOptions {
   // m x m subdivision, m = ceil(its size / spacing)). Speed only: closest points are exact for any.
   float tree_point_spacing = 0.25f;
 
+  // How much a point this far (cm) from the posed surface follows it: 1 up to inner_radius, a
+  // smoothstep down to 0 at outer_radius, 0 beyond.
+  float Weight(float distance) const;
+
   Status Validate() const;
   std::string ToString() const;
 };

@@ -241,13 +241,16 @@ struct IctPrior::Expression {
     LazyGrid::Options grid_options;
     grid_options.cell = options.grid_cell;
     grid_options.tolerance.assign(kGridChannels, options.normal_tolerance);
+    grid_options.mixed_anchors = true;  // every channel fades to 0 at outer_radius (Exact)
     std::fill_n(grid_options.tolerance.begin(), 3, options.offset_tolerance);
     grid = std::make_unique<LazyGrid>(
         lo - margin, hi + margin, std::move(grid_options),
         [this](const Vec3f& x, float* values, Vec3f* anchor) { return Exact(x, values, anchor); });
   }
 
-  // values[kGridChannels] at x (head frame); the anchor is x's closest surface point, if any.
+  // values[kGridChannels] at x (head frame); the anchor is x's closest surface point, if any. The
+  // normals are scaled by the warp's weight (IctWarpOptions::Weight), so that every channel fades to
+  // 0 at outer_radius, as the offset does (Sample's caller normalises them).
   bool Exact(const Vec3f& x, float* values, Vec3f* anchor) const {
     const face::IctWarpClosest closest = posed.Closest(x);
     Eigen::Map<Vec3f> offset(values), observed(values + 3), canonical(values + 6);
@@ -258,8 +261,9 @@ struct IctPrior::Expression {
     }
     const std::array<uint32_t, 3>& t = posed.warp().triangles()[closest.triangle];
     const Vec3f& b = closest.barycentric;
-    observed = Interpolated(normals, t, b);
-    canonical = Interpolated(canonical_normals, t, b);
+    const float weight = posed.warp().options().Weight(closest.distance);
+    observed = weight * Interpolated(normals, t, b);
+    canonical = weight * Interpolated(canonical_normals, t, b);
     const std::vector<Vec3f>& mesh = posed.posed();
     *anchor = b[0] * mesh[t[0]] + b[1] * mesh[t[1]] + b[2] * mesh[t[2]];
     return true;
@@ -449,11 +453,12 @@ bool IctPrior::Normals(const Executor& executor, int64_t n, const float* positio
   ForEachSample(executor, n, positions, betas, [&](int64_t i, const Expression& e, const Vec3f& x) {
     float values[kGridChannels];
     e.Sample(x, values);
-    // Unit normals, or 0 where there is no surface (interpolated ones are renormalised).
+    // Unit normals where the warp's weight is above 1e-3 (within ~2.96 of the 3 cm outer radius),
+    // else 0 (the channels are the normals times the weight; interpolated ones are renormalised).
     const auto unit = [](const float* v) {
       const Vec3f n = Eigen::Map<const Vec3f>(v);
       const float norm = n.norm();
-      return norm > 1e-6f ? Vec3f(n / norm) : Vec3f::Zero();
+      return norm > 1e-3f ? Vec3f(n / norm) : Vec3f::Zero();
     };
     Eigen::Map<Vec3f>(observed + 3 * i) = world_from_head_rotation_ * unit(values + 3);
     Eigen::Map<Vec3f>(canonical + 3 * i) = world_from_head_rotation_ * unit(values + 6);

@@ -25,7 +25,8 @@
 // Normals: from the closest point of S x on the posed surface (triangle t, barycentric b): observed =
 // the posed mesh's interpolated vertex normal at (t, b), canonical = the neutral mesh's at (t, b),
 // where the warp maps that point (within inner_radius P keeps the signed distance along it). Both
-// are 0 where no surface lies within outer_radius (the prior's shading is then neutral).
+// are 0 where no surface lies within outer_radius, or where the warp's weight there has faded below
+// 1e-3 (the last ~0.04 cm; the prior's shading is then neutral).
 //
 // Grid (IctPriorOptions::grid_cell): the closest-point search costs microseconds a point, and a
 // training step asks it of every sample at a handful of expressions. Each posed expression therefore
@@ -33,10 +34,11 @@
 // points are asked), interpolated where the exact warp is smooth across a cell and exact elsewhere:
 // between the lips, at the lids' margins, where the warp fades out. Offsets then differ from the
 // exact warp by about offset_tolerance (IctPrior.GridMatchesTheExactWarp: 99.9 % of points within
-// 0.02 cm). Measured on a real subject's 300-step training (smirk-dafoe, ICT K = 5, 2 threads):
-// 0.68 s a step exact, 0.39 s with the grid (71 % of the samples interpolated), the same losses to
-// four digits. Cost: a grid over the whole head's box takes ~3.4 s to build on 2 threads and ~80 MB
-// per expression (bricks are built only where points are asked).
+// 0.02 cm). The normals are stored times the warp's weight, so every channel fades to 0 at
+// outer_radius and the cells around it interpolate as well. Measured on a real subject's 300-step
+// training (smirk-dafoe, ICT K = 5, 2 threads): 0.68 s a step exact, 0.34 s with the grid, the same
+// losses to four digits. Cost: a grid over the whole head's box takes ~3.4 s to build on 2 threads
+// and ~80 MB per expression (bricks are built only where points are asked).
 //
 // Thread safety: const methods may be called concurrently (the cache is guarded by a mutex).
 #pragma once

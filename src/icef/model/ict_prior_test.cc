@@ -205,9 +205,23 @@ TEST(IctPrior, GridMatchesTheExactWarp) {
     const Outputs grid = Evaluate(p, world, Rows(beta, world.size()));
     const Outputs truth = Evaluate(exact, world, Rows(beta, world.size()));
     std::vector<float> errors, normal_errors;
-    int moved = 0;
+    int moved = 0, fade_band = 0;
+    // Distances up to 4 cm (past outer_radius, 3 cm): a warp of its own with a wider reach.
+    face::IctWarpOptions reach = exact.warp().options();
+    reach.outer_radius = 4.f;
+    const face::IctWarp wide = face::IctWarp::Create(*Model(), {}, reach).value();
+    const face::PosedIctWarp posed = wide.Pose(beta);
+    const float outer = exact.warp().options().outer_radius;
     for (size_t i = 0; i < world.size(); ++i) {
       errors.push_back((grid.offsets[i] - truth.offsets[i]).norm() / world_from_cm);
+      // Normals fade out with the warp's weight: around outer_radius (-0.3 cm to + a cell's
+      // diagonal) the grid may say "a normal" where the exact warp has faded below 1e-3 (the prior's
+      // shading there is ~neutral anyway).
+      const face::IctWarpClosest c = posed.Closest(head[i]);
+      if (c.triangle >= 0 && c.distance > outer - 0.3f && c.distance < outer + 0.45f) {
+        ++fade_band;
+        continue;
+      }
       normal_errors.push_back(std::max((grid.observed[i] - truth.observed[i]).norm(),
                                        (grid.canonical[i] - truth.canonical[i]).norm()));
       moved += truth.offsets[i].norm() > 0.1f * world_from_cm;
@@ -216,12 +230,13 @@ TEST(IctPrior, GridMatchesTheExactWarp) {
     std::sort(errors.begin(), errors.end());
     std::sort(normal_errors.begin(), normal_errors.end());
     const size_t p99 = errors.size() * 99 / 100, p999 = errors.size() * 999 / 1000;
+    const size_t q99 = normal_errors.size() * 99 / 100, q999 = normal_errors.size() * 999 / 1000;
     std::printf(
         "[ grid ] %zu points, %d moved > 1 mm: offset error 99%% %.4f, 99.9%% %.4f, max %.4f cm; normals "
         "99%% "
-        "%.3f, 99.9%% %.3f, max %.3f; %s\n",
-        world.size(), moved, errors[p99], errors[p999], errors.back(), normal_errors[p99],
-        normal_errors[p999], normal_errors.back(), p.ToString().c_str());
+        "%.3f, 99.9%% %.3f, max %.3f (%d points in the fade band left out); %s\n",
+        world.size(), moved, errors[p99], errors[p999], errors.back(), normal_errors[q99],
+        normal_errors[q999], normal_errors.back(), fade_band, p.ToString().c_str());
     EXPECT_GT(moved, 200);
     EXPECT_LT(errors[p999], 0.03f);
     // The largest: a point on a part thinner than a cell (the closing lid's margin) that no corner
@@ -229,8 +244,8 @@ TEST(IctPrior, GridMatchesTheExactWarp) {
     EXPECT_LT(errors.back(), 0.25f);
     // Normals: within the tolerance nearly everywhere; a thin part narrower than a cell (a lid's
     // margin, the lips' edge) can hide between a cell's corners and flip the few points on it.
-    EXPECT_LT(normal_errors[p99], 0.1f);
-    EXPECT_LT(normal_errors[p999], 0.5f);
+    EXPECT_LT(normal_errors[q99], 0.1f);
+    EXPECT_LT(normal_errors[q999], 0.5f);
   }
 }
 

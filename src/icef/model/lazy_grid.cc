@@ -91,7 +91,8 @@ LazyGrid::Brick* LazyGrid::Build(int bx, int by, int bz) const {
           a_lo = a_lo.cwiseMin(anchors[n]);
           a_hi = a_hi.cwiseMax(anchors[n]);
         }
-        if (count != 0 && (count != 8 || (a_hi - a_lo).norm() > spread)) continue;
+        if (count != 0 && count != 8 && !options_.mixed_anchors) continue;
+        if (count > 1 && (a_hi - a_lo).norm() > spread) continue;
         f_(origin + options_.cell * Vec3f(i + 0.5f, j + 0.5f, k + 0.5f), exact.data(), &anchor);
         Interpolate(brick->nodes.data(), channels, i, j, k, Vec3f::Constant(0.5f), interpolated.data());
         bool close = true;

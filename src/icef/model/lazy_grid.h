@@ -3,7 +3,8 @@
 // sampled (its 9^3 corners and its cells' centres) the first time a point falls in it, so a caller
 // pays for the part of space it asks about.
 //
-// A cell is interpolated when (1) f gives an anchor at all 8 corners or at none of them, (2) the
+// A cell is interpolated when (1) f gives an anchor at all 8 corners or at none of them (or at any
+// number, with mixed_anchors: f then fades continuously to where it has no anchor), (2) the
 // anchors lie within max_anchor_spread cells of one another (an anchor is where f's value comes from,
 // e.g. the closest surface point: corners whose anchors are far apart straddle a jump of f, such as
 // the medial axis between two lips), and (3) at the cell's centre, trilinear interpolation and f agree
@@ -38,6 +39,7 @@ class LazyGrid {
     float cell = 0.25f;              // side of a cell, in the units of the points
     float max_anchor_spread = 4.f;   // in cells: the largest extent of a cell's corner anchors
     std::vector<float> tolerance;    // per channel: |interpolated - f| allowed at a cell's centre
+    bool mixed_anchors = false;      // cells with anchors at some corners only may be interpolated
   };
 
   // The grid covers [lo, hi] (cells of options.cell; the last ones reach past hi). Requires
