@@ -144,19 +144,15 @@ BENCHMARK(BM_RenderImage256)->Unit(benchmark::kMillisecond)->UseRealTime();
 // sums); bf16:0 the same step in FP32. composited:1 is the default (only the samples the pixel rays
 // composite run the colour MLP and the shading normals: AvatarModel::TrainForwardBackward);
 // composited:0 colours every sample, as training did before.
-void BM_TrainStep(benchmark::State& state) {
-  const Subject& s = TrainedSubject();
-  if (!s.error.empty()) return state.SkipWithError(s.error.c_str());
-  icef::RunConfig config;
-  config.model.bf16_training = state.range(0) != 0;
-  config.train.steps = 1000000;
-  config.train.threads = 2;
-  config.train.checkpoint_every = 0;
+// The timed part of BM_TrainStep and BM_TrainStepIct: a fresh trainer on `dataset` warmed up past
+// train.occupancy_warmup (44 steps more), then one step per iteration; steps/s, rays/s, samples/s.
+void TimeTrainSteps(benchmark::State& state, const icef::Dataset& dataset, const icef::RunConfig& config,
+                    bool composited_only, const std::string& name) {
   const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() / ("icef_train_bench_" + std::to_string(::getpid()));
-  auto trainer = icef::Trainer::Create(s.dataset, dir, config);
+      std::filesystem::temp_directory_path() / ("icef_" + name + "_bench_" + std::to_string(::getpid()));
+  auto trainer = icef::Trainer::Create(dataset, dir, config);
   if (!trainer.ok()) return state.SkipWithError(trainer.status().message().c_str());
-  (*trainer)->model().set_color_composited_only(state.range(1) != 0);
+  (*trainer)->model().set_color_composited_only(composited_only);
   for (int i = 0; i < config.train.occupancy_warmup + 44; ++i)
     if (!(*trainer)->Step().ok()) return state.SkipWithError("warm-up step failed");
   int64_t samples = 0;
@@ -169,7 +165,19 @@ void BM_TrainStep(benchmark::State& state) {
   state.counters["steps/s"] = benchmark::Counter(steps, benchmark::Counter::kIsRate);
   state.counters["rays/s"] = benchmark::Counter(steps * config.train.batch_rays, benchmark::Counter::kIsRate);
   state.counters["samples/s"] = benchmark::Counter(static_cast<double>(samples), benchmark::Counter::kIsRate);
+  trainer->reset();
   std::filesystem::remove_all(dir);
+}
+
+void BM_TrainStep(benchmark::State& state) {
+  const Subject& s = TrainedSubject();
+  if (!s.error.empty()) return state.SkipWithError(s.error.c_str());
+  icef::RunConfig config;
+  config.model.bf16_training = state.range(0) != 0;
+  config.train.steps = 1000000;
+  config.train.threads = 2;
+  config.train.checkpoint_every = 0;
+  TimeTrainSteps(state, s.dataset, config, state.range(1) != 0, "train");
 }
 BENCHMARK(BM_TrainStep)
     ->ArgNames({"bf16", "composited"})
@@ -200,23 +208,7 @@ void BM_TrainStepIct(benchmark::State& state) {
   config.train.steps = 1000000;
   config.train.threads = 2;
   config.train.checkpoint_every = 0;
-  const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() / ("icef_train_ict_bench_" + std::to_string(::getpid()));
-  auto trainer = icef::Trainer::Create(ict->dataset, dir, config);
-  if (!trainer.ok()) return state.SkipWithError(trainer.status().message().c_str());
-  for (int i = 0; i < config.train.occupancy_warmup + 44; ++i)
-    if (!(*trainer)->Step().ok()) return state.SkipWithError("warm-up step failed");
-  int64_t samples = 0;
-  for (auto _ : state) {
-    const icef::Result<icef::LossTerms> terms = (*trainer)->Step();
-    if (!terms.ok()) return state.SkipWithError(terms.status().message().c_str());
-    samples += terms->samples;
-  }
-  const double steps = static_cast<double>(state.iterations());
-  state.counters["steps/s"] = benchmark::Counter(steps, benchmark::Counter::kIsRate);
-  state.counters["samples/s"] = benchmark::Counter(static_cast<double>(samples), benchmark::Counter::kIsRate);
-  trainer->reset();
-  std::filesystem::remove_all(dir);
+  TimeTrainSteps(state, ict->dataset, config, true, "train_ict");
 }
 BENCHMARK(BM_TrainStepIct)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
 

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <utility>
 
@@ -131,80 +132,25 @@ void RotationAndDerivatives(const double* angle_axis, Mat3d* r, std::array<Mat3d
     }
 }
 
-// The landmark residuals of one photo, (projection - observed) * weight / (sigma * IOD), over the
-// blocks (identity [N], expression [E], angle-axis [3], translation [3]), with their Jacobian.
+// The landmark residuals of one photo, (projection - observed) * weight / (sigma * IOD), with
+// their Jacobian. The camera-frame point of a head point h is A (s R h + t) + b: with the photo's
+// own pose (A = I, b = 0, s = 1) over the blocks (identity [N], expression [E], angle-axis of R
+// [3], t [3] cm); with a known camera (A, b = its rigid cam_from_world, world units) and the head
+// placed by one similarity for all photos, x_world = s R h + t, over (identity, expression,
+// angle-axis, t [3] world units, log s [1]). The projection does not see the camera frame's units.
 class LandmarkCost : public ceres::CostFunction {
  public:
-  LandmarkCost(const LandmarkBasis* basis, const PhotoData* photo, double sigma_iod)
-      : basis_(basis), photo_(photo), scale_(1.0 / (sigma_iod * photo->iod_px)) {
-    set_num_residuals(2 * kNumLandmarks);
-    *mutable_parameter_block_sizes() = {basis->num_identity(), basis->num_expressions(), 3, 3};
-  }
-
-  bool Evaluate(double const* const* params, double* residuals, double** jacobians) const override {
-    const int n = basis_->num_identity(), ne = basis_->num_expressions();
-    Mat3d r;
-    std::array<Mat3d, 3> dr;
-    RotationAndDerivatives(params[2], &r, &dr);
-    const Vec3d t(params[3][0], params[3][1], params[3][2]);
-    const VecXd x = basis_->Positions(params[0], params[1]);
-    const int sizes[4] = {n, ne, 3, 3};
-    for (int b = 0; b < 4; ++b)
-      if (jacobians && jacobians[b]) std::fill_n(jacobians[b], 2 * kNumLandmarks * sizes[b], 0.0);
-    for (int i = 0; i < kNumLandmarks; ++i) {
-      residuals[2 * i] = residuals[2 * i + 1] = 0;
-      if (photo_->weight[i] == 0) continue;
-      const Vec3d head = x.segment<3>(3 * i);
-      const Vec3d cam = r * head + t;
-      if (cam.z() > -kMinDepth) return false;  // at or behind the camera: the step fails
-      Eigen::Matrix<double, 2, 3> d_cam;
-      const double s = scale_ * photo_->weight[i];
-      const Vec2d e = s * (ProjectCam(photo_->intrinsics, cam, &d_cam) - photo_->observed[i]);
-      residuals[2 * i] = e.x();
-      residuals[2 * i + 1] = e.y();
-      if (!jacobians) continue;
-      const Eigen::Matrix<double, 2, 3> d_head = s * d_cam * r;
-      if (jacobians[0])
-        Eigen::Map<RowMatrix>(jacobians[0], 2 * kNumLandmarks, n).middleRows<2>(2 * i) =
-            d_head * basis_->identity.middleRows<3>(3 * i);
-      if (jacobians[1])
-        Eigen::Map<RowMatrix>(jacobians[1], 2 * kNumLandmarks, ne).middleRows<2>(2 * i) =
-            d_head * basis_->expression.middleRows<3>(3 * i);
-      for (int k = 0; k < 3 && jacobians[2]; ++k) {
-        const Vec2d d = s * d_cam * (dr[k] * head);
-        jacobians[2][6 * i + k] = d.x();
-        jacobians[2][6 * i + 3 + k] = d.y();
-      }
-      for (int k = 0; k < 3 && jacobians[3]; ++k) {
-        jacobians[3][6 * i + k] = s * d_cam(0, k);
-        jacobians[3][6 * i + 3 + k] = s * d_cam(1, k);
-      }
-    }
-    return true;
-  }
-
- private:
-  const LandmarkBasis* basis_;
-  const PhotoData* photo_;
-  double scale_;
-};
-
-// The landmark residuals of one photo with a known camera (rigid cam_from_world, world units) and
-// the head placed by one similarity for all photos, world_from_head: x_world = exp(log_scale) R
-// x_head + t. Blocks: identity [N], expression [E], angle-axis of R [3], t [3] (world units),
-// log_scale [1]. The projection does not see the camera frame's units, so the residuals are
-// LandmarkCost's for the camera-frame point Rc (s R head + t) + tc.
-class KnownCameraLandmarkCost : public ceres::CostFunction {
- public:
-  KnownCameraLandmarkCost(const LandmarkBasis* basis, const PhotoData* photo, const Mat4d& cam_from_world,
-                          double sigma_iod)
+  LandmarkCost(const LandmarkBasis* basis, const PhotoData* photo, double sigma_iod,
+               const std::optional<Mat4d>& cam_from_world = std::nullopt)
       : basis_(basis),
         photo_(photo),
-        cam_rotation_(cam_from_world.block<3, 3>(0, 0)),
-        cam_translation_(cam_from_world.block<3, 1>(0, 3)),
+        known_camera_(cam_from_world.has_value()),
+        cam_rotation_(known_camera_ ? Mat3d(cam_from_world->block<3, 3>(0, 0)) : Mat3d::Identity()),
+        cam_translation_(known_camera_ ? Vec3d(cam_from_world->block<3, 1>(0, 3)) : Vec3d::Zero()),
         scale_(1.0 / (sigma_iod * photo->iod_px)) {
     set_num_residuals(2 * kNumLandmarks);
-    *mutable_parameter_block_sizes() = {basis->num_identity(), basis->num_expressions(), 3, 3, 1};
+    *mutable_parameter_block_sizes() = {basis->num_identity(), basis->num_expressions(), 3, 3};
+    if (known_camera_) mutable_parameter_block_sizes()->push_back(1);
   }
 
   bool Evaluate(double const* const* params, double* residuals, double** jacobians) const override {
@@ -213,18 +159,18 @@ class KnownCameraLandmarkCost : public ceres::CostFunction {
     std::array<Mat3d, 3> dr;
     RotationAndDerivatives(params[2], &r, &dr);
     const Vec3d t(params[3][0], params[3][1], params[3][2]);
-    const double scale = std::exp(params[4][0]);
+    const double head_scale = known_camera_ ? std::exp(params[4][0]) : 1.0;
     const VecXd x = basis_->Positions(params[0], params[1]);
     const int sizes[5] = {n, ne, 3, 3, 1};
-    for (int b = 0; b < 5; ++b)
+    for (int b = 0; b < (known_camera_ ? 5 : 4); ++b)
       if (jacobians && jacobians[b]) std::fill_n(jacobians[b], 2 * kNumLandmarks * sizes[b], 0.0);
-    const Mat3d cam_head = scale * cam_rotation_ * r;  // d cam / d head
+    const Mat3d cam_head = head_scale * cam_rotation_ * r;  // d cam / d head
     for (int i = 0; i < kNumLandmarks; ++i) {
       residuals[2 * i] = residuals[2 * i + 1] = 0;
       if (photo_->weight[i] == 0) continue;
       const Vec3d head = x.segment<3>(3 * i);
       const Vec3d cam = cam_head * head + cam_rotation_ * t + cam_translation_;
-      if (cam.z() >= 0) return false;  // at or behind the camera: the step fails
+      if (cam.z() > -kMinDepth) return false;  // at or behind the camera: the step fails
       Eigen::Matrix<double, 2, 3> d_cam;
       const double s = scale_ * photo_->weight[i];
       const Vec2d e = s * (ProjectCam(photo_->intrinsics, cam, &d_cam) - photo_->observed[i]);
@@ -239,7 +185,7 @@ class KnownCameraLandmarkCost : public ceres::CostFunction {
         Eigen::Map<RowMatrix>(jacobians[1], 2 * kNumLandmarks, ne).middleRows<2>(2 * i) =
             d_head * basis_->expression.middleRows<3>(3 * i);
       for (int k = 0; k < 3 && jacobians[2]; ++k) {
-        const Vec2d d = s * d_cam * (scale * cam_rotation_ * (dr[k] * head));
+        const Vec2d d = s * d_cam * (head_scale * cam_rotation_ * (dr[k] * head));
         jacobians[2][6 * i + k] = d.x();
         jacobians[2][6 * i + 3 + k] = d.y();
       }
@@ -250,8 +196,8 @@ class KnownCameraLandmarkCost : public ceres::CostFunction {
           jacobians[3][6 * i + 3 + k] = d_t(1, k);
         }
       }
-      if (jacobians[4]) {
-        const Vec2d d = s * d_cam * (cam_head * head);
+      if (known_camera_ && jacobians[4]) {
+        const Vec2d d = d_head * head;
         jacobians[4][2 * i] = d.x();
         jacobians[4][2 * i + 1] = d.y();
       }
@@ -262,6 +208,7 @@ class KnownCameraLandmarkCost : public ceres::CostFunction {
  private:
   const LandmarkBasis* basis_;
   const PhotoData* photo_;
+  bool known_camera_;
   Mat3d cam_rotation_;
   Vec3d cam_translation_;
   double scale_;
@@ -582,9 +529,8 @@ Status SolveKnownCameras(const LandmarkBasis& b, const std::vector<PhotoData>& d
   for (int k = 0; k < n; ++k) {
     double* expression = u->photo(k).expression;
     expressions.push_back(expression);
-    problem.AddResidualBlock(
-        new KnownCameraLandmarkCost(&b, &data[k], cam_from_world[k], o.landmark_sigma_iod), nullptr, identity,
-        expression, pose.data(), pose.data() + 3, pose.data() + 6);
+    problem.AddResidualBlock(new LandmarkCost(&b, &data[k], o.landmark_sigma_iod, cam_from_world[k]), nullptr,
+                             identity, expression, pose.data(), pose.data() + 3, pose.data() + 6);
     problem.AddResidualBlock(new ExpressionPrior(&b, o), nullptr, expression);
     for (int e = 0; e < b.num_expressions(); ++e) {
       problem.SetParameterLowerBound(expression, e, 0.0);

@@ -71,10 +71,9 @@ LazyGrid::Brick* LazyGrid::Build(int bx, int by, int bz) const {
     for (int j = 0; j < kNodes; ++j)
       for (int i = 0; i < kNodes; ++i) {
         const int n = NodeIndex(i, j, k);
-        anchored[n] = f_(origin + options_.cell * Vec3f(i, j, k), brick->nodes.data() + n * channels,
-                         &anchors[n])
-                          ? 1
-                          : 0;
+        anchored[n] =
+            f_(origin + options_.cell * Vec3f(i, j, k), brick->nodes.data() + n * channels, &anchors[n]) ? 1
+                                                                                                         : 0;
       }
   const float spread = options_.max_anchor_spread * options_.cell;
   std::vector<float> exact(channels), interpolated(channels);
@@ -101,9 +100,10 @@ LazyGrid::Brick* LazyGrid::Build(int bx, int by, int bz) const {
         brick->interpolated[CellIndex(i, j, k)] = close ? 1 : 0;
       }
   // Nothing anchored, every value 0 and every cell interpolated: keep no nodes.
-  const bool empty = std::all_of(anchored.begin(), anchored.end(), [](uint8_t a) { return a == 0; }) &&
-                     std::all_of(brick->nodes.begin(), brick->nodes.end(), [](float v) { return v == 0.f; }) &&
-                     std::all_of(brick->interpolated.begin(), brick->interpolated.end(), [](uint8_t c) { return c == 1; });
+  const bool empty =
+      std::all_of(anchored.begin(), anchored.end(), [](uint8_t a) { return a == 0; }) &&
+      std::all_of(brick->nodes.begin(), brick->nodes.end(), [](float v) { return v == 0.f; }) &&
+      std::all_of(brick->interpolated.begin(), brick->interpolated.end(), [](uint8_t c) { return c == 1; });
   if (empty) brick->nodes = {};
   return brick.release();
 }
@@ -167,8 +167,8 @@ std::string LazyGrid::ToString() const {
   const Counts c = counts();
   std::ostringstream os;
   os << "LazyGrid(cells=" << cells_[0] << "x" << cells_[1] << "x" << cells_[2] << " of " << options_.cell
-     << ", channels=" << channels() << ", bricks built=" << c.bricks << ", interpolated cells=" << c.interpolated
-     << "/" << c.cells << ")";
+     << ", channels=" << channels() << ", bricks built=" << c.bricks
+     << ", interpolated cells=" << c.interpolated << "/" << c.cells << ")";
   return os.str();
 }
 

@@ -36,10 +36,10 @@ class LazyGrid {
   using Function = std::function<bool(const Vec3f& x, float* values, Vec3f* anchor)>;
 
   struct Options {
-    float cell = 0.25f;              // side of a cell, in the units of the points
-    float max_anchor_spread = 4.f;   // in cells: the largest extent of a cell's corner anchors
-    std::vector<float> tolerance;    // per channel: |interpolated - f| allowed at a cell's centre
-    bool mixed_anchors = false;      // cells with anchors at some corners only may be interpolated
+    float cell = 0.25f;             // side of a cell, in the units of the points
+    float max_anchor_spread = 4.f;  // in cells: the largest extent of a cell's corner anchors
+    std::vector<float> tolerance;   // per channel: |interpolated - f| allowed at a cell's centre
+    bool mixed_anchors = false;     // cells with anchors at some corners only may be interpolated
   };
 
   // The grid covers [lo, hi] (cells of options.cell; the last ones reach past hi). Requires
@@ -70,8 +70,8 @@ class LazyGrid {
   Vec3f lo_;
   Options options_;
   Function f_;
-  int cells_[3] = {1, 1, 1};   // per axis
-  int bricks_[3] = {1, 1, 1};  // per axis
+  int cells_[3] = {1, 1, 1};                                   // per axis
+  int bricks_[3] = {1, 1, 1};                                  // per axis
   std::unique_ptr<std::atomic<const Brick*>[]> bricks_built_;  // nullptr until built
   mutable std::mutex locks_[kLocks];
 };

@@ -49,7 +49,7 @@ TEST(LazyGrid, InterpolatesWhereSmoothAndIsExactAtTheJump) {
     if (used_grid && x.x() > 0.302f && x.x() < 0.348f && std::abs(x.y()) < 0.75f) ++near_jump_interpolated;
     worst = std::max({worst, std::abs(got[0] - want[0]), std::abs(got[1] - want[1])});
   }
-  EXPECT_GT(interpolated, 20000 / 2);  // most of the box is smooth
+  EXPECT_GT(interpolated, 20000 / 2);    // most of the box is smooth
   EXPECT_EQ(near_jump_interpolated, 0);  // cells across the jump: f's own values
   EXPECT_LT(worst, 3e-3f);               // the tolerance at the centres, a little more inside
   const LazyGrid::Counts counts = grid.counts();
