@@ -242,6 +242,7 @@ struct IctPrior::Expression {
     grid_options.cell = options.grid_cell;
     grid_options.tolerance.assign(kGridChannels, options.normal_tolerance);
     grid_options.mixed_anchors = true;  // every channel fades to 0 at outer_radius (Exact)
+    grid_options.zero_outside = true;   // the box holds every point within outer_radius of the surface
     std::fill_n(grid_options.tolerance.begin(), 3, options.offset_tolerance);
     grid = std::make_unique<LazyGrid>(
         lo - margin, hi + margin, std::move(grid_options),

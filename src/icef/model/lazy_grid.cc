@@ -127,6 +127,10 @@ bool LazyGrid::At(const Vec3f& x, float* values) const {
   int cell[3];
   for (int a = 0; a < 3; ++a) {
     if (!(g[a] >= 0.f && g[a] < static_cast<float>(cells_[a]))) {  // outside, or not finite
+      if (options_.zero_outside && x.allFinite()) {
+        std::fill_n(values, channels(), 0.f);
+        return true;
+      }
       Vec3f anchor;
       f_(x, values, &anchor);
       return false;

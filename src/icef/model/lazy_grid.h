@@ -8,8 +8,8 @@
 // anchors lie within max_anchor_spread cells of one another (an anchor is where f's value comes from,
 // e.g. the closest surface point: corners whose anchors are far apart straddle a jump of f, such as
 // the medial axis between two lips), and (3) at the cell's centre, trilinear interpolation and f agree
-// within each channel's tolerance. Elsewhere (the cells that fail, points outside the box) the answer
-// is f's own.
+// within each channel's tolerance. Elsewhere (the cells that fail, points outside the box unless
+// zero_outside) the answer is f's own.
 //
 // Determinism: every corner, centre and answer is a function of the point alone (given a
 // deterministic f), so results do not depend on the thread count or on the order of queries.
@@ -40,6 +40,7 @@ class LazyGrid {
     float max_anchor_spread = 4.f;  // in cells: the largest extent of a cell's corner anchors
     std::vector<float> tolerance;   // per channel: |interpolated - f| allowed at a cell's centre
     bool mixed_anchors = false;     // cells with anchors at some corners only may be interpolated
+    bool zero_outside = false;      // f is 0 outside the box: answer 0 there without asking f
   };
 
   // The grid covers [lo, hi] (cells of options.cell; the last ones reach past hi). Requires

@@ -58,6 +58,24 @@ TEST(LazyGrid, InterpolatesWhereSmoothAndIsExactAtTheJump) {
   EXPECT_NE(grid.ToString().find("bricks built"), std::string::npos);
 }
 
+// zero_outside: points outside the box are 0 without asking f.
+TEST(LazyGrid, ZeroOutsideAsksNothingThere) {
+  int calls = 0;
+  LazyGrid::Options o = GridOptions();
+  o.zero_outside = true;
+  const LazyGrid grid(Vec3f(-1, -1, -1), Vec3f(1, 1, 1), o, [&](const Vec3f& x, float* v, Vec3f* a) {
+    ++calls;
+    return Field(x, v, a);
+  });
+  float values[2] = {1, 1};
+  EXPECT_TRUE(grid.At(Vec3f(3, 0, 0), values));
+  EXPECT_EQ(values[0], 0.f);
+  EXPECT_EQ(values[1], 0.f);
+  EXPECT_EQ(calls, 0);
+  grid.At(Vec3f(0, 0, 0), values);  // inside: its brick is sampled
+  EXPECT_GT(calls, 0);
+}
+
 // The answers depend on the point alone: the same for queries in another order, on more threads.
 TEST(LazyGrid, AnswersDoNotDependOnTheOrderOrThreads) {
   std::mt19937 rng(2);
