@@ -50,7 +50,8 @@ class LazyGrid {
   LazyGrid(const LazyGrid&) = delete;
   LazyGrid& operator=(const LazyGrid&) = delete;
 
-  // values[channels] at x; true when interpolated, false when f's own.
+  // values[channels] at x; true when interpolated (or 0 outside the box, zero_outside), false when
+  // f's own.
   bool At(const Vec3f& x, float* values) const;
 
   int channels() const { return static_cast<int>(options_.tolerance.size()); }
