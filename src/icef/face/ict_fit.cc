@@ -399,15 +399,28 @@ IctPhotoFit Report(const LandmarkBasis& b, const PhotoData& d, const PhotoParams
   return f;
 }
 
-// The Ceres problem over the unknowns (it points into them).
+// With known cameras: each photo's rigid cam_from_world and the shared head pose (angle-axis [3],
+// translation [3], log scale [1]) the landmark residuals use instead of the photo's own pose.
+struct SharedPose {
+  const std::vector<Mat4d>* cam_from_world;
+  double* pose;
+};
+
+// The Ceres problem over the unknowns (it points into them, and into shared->pose).
 void BuildProblem(const LandmarkBasis& b, const std::vector<PhotoData>& data, const IctFitOptions& o,
-                  Unknowns* u, ceres::Problem* problem) {
+                  Unknowns* u, ceres::Problem* problem, const SharedPose* shared = nullptr) {
   double* identity = u->identity();
   problem->AddResidualBlock(new GaussianPrior(b.num_identity(), o.identity_prior_sigma), nullptr, identity);
   for (size_t k = 0; k < data.size(); ++k) {
     const PhotoParams p = u->photo(static_cast<int>(k));
-    problem->AddResidualBlock(new LandmarkCost(&b, &data[k], o.landmark_sigma_iod), nullptr, identity,
-                              p.expression, p.rotation, p.translation);
+    if (shared == nullptr) {
+      problem->AddResidualBlock(new LandmarkCost(&b, &data[k], o.landmark_sigma_iod), nullptr, identity,
+                                p.expression, p.rotation, p.translation);
+    } else {
+      problem->AddResidualBlock(
+          new LandmarkCost(&b, &data[k], o.landmark_sigma_iod, (*shared->cam_from_world)[k]), nullptr,
+          identity, p.expression, shared->pose, shared->pose + 3, shared->pose + 6);
+    }
     problem->AddResidualBlock(new ExpressionPrior(&b, o), nullptr, p.expression);
     for (int e = 0; e < b.num_expressions(); ++e) {
       problem->SetParameterLowerBound(p.expression, e, 0.0);
@@ -523,20 +536,10 @@ Status SolveKnownCameras(const LandmarkBasis& b, const std::vector<PhotoData>& d
   std::array<double, 7> pose{};  // angle-axis, translation, log scale
   ICEF_RETURN_IF_ERROR(InitialSharedPose(cam_from_world, cam_from_head, pose.data()));
   ceres::Problem problem;
-  double* identity = u->identity();
-  problem.AddResidualBlock(new GaussianPrior(b.num_identity(), o.identity_prior_sigma), nullptr, identity);
+  const SharedPose shared{&cam_from_world, pose.data()};
+  BuildProblem(b, data, o, u, &problem, &shared);
   std::vector<double*> expressions;
-  for (int k = 0; k < n; ++k) {
-    double* expression = u->photo(k).expression;
-    expressions.push_back(expression);
-    problem.AddResidualBlock(new LandmarkCost(&b, &data[k], o.landmark_sigma_iod, cam_from_world[k]), nullptr,
-                             identity, expression, pose.data(), pose.data() + 3, pose.data() + 6);
-    problem.AddResidualBlock(new ExpressionPrior(&b, o), nullptr, expression);
-    for (int e = 0; e < b.num_expressions(); ++e) {
-      problem.SetParameterLowerBound(expression, e, 0.0);
-      problem.SetParameterUpperBound(expression, e, 1.0);
-    }
-  }
+  for (int k = 0; k < n; ++k) expressions.push_back(u->photo(k).expression);
   ceres::Solver::Summary summary;
   SetShapeConstant(u, true, &problem);
   ICEF_RETURN_IF_ERROR(RunSolver(problem, std::max(o.rigid_iterations, 30), o, {}, &summary));

@@ -388,10 +388,7 @@ Json RetrackReportJson(const RetrackResult& result) {
              {"translation", {s.translation.x(), s.translation.y(), s.translation.z()}}}},
            {"shape", shape}};
   if (!result.fit.ict_identity.empty()) {  // ICT: its identity instead of the procedural shape
-    Json identity = Json::array();
-    for (const float c : result.fit.ict_identity) identity.push_back(JsonFloat(c));
-    out["face_model"] = "ict";
-    out["ict_identity"] = identity;
+    AddIctReportFields(result.fit, &out);
     out.erase("shape");
   }
   return out;

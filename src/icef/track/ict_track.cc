@@ -66,6 +66,13 @@ Result<TrackFit> FitIctTrack(const face::IctModel& model, std::span<const TrackF
   return out;
 }
 
+void AddIctReportFields(const TrackFit& fit, Json* report) {
+  Json identity = Json::array();
+  for (const float c : fit.ict_identity) identity.push_back(JsonFloat(c));
+  (*report)["face_model"] = "ict";
+  (*report)["ict_identity"] = identity;
+}
+
 std::vector<std::array<uint32_t, 3>> IctOuterTriangles(const face::IctModel& model) {
   const int face = model.PartIndex("face"), head = model.PartIndex("head_neck");
   std::vector<std::array<uint32_t, 3>> out;

@@ -20,6 +20,7 @@
 #include "icef/face/ict_fit.h"
 #include "icef/face/ict_model.h"
 #include "icef/io/image.h"
+#include "icef/io/json_util.h"
 #include "icef/math/camera.h"
 #include "icef/math/ray.h"
 #include "icef/track/track_fit.h"
@@ -42,6 +43,10 @@ face::Similarity WorldFromIctHead();
 // those of FitIctToLandmarks.
 Result<TrackFit> FitIctTrack(const face::IctModel& model, std::span<const TrackFrame> frames,
                              const face::IctFitOptions& options = {});
+
+// The report fields of an ICT fit (track/report.json): "face_model": "ict" and "ict_identity",
+// the fit's identity coefficients.
+void AddIctReportFields(const TrackFit& fit, Json* report);
 
 // The parts of the posed head whose outline is the head's: face and head_neck.
 std::vector<std::array<uint32_t, 3>> IctOuterTriangles(const face::IctModel& model);

@@ -521,10 +521,7 @@ Json TrackReportJson(const TrackResult& result) {
       shape[face::kShapeParamNames[i]] = JsonFloat(values[i]);
     out["shape"] = shape;
   } else {
-    out["face_model"] = "ict";
-    Json identity = Json::array();
-    for (const float c : result.fit.ict_identity) identity.push_back(JsonFloat(c));
-    out["ict_identity"] = identity;
+    AddIctReportFields(result.fit, &out);
   }
   return out;
 }
