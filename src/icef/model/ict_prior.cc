@@ -244,6 +244,7 @@ struct IctPrior::Expression {
     grid_options.mixed_anchors = true;  // every channel fades to 0 at outer_radius (Exact)
     grid_options.zero_outside = true;   // the box holds every point within outer_radius of the surface
     std::fill_n(grid_options.tolerance.begin(), 3, options.offset_tolerance);
+    grid_options.smooth_beyond = options.smooth_beyond;
     grid = std::make_unique<LazyGrid>(
         lo - margin, hi + margin, std::move(grid_options),
         [this](const Vec3f& x, float* values, Vec3f* anchor) { return Exact(x, values, anchor); });
@@ -295,13 +296,17 @@ Status IctPriorOptions::Validate() const {
   if (!std::isfinite(offset_tolerance) || offset_tolerance < 0.f || !std::isfinite(normal_tolerance) ||
       normal_tolerance < 0.f)
     return Status::Error("offset_tolerance and normal_tolerance must be finite numbers >= 0");
+  if (!(smooth_beyond >= 0.f))
+    return Status::Error("smooth_beyond must be >= 0 (cm; infinity: never), got " +
+                         std::to_string(smooth_beyond));
   return Status::Ok();
 }
 
 std::string IctPriorOptions::ToString() const {
   std::ostringstream os;
   os << "IctPriorOptions(" << warp.ToString() << ", grid_cell=" << grid_cell
-     << ", offset_tolerance=" << offset_tolerance << ", normal_tolerance=" << normal_tolerance << ")";
+     << ", offset_tolerance=" << offset_tolerance << ", normal_tolerance=" << normal_tolerance
+     << ", smooth_beyond=" << smooth_beyond << ")";
   return os.str();
 }
 

@@ -43,6 +43,7 @@ LazyGrid::LazyGrid(const Vec3f& lo, const Vec3f& hi, Options options, Function f
   ICEF_CHECK(std::isfinite(options_.cell) && options_.cell > 0.f, "LazyGrid: cell must be > 0");
   ICEF_CHECK(!options_.tolerance.empty(), "LazyGrid: no channels");
   for (float t : options_.tolerance) ICEF_CHECK(std::isfinite(t) && t >= 0.f, "LazyGrid: bad tolerance");
+  ICEF_CHECK(options_.smooth_beyond >= 0.f, "LazyGrid: smooth_beyond must be >= 0");
   int64_t count = 1;
   for (int a = 0; a < 3; ++a) {
     cells_[a] = std::max(1, static_cast<int>(std::ceil((hi[a] - lo[a]) / options_.cell)));
@@ -76,6 +77,7 @@ LazyGrid::Brick* LazyGrid::Build(int bx, int by, int bz) const {
                                                                                                          : 0;
       }
   const float spread = options_.max_anchor_spread * options_.cell;
+  const float diagonal = std::sqrt(3.f) * options_.cell;
   std::vector<float> exact(channels), interpolated(channels);
   Vec3f anchor;
   for (int k = 0; k < kBrickCells; ++k)
@@ -83,12 +85,19 @@ LazyGrid::Brick* LazyGrid::Build(int bx, int by, int bz) const {
       for (int i = 0; i < kBrickCells; ++i) {
         int count = 0;
         Vec3f a_lo = Vec3f::Constant(INFINITY), a_hi = Vec3f::Constant(-INFINITY);
+        float nearest = INFINITY;  // the corners' smallest distance to their anchors
         for (int d = 0; d < 8; ++d) {
           const int n = NodeIndex(i + (d & 1), j + ((d >> 1) & 1), k + (d >> 2));
           if (!anchored[n]) continue;
           ++count;
           a_lo = a_lo.cwiseMin(anchors[n]);
           a_hi = a_hi.cwiseMax(anchors[n]);
+          const Vec3f corner = origin + options_.cell * Vec3f(i + (d & 1), j + ((d >> 1) & 1), k + (d >> 2));
+          nearest = std::min(nearest, (corner - anchors[n]).norm());
+        }
+        if (std::isfinite(options_.smooth_beyond) && nearest - diagonal >= options_.smooth_beyond) {
+          brick->interpolated[CellIndex(i, j, k)] = 1;  // far from every anchor: smooth by definition
+          continue;
         }
         if (count != 0 && count != 8 && !options_.mixed_anchors) continue;
         if (count > 1 && (a_hi - a_lo).norm() > spread) continue;

@@ -3,12 +3,12 @@
 // sampled (its 9^3 corners and its cells' centres) the first time a point falls in it, so a caller
 // pays for the part of space it asks about.
 //
-// A cell is interpolated when (1) f gives an anchor at all 8 corners or at none of them (or at any
-// number, with mixed_anchors: f then fades continuously to where it has no anchor), (2) the
-// anchors lie within max_anchor_spread cells of one another (an anchor is where f's value comes from,
-// e.g. the closest surface point: corners whose anchors are far apart straddle a jump of f, such as
-// the medial axis between two lips), and (3) at the cell's centre, trilinear interpolation and f agree
-// within each channel's tolerance. Elsewhere (the cells that fail, points outside the box unless
+// A cell is interpolated when it lies far from every anchor (smooth_beyond), or when (1) f gives an anchor at
+// all 8 corners or at none of them (or at any number, with mixed_anchors: f then fades continuously to where
+// it has no anchor), (2) the anchors lie within max_anchor_spread cells of one another (an anchor is where
+// f's value comes from, e.g. the closest surface point: corners whose anchors are far apart straddle a jump
+// of f, such as the medial axis between two lips), and (3) at the cell's centre, trilinear interpolation and
+// f agree within each channel's tolerance. Elsewhere (the cells that fail, points outside the box unless
 // zero_outside) the answer is f's own.
 //
 // Determinism: every corner, centre and answer is a function of the point alone (given a
@@ -17,6 +17,7 @@
 #pragma once
 
 #include <atomic>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -41,6 +42,11 @@ class LazyGrid {
     std::vector<float> tolerance;   // per channel: |interpolated - f| allowed at a cell's centre
     bool mixed_anchors = false;     // cells with anchors at some corners only may be interpolated
     bool zero_outside = false;      // f is 0 outside the box: answer 0 there without asking f
+    // A cell all of whose points lie at least this far from every corner's anchor (the corners'
+    // smallest distance to their anchors less the cell's diagonal; a corner without one counts as
+    // far) is interpolated without the tests: the grid's smooth interpolation is the answer there,
+    // jumps of f included. Infinity: never.
+    float smooth_beyond = INFINITY;
   };
 
   // The grid covers [lo, hi] (cells of options.cell; the last ones reach past hi). Requires

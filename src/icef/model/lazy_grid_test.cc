@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <random>
 
 #include "icef/core/parallel.h"
@@ -74,6 +75,38 @@ TEST(LazyGrid, ZeroOutsideAsksNothingThere) {
   EXPECT_EQ(calls, 0);
   grid.At(Vec3f(0, 0, 0), values);  // inside: its brick is sampled
   EXPECT_GT(calls, 0);
+}
+
+// smooth_beyond: a field anchored on the plane z = 0 (distance |z|) that jumps across x = 0.31.
+// Cells that reach within smooth_beyond of the plane keep the tests (the jump's cells are f's own
+// values); the cells beyond are interpolated without them (the jump is smoothed over one cell).
+TEST(LazyGrid, SmoothBeyondInterpolatesFarFromTheAnchors) {
+  const auto field = [](const Vec3f& x, float* values, Vec3f* anchor) {
+    values[0] = x.x() < 0.31f ? 0.f : 1.f;
+    values[1] = x.y();
+    *anchor = Vec3f(x.x(), x.y(), 0.f);
+    return true;
+  };
+  LazyGrid::Options o = GridOptions();
+  o.smooth_beyond = 0.3f;
+  const LazyGrid grid(Vec3f(-1, -1, -1), Vec3f(1, 1, 1), o, field);
+  const float diagonal = std::sqrt(3.f) * o.cell;
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<float> u(-1.f, 1.f);
+  int near_interpolated = 0, near = 0, far_exact = 0, far = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const Vec3f x(0.302f + 0.046f * 0.5f * (u(rng) + 1.f), u(rng), u(rng));  // in the jump's cells
+    float got[2];
+    const bool used_grid = grid.At(x, got);
+    EXPECT_GE(got[0], 0.f);
+    EXPECT_LE(got[0], 1.f);
+    if (std::abs(x.z()) < o.smooth_beyond) near_interpolated += used_grid, ++near;
+    if (std::abs(x.z()) > o.smooth_beyond + 2 * diagonal) far_exact += !used_grid, ++far;
+  }
+  EXPECT_GT(near, 1000);
+  EXPECT_GT(far, 1000);
+  EXPECT_EQ(near_interpolated, 0);  // within smooth_beyond of the anchors: the tests hold
+  EXPECT_EQ(far_exact, 0);          // beyond it (and a cell's reach): smooth
 }
 
 // The answers depend on the point alone: the same for queries in another order, on more threads.
