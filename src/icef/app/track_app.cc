@@ -266,6 +266,11 @@ Status ApplyNamedTrackChoices(const TrackCommandOptions& c, TrackAppOptions* o) 
   if (!face_model)
     return Status::Error("--face-model: expected procedural or ict, got \"" + c.face_model + "\"");
   o->track.face_model = *face_model;
+  if (*face_model == track::TrackFaceModel::kIct &&
+      (c.silhouette_points || c.photometric_weight || c.generic_style))
+    return Status::Error(
+        "--silhouette-points, --photometric-weight and --generic-style refine the procedural model's fit; "
+        "ICT-FaceKit (--face-model ict) is fitted to the landmarks alone");
   if (c.segmentation != "selfie" && c.segmentation != "none" && c.segmentation != "selfie-only")
     return Status::Error("--segmentation: expected selfie, none or selfie-only, got \"" + c.segmentation +
                          "\"");

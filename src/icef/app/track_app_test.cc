@@ -126,6 +126,20 @@ TEST(TrackCommand, BadChoicesNameTheOption) {
   model.app.keep_cameras = true;  // a dataset re-expressed in ICT with its cameras held
   ASSERT_TRUE(ResolveTrackOptions(model).ok());
   EXPECT_EQ(ResolveTrackOptions(model)->track.face_model, track::TrackFaceModel::kIct);
+  // The procedural fit's refinements are refused with ICT, which fits the landmarks alone.
+  for (const bool keep : {true, false}) {
+    TrackCommandOptions refine = model;
+    refine.app.keep_cameras = keep;
+    refine.silhouette_points = 100;
+    EXPECT_NE(ResolveTrackOptions(refine).status().message().find("--silhouette-points"), std::string::npos);
+    refine.silhouette_points.reset();
+    refine.photometric_weight = 4.0;
+    EXPECT_FALSE(ResolveTrackOptions(refine).ok());
+    refine.photometric_weight.reset();
+    refine.landmarks = "model";
+    refine.generic_style = true;
+    EXPECT_NE(ResolveTrackOptions(refine).status().message().find("landmarks alone"), std::string::npos);
+  }
   TrackCommandOptions none;  // nothing to track
   EXPECT_NE(RunTrackCommand(none, std::cout, std::cerr).message().find("give the photos"), std::string::npos);
 }
