@@ -234,7 +234,8 @@ Result<Dataset> EnsureBenchDataset(const BenchOptions& o, uint64_t seed, int k, 
                          fs::last_write_time(source.root / "synth_options.txt", ec);
   if (fresh) return LoadDataset(dir);
   fs::remove_all(dir, ec);
-  log << "bench: re-expressing " << source.root.filename().string() << " in " << o.face_model << "\n";
+  // Flushed: a bench's log is read while it runs, often from a file.
+  log << "bench: re-expressing " << source.root.filename().string() << " in " << o.face_model << std::endl;
   return o.reexpress(source, dir);
 }
 
@@ -365,7 +366,7 @@ Status RunBench(const BenchOptions& o, std::ostream& log, bool interactive) {
     log << "bench: run " << i + 1 << "/" << todo.size() << " " << id.Name() << "  elapsed "
         << ProgressBar::FormatDuration(elapsed);
     if (i > 0) log << ", ETA " << ProgressBar::FormatDuration(elapsed / i * (todo.size() - i));
-    log << "\n";
+    log << std::endl;
     auto it = datasets.find({id.identity_seed, id.k});
     if (it == datasets.end()) {
       // Only one identity x K dataset is held at a time (runs are identity/K-major).
@@ -383,7 +384,7 @@ Status RunBench(const BenchOptions& o, std::ostream& log, bool interactive) {
                   far.id_distance ? std::to_string(*far.id_distance).c_str() : "-",
                   ProgressBar::FormatDuration(record.train_seconds).c_str(),
                   ProgressBar::FormatDuration(record.eval_seconds).c_str());
-    log << line;
+    log << line << std::flush;
   }
 
   ICEF_ASSIGN_OR_RETURN(const std::vector<RunRecord> records, ReadRunRecords(o.out_dir));
