@@ -206,13 +206,8 @@ TEST(IctPrior, GridMatchesTheExactWarp) {
     const Outputs grid = Evaluate(p, world, Rows(beta, world.size()));
     const Outputs truth = Evaluate(exact, world, Rows(beta, world.size()));
     std::vector<float> errors, normal_errors;
-    int moved = 0, fade_band = 0;
-    // Distances up to 4 cm (past outer_radius, 3 cm): a warp of its own with a wider reach.
-    face::IctWarpOptions reach = exact.warp().options();
-    reach.outer_radius = 4.f;
-    const face::IctWarp wide = face::IctWarp::Create(*Model(), {}, reach).value();
-    const face::PosedIctWarp posed = wide.Pose(beta);
-    const float outer = exact.warp().options().outer_radius;
+    int moved = 0;
+    const face::PosedIctWarp posed = exact.warp().Pose(beta);
     const float smooth_beyond = IctPriorOptions().smooth_beyond;
     std::vector<float> far_errors;  // points beyond smooth_beyond: the grid's smooth warp
     for (size_t i = 0; i < world.size(); ++i) {
@@ -223,13 +218,6 @@ TEST(IctPrior, GridMatchesTheExactWarp) {
         continue;
       }
       errors.push_back(error);
-      // Normals fade out with the warp's weight: around outer_radius (-0.3 cm to + a cell's
-      // diagonal) the grid may say "a normal" where the exact warp has faded below 1e-3 (the prior's
-      // shading there is ~neutral anyway).
-      if (c.triangle >= 0 && c.distance > outer - 0.3f && c.distance < outer + 0.45f) {
-        ++fade_band;
-        continue;
-      }
       normal_errors.push_back(std::max((grid.observed[i] - truth.observed[i]).norm(),
                                        (grid.canonical[i] - truth.canonical[i]).norm()));
       moved += truth.offsets[i].norm() > 0.1f * world_from_cm;
@@ -247,9 +235,9 @@ TEST(IctPrior, GridMatchesTheExactWarp) {
         far_errors.size(), smooth_beyond, far_errors[f90], far_errors[f99], far_errors.back());
     std::printf(
         "[ grid ] %zu points within %.2f cm, %d moved > 1 mm: offset error 99%% %.4f, 99.9%% %.4f, max %.4f "
-        "cm; normals 99%% %.3f, 99.9%% %.3f, max %.3f (%d points in the fade band left out); %s\n",
+        "cm; normals 99%% %.3f, 99.9%% %.3f, max %.3f; %s\n",
         errors.size(), smooth_beyond, moved, errors[p99], errors[p999], errors.back(), normal_errors[q99],
-        normal_errors[q999], normal_errors.back(), fade_band, p.ToString().c_str());
+        normal_errors[q999], normal_errors.back(), p.ToString().c_str());
     EXPECT_GT(moved, 200);
     EXPECT_GT(errors.size(), 2000u);
     // Beyond smooth_beyond the grid smooths the exact warp's jumps (where two parts are equally close)

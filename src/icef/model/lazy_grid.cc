@@ -67,14 +67,15 @@ LazyGrid::Brick* LazyGrid::Build(int bx, int by, int bz) const {
   brick->interpolated.assign(kBrickCellCount, 0);
   std::vector<Vec3f> anchors(kNodes * kNodes * kNodes);
   std::vector<uint8_t> anchored(anchors.size());
+  std::vector<float> to_anchor(anchors.size(), INFINITY);  // a node's distance to its anchor
   const Vec3f origin = lo_ + options_.cell * Vec3f(bx * kBrickCells, by * kBrickCells, bz * kBrickCells);
   for (int k = 0; k < kNodes; ++k)
     for (int j = 0; j < kNodes; ++j)
       for (int i = 0; i < kNodes; ++i) {
         const int n = NodeIndex(i, j, k);
-        anchored[n] =
-            f_(origin + options_.cell * Vec3f(i, j, k), brick->nodes.data() + n * channels, &anchors[n]) ? 1
-                                                                                                         : 0;
+        const Vec3f node = origin + options_.cell * Vec3f(i, j, k);
+        anchored[n] = f_(node, brick->nodes.data() + n * channels, &anchors[n]) ? 1 : 0;
+        if (anchored[n]) to_anchor[n] = (node - anchors[n]).norm();
       }
   const float spread = options_.max_anchor_spread * options_.cell;
   const float diagonal = std::sqrt(3.f) * options_.cell;
@@ -92,8 +93,7 @@ LazyGrid::Brick* LazyGrid::Build(int bx, int by, int bz) const {
           ++count;
           a_lo = a_lo.cwiseMin(anchors[n]);
           a_hi = a_hi.cwiseMax(anchors[n]);
-          const Vec3f corner = origin + options_.cell * Vec3f(i + (d & 1), j + ((d >> 1) & 1), k + (d >> 2));
-          nearest = std::min(nearest, (corner - anchors[n]).norm());
+          nearest = std::min(nearest, to_anchor[n]);
         }
         if (std::isfinite(options_.smooth_beyond) && nearest - diagonal >= options_.smooth_beyond) {
           brick->interpolated[CellIndex(i, j, k)] = 1;  // far from every anchor: smooth by definition
