@@ -18,37 +18,61 @@ namespace {
 // it no gradient, and the colour keeps its start, a dark red-brown mouth interior).
 constexpr float kCavityDensity = 400.f;
 constexpr float kCavityColorStart[3] = {0.12f, 0.04f, 0.04f};
+// The teeth of an open mouth (priors with teeth) are as opaque, and their colour is learned the same
+// way from the training frames that show them; it starts as the off-white of teeth.
+constexpr float kTeethColorStart[3] = {0.86f, 0.82f, 0.74f};
 // Density (1/world units) below which a sample is left unshaded by the prior shading.
 constexpr float kShadeMinDensity = 0.05f;
 
 float Sigmoid(float v) { return 1.f / (1.f + std::exp(-v)); }
 
-// Samples inside the cavity take its density and colour.
-void ApplyCavity(int64_t n, const uint8_t* inside, const float colour[3], float* sigma, float* rgb) {
-  for (int64_t i = 0; i < n; ++i) {
-    if (!inside[i]) continue;
-    sigma[i] = kCavityDensity;
-    for (int a = 0; a < 3; ++a) rgb[3 * i + a] = colour[a];
+// The density compositing sees at a sample of the prior's material (DeformationPrior::Cavity's
+// labels) whose static field density is sigma.
+float MaterialDensity(uint8_t material, float sigma) {
+  switch (material) {
+    case DeformationPrior::kField:
+      return sigma;
+    case DeformationPrior::kAir:
+      return 0.f;
+    default:
+      return kCavityDensity;
   }
 }
-// The cavity samples' colour gradients, summed (in sample order, in double) onto the cavity colour's
-// logits (d rgb / d logit = rgb (1 - rgb)); then both their gradients are dropped (the static field
-// did not produce them).
-void CavityBackward(int64_t n, const uint8_t* inside, std::span<const float> logits, float* d_sigma,
-                    float* d_rgb, std::span<float> d_logits) {
-  double sum[3] = {0, 0, 0};
+// Samples in the cavity or the teeth take their density and colour (colours[3 * (label - 1) +
+// channel]); samples in the air between parted lips are empty.
+void ApplyCavity(int64_t n, const uint8_t* inside, const float colours[6], float* sigma, float* rgb) {
   for (int64_t i = 0; i < n; ++i) {
     if (!inside[i]) continue;
+    sigma[i] = MaterialDensity(inside[i], sigma[i]);
+    if (inside[i] == DeformationPrior::kAir) continue;
+    for (int a = 0; a < 3; ++a) rgb[3 * i + a] = colours[3 * (inside[i] - 1) + a];
+  }
+}
+// The cavity's (and the teeth's) samples' colour gradients, summed (in sample order, in double) onto
+// their colour's logits (d rgb / d logit = rgb (1 - rgb)); then both their gradients are dropped (the
+// static field did not produce them). teeth_logits is empty for a prior without teeth.
+void CavityBackward(int64_t n, const uint8_t* inside, std::span<const float> cavity_logits,
+                    std::span<const float> teeth_logits, float* d_sigma, float* d_rgb,
+                    std::span<float> d_cavity_logits, std::span<float> d_teeth_logits) {
+  double sum[2][3] = {{0, 0, 0}, {0, 0, 0}};
+  for (int64_t i = 0; i < n; ++i) {
+    if (!inside[i]) continue;
+    ICEF_CHECK(inside[i] != DeformationPrior::kTeeth || !teeth_logits.empty(),
+               "teeth samples from a prior without teeth");
     d_sigma[i] = 0.f;
     for (int a = 0; a < 3; ++a) {
-      sum[a] += d_rgb[3 * i + a];
+      if (inside[i] != DeformationPrior::kAir) sum[inside[i] - 1][a] += d_rgb[3 * i + a];
       d_rgb[3 * i + a] = 0.f;
     }
   }
-  for (int a = 0; a < 3; ++a) {
-    const double c = Sigmoid(logits[a]);
-    d_logits[a] += static_cast<float>(sum[a] * c * (1.0 - c));
-  }
+  const auto add = [](const double* s, std::span<const float> logits, std::span<float> d_logits) {
+    for (int a = 0; a < 3; ++a) {
+      const double c = Sigmoid(logits[a]);
+      d_logits[a] += static_cast<float>(s[a] * c * (1.0 - c));
+    }
+  };
+  add(sum[0], cavity_logits, d_cavity_logits);
+  if (!teeth_logits.empty()) add(sum[1], teeth_logits, d_teeth_logits);
 }
 }  // namespace
 
@@ -104,6 +128,8 @@ Result<std::unique_ptr<AvatarModel>> AvatarModel::Create(const ModelConfig& conf
   }
   if (model->prior_ && config.prior_shading) model->light_ = setup.prior_light;
   if (model->prior_) model->cavity_block_ = model->store_.Register("cavity/colour", 3, kGridGroup);
+  if (model->prior_ && model->prior_->has_teeth())
+    model->teeth_block_ = model->store_.Register("teeth/colour", 3, kGridGroup);
   return model;
 }
 
@@ -113,6 +139,10 @@ void AvatarModel::Initialize(uint64_t seed) {
   if (cavity_block_ >= 0) {
     const std::span<float> logits = store_.params(cavity_block_);
     for (int a = 0; a < 3; ++a) logits[a] = std::log(kCavityColorStart[a] / (1.f - kCavityColorStart[a]));
+  }
+  if (teeth_block_ >= 0) {
+    const std::span<float> logits = store_.params(teeth_block_);
+    for (int a = 0; a < 3; ++a) logits[a] = std::log(kTeethColorStart[a] / (1.f - kTeethColorStart[a]));
   }
   occupancy_.Fill(true);
 }
@@ -124,6 +154,11 @@ NearestExpression AvatarModel::Nearest(std::span<const float> beta) const {
 float AvatarModel::CavityColour(int channel) const {
   ICEF_CHECK(cavity_block_ >= 0, "no mouth cavity without a prior");
   return Sigmoid(store_.params(cavity_block_)[channel]);
+}
+
+float AvatarModel::TeethColour(int channel) const {
+  ICEF_CHECK(teeth_block_ >= 0, "no teeth: the prior has none");
+  return Sigmoid(store_.params(teeth_block_)[channel]);
 }
 
 void AvatarModel::QueryStatic(const Executor& executor, int64_t n, const float* canonical,
@@ -211,8 +246,10 @@ void AvatarModel::FieldForward(ModelWorkspace& ws, int64_t n, const float* posit
                       ws.shade.data());
   }
   if (cavity) {
-    const float colour[3] = {CavityColour(0), CavityColour(1), CavityColour(2)};
-    ApplyCavity(n, ws.cavity.data(), colour, ws.sigma.data(), ws.rgb.data());
+    float colours[6] = {CavityColour(0), CavityColour(1), CavityColour(2), 0.f, 0.f, 0.f};
+    if (has_teeth())
+      for (int a = 0; a < 3; ++a) colours[3 + a] = TeethColour(a);
+    ApplyCavity(n, ws.cavity.data(), colours, ws.sigma.data(), ws.rgb.data());
   }
 }
 
@@ -224,7 +261,7 @@ void AvatarModel::CompositedRows(ModelWorkspace& ws, int64_t rays, bool cavity) 
     const float* sigma = ws.sigma.data() + off;
     if (cavity) {  // the densities compositing will see, after ApplyCavity
       Fit(ws.ray_sigma, cnt);
-      for (int32_t k = 0; k < cnt; ++k) ws.ray_sigma[k] = ws.cavity[off + k] ? kCavityDensity : sigma[k];
+      for (int32_t k = 0; k < cnt; ++k) ws.ray_sigma[k] = MaterialDensity(ws.cavity[off + k], sigma[k]);
       sigma = ws.ray_sigma.data();
     }
     const int used = CompositeRayUsed<float>(cnt, sigma, ws.samples.dt.data() + off, eps);
@@ -313,7 +350,7 @@ void AvatarModel::PlaceTrainingSamples(const TrainRays& batch, ModelWorkspace& w
     Fit(ws.coarse_cavity, m);
     warp_->Cavity(executor, m, positions, ws.coarse_betas.data(), ws.coarse_cavity.data());
     for (int64_t i = 0; i < m; ++i)
-      if (ws.coarse_cavity[i]) ws.coarse_sigma[i] = kCavityDensity;
+      ws.coarse_sigma[i] = MaterialDensity(ws.coarse_cavity[i], ws.coarse_sigma[i]);
   }
   ResampleRays(batch.rays, ws.coarse, ws.coarse_sigma, config_.importance, seed, step, executor, &ws.samples);
 }
@@ -365,8 +402,10 @@ LossTerms AvatarModel::TrainForwardBackward(const TrainRays& batch, const LossWe
   CompositeBackward(in, ws.composite, grads, executor, &ws.d_sigma, &ws.d_rgb);
   RunLosses(LossStage::kSamples, ctx, &terms);
   if (warp_ && warp_->has_prior())
-    CavityBackward(n, ws.cavity.data(), store_.params(cavity_block_), ws.d_sigma.data(), ws.d_rgb.data(),
-                   store_.grads(cavity_block_));
+    CavityBackward(n, ws.cavity.data(), store_.params(cavity_block_),
+                   has_teeth() ? store_.params(teeth_block_) : std::span<const float>(), ws.d_sigma.data(),
+                   ws.d_rgb.data(), store_.grads(cavity_block_),
+                   has_teeth() ? store_.grads(teeth_block_) : std::span<float>());
   if (warp_) Fit(ws.d_canonical, 3 * n);
   const bool shaded = !ws.shade.empty();
   if (shaded)  // d rgb_unshaded = s d rgb
@@ -425,7 +464,7 @@ OccupancyGrid AvatarModel::RenderOccupancy(std::span<const float> beta, const Ex
       cavity.resize(n);
       warp_->Cavity(executor, n, positions, dws.betas.data(), cavity.data());
       for (int64_t i = 0; i < n; ++i)
-        if (cavity[i]) sigma[i] = kCavityDensity;
+        if (cavity[i]) sigma[i] = MaterialDensity(cavity[i], sigma[i]);
     }
   };
   // One query per 2 x 2 x 2 cells: the training grid already holds the observed geometry, what is

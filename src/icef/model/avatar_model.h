@@ -98,9 +98,12 @@ class AvatarModel {
   // beta_n, delta, kappa for an expression.
   NearestExpression Nearest(std::span<const float> beta) const;
 
-  // The face model's mouth cavity (the *-prior methods) and its learned colour (channel 0-2).
+  // The face model's mouth cavity (the *-prior methods) and its learned colour (channel 0-2); the
+  // teeth of an open mouth (priors with teeth: the ICT-FaceKit prior) and their learned colour.
   bool has_mouth_cavity() const { return cavity_block_ >= 0; }
   float CavityColour(int channel) const;
+  bool has_teeth() const { return teeth_block_ >= 0; }
+  float TeethColour(int channel) const;
 
   // Canonical-space query of the static field (tests and tools): sigma [n], rgb [n, 3].
   void QueryStatic(const Executor& executor, int64_t n, const float* canonical, const float* directions,
@@ -176,6 +179,7 @@ class AvatarModel {
   std::unique_ptr<Deformation> warp_;
   std::optional<Vec3f> light_;
   int cavity_block_ = -1;  // the mouth cavity's colour logits (*-prior methods), else -1
+  int teeth_block_ = -1;   // the teeth's colour logits (priors with teeth), else -1
   RegionMask mask_;
   ExpressionConfidence confidence_;
   OccupancyGrid occupancy_;

@@ -25,6 +25,10 @@ constexpr int kGridCells = 32;
 // (the neutral's is 0.1 cm; jawOpen = 1 parts them by 3.6 cm).
 constexpr float kOpenLipGap = 0.3f;
 constexpr int kInnerLipPairs[3][2] = {{61, 67}, {62, 66}, {63, 65}};
+// cm: the air between parted lips is looked for within this of the inner lips' box (Cavity's kAir),
+// and it is air when the warp carries it more than kAirDepth behind the surface at rest.
+constexpr float kLipsReach = 1.5f;
+constexpr float kAirDepth = 0.1f;
 
 // ARKit weights are 0..1: negative and non-finite ones act as 0 (as in FacePrior).
 float Sanitized(float w) { return std::isfinite(w) && w > 0.f ? w : 0.f; }
@@ -60,7 +64,8 @@ struct IctPrior::MouthSurface {
   std::vector<uint32_t> rim;                          // local indices of the rim's vertices
   std::vector<std::array<uint32_t, 3>> triangles;     // local indices; the apex is vertices.size()
   std::array<std::array<uint32_t, 2>, 3> inner_lips;  // model vertices of the inner lips' pairs
-  int socket = -1, tongue = -1;                       // part indices of mouth_socket, gums_tongue
+  int socket = -1, tongue = -1, teeth = -1;           // part indices of mouth_socket, gums_tongue, teeth
+  std::vector<uint32_t> teeth_vertices;               // model vertices of the teeth
 
   static Result<MouthSurface> Build(const face::IctWarp& warp);
 };
@@ -71,9 +76,12 @@ Result<IctPrior::MouthSurface> IctPrior::MouthSurface::Build(const face::IctWarp
   MouthSurface surface;
   surface.socket = socket;
   surface.tongue = model.PartIndex("gums_tongue");
-  if (socket < 0 || face < 0 || surface.tongue < 0)
+  surface.teeth = model.PartIndex("teeth");
+  if (socket < 0 || face < 0 || surface.tongue < 0 || surface.teeth < 0)
     return Status::Error(model.path().string() +
-                         ": the face model has no mouth_socket, gums_tongue or face part");
+                         ": the face model has no mouth_socket, gums_tongue, teeth or face part");
+  for (uint32_t v = 0; v < model.part_labels().size(); ++v)
+    if (model.part_labels()[v] == surface.teeth) surface.teeth_vertices.push_back(v);
   for (int k = 0; k < 3; ++k) {
     for (int j = 0; j < 2; ++j) {
       const int32_t v = model.landmark_vertices()[kInnerLipPairs[k][j]];
@@ -232,6 +240,12 @@ struct IctPrior::Expression {
     for (const auto& [upper, lower] : surface.inner_lips)
       gap += (posed.posed()[upper] - posed.posed()[lower]).norm();
     open = gap / 3.f > kOpenLipGap;
+    for (uint32_t v : surface.teeth_vertices)
+      teeth_lo = teeth_lo.cwiseMin(posed.posed()[v]), teeth_hi = teeth_hi.cwiseMax(posed.posed()[v]);
+    for (const auto& pair : surface.inner_lips)
+      for (uint32_t v : pair)
+        lips_lo = lips_lo.cwiseMin(posed.posed()[v]), lips_hi = lips_hi.cwiseMax(posed.posed()[v]);
+    lips_lo -= Vec3f::Constant(kLipsReach), lips_hi += Vec3f::Constant(kLipsReach);
     if (options.grid_cell <= 0.f) return;
     // The box: the posed surface and outer_radius around it (beyond, nothing moves and no normal).
     Vec3f lo = Vec3f::Constant(INFINITY), hi = Vec3f::Constant(-INFINITY);
@@ -286,7 +300,11 @@ struct IctPrior::Expression {
   std::vector<Vec3f> normals;                   // of the posed warp surface: [num_vertices], head frame
   const std::vector<Vec3f>& canonical_normals;  // of the neutral (beta = 0)
   bool open = false;                            // the inner lips are parted (kOpenLipGap)
-  std::unique_ptr<LazyGrid> grid;               // nullptr: grid_cell = 0
+  Vec3f teeth_lo = Vec3f::Constant(INFINITY);   // the posed teeth's bounding box, head frame
+  Vec3f teeth_hi = Vec3f::Constant(-INFINITY);
+  Vec3f lips_lo = Vec3f::Constant(INFINITY);  // the inner lips' box grown by kLipsReach
+  Vec3f lips_hi = Vec3f::Constant(-INFINITY);
+  std::unique_ptr<LazyGrid> grid;  // nullptr: grid_cell = 0
 };
 
 Status IctPriorOptions::Validate() const {
@@ -437,8 +455,14 @@ void IctPrior::Cavity(const Executor& executor, int64_t n, const float* position
                       uint8_t* inside) const {
   const std::vector<uint8_t>& labels = model_->part_labels();
   ForEachSample(executor, n, positions, betas, [&](int64_t i, const Expression& e, const Vec3f& x) {
-    inside[i] = 0;
-    if (!e.open || !e.mouth.Inside(x)) return;
+    inside[i] = kField;
+    if (!e.open) return;
+    const auto in_box = [&](const Vec3f& lo, const Vec3f& hi) {
+      return (x.array() >= lo.array()).all() && (x.array() <= hi.array()).all();
+    };
+    const bool in_mouth = e.mouth.Inside(x), near_teeth = in_box(e.teeth_lo, e.teeth_hi),
+               near_lips = in_box(e.lips_lo, e.lips_hi);
+    if (!in_mouth && !near_teeth && !near_lips) return;
     const face::IctWarpClosest closest = e.posed.Closest(x);
     if (closest.triangle < 0) return;
     // The part of the closest point: that of the triangle's corner nearest to it.
@@ -446,11 +470,38 @@ void IctPrior::Cavity(const Executor& executor, int64_t n, const float* position
     const Vec3f& b = closest.barycentric;
     const int corner = b[0] >= b[1] && b[0] >= b[2] ? 0 : b[1] >= b[2] ? 1 : 2;
     const int part = labels[t[corner]];
-    if (part != mouth_surface_->socket && part != mouth_surface_->tongue) return;
-    // On the air side: both parts' normals point into the mouth.
     const std::vector<Vec3f>& mesh = e.posed.posed();
     const Vec3f p = b[0] * mesh[t[0]] + b[1] * mesh[t[1]] + b[2] * mesh[t[2]];
-    inside[i] = Interpolated(e.normals, t, b).dot(x - p) > 0.f ? 1 : 0;
+    const float side = Interpolated(e.normals, t, b).dot(x - p);
+    const bool interior =
+        part == mouth_surface_->teeth || part == mouth_surface_->socket || part == mouth_surface_->tongue;
+    // Inside a tooth: behind the teeth's surface (their normals point out).
+    if (part == mouth_surface_->teeth && side < 0.f) {
+      inside[i] = kTeeth;
+      return;
+    }
+    // On the air side of the socket or the tongue (their normals point into the mouth): the cavity.
+    if (in_mouth && (part == mouth_surface_->socket || part == mouth_surface_->tongue) && side > 0.f) {
+      inside[i] = kMouthCavity;
+      return;
+    }
+    // Air in the parted lips: x on the air side of its closest surface (its normal points to x), and
+    // that surface is inside the mouth (teeth, gums, tongue, socket: x is in the opening, which the
+    // unmoving upper teeth would carry into the closed lips at rest), or x's canonical point lies more
+    // than kAirDepth behind the surface at rest.
+    if (!near_lips || !(side > 0.f)) return;
+    if (interior) {
+      inside[i] = kAir;
+      return;
+    }
+    const Vec3f canonical = x + e.posed.OffsetAt(x, closest);
+    const face::IctWarpClosest rest = rest_->posed.Closest(canonical);
+    if (rest.triangle < 0) return;
+    const std::array<uint32_t, 3>& r = warp_->triangles()[rest.triangle];
+    const Vec3f& rb = rest.barycentric;
+    const std::vector<Vec3f>& neutral = rest_->posed.posed();
+    const Vec3f q = rb[0] * neutral[r[0]] + rb[1] * neutral[r[1]] + rb[2] * neutral[r[2]];
+    if (Interpolated(rest_->normals, r, rb).dot(canonical - q) < -kAirDepth) inside[i] = kAir;
   });
 }
 

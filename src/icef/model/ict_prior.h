@@ -22,6 +22,19 @@
 // points nearest the lips or the teeth are never inside, so the cavity does not hide the teeth, and
 // the air just between the lips (in front of the rim) is left to the warped static field.
 //
+// Teeth (Cavity's kTeeth): when the expression parts the inner lips, S x lies inside the teeth when
+// its closest posed surface point is on ICT's teeth, on the side their normals point away from. The
+// training frames rarely show teeth, so the canonical field has none to warp (behind closed lips it
+// holds whatever the lips left there); the avatar draws them as an opaque volume of one learned
+// colour (AvatarModel::TeethColour).
+//
+// Air between parted lips (Cavity's kAir): the closest-point warp carries the space the lower lip
+// left to where it was at rest (a point under the unmoving upper lip maps as far under it at rest,
+// into the closed lips), so the canonical lips would fill the opening and hide what lies behind.
+// When the lips are parted, a point within 1.5 cm of the inner lips' box that lies on the air side
+// of its closest posed surface and whose canonical point lies more than 0.1 cm behind the surface at
+// rest (on the side its normals point away from) is empty.
+//
 // Normals: from the closest point of S x on the posed surface (triangle t, barycentric b): observed =
 // the posed mesh's interpolated vertex normal at (t, b), canonical = the neutral mesh's at (t, b),
 // where the warp maps that point (within inner_radius P keeps the signed distance along it). Both
@@ -103,9 +116,10 @@ class IctPrior final : public DeformationPrior {
   // positions [n, 3] world frame, betas [n, 53] -> offsets [n, 3] world frame.
   void Offsets(const Executor& executor, int64_t n, const float* positions, const float* betas,
                float* offsets) const override;
-  // positions [n, 3] world frame, betas [n, 53] -> inside [n] (the rule above).
+  // positions [n, 3] world frame, betas [n, 53] -> inside [n] (the rules above).
   void Cavity(const Executor& executor, int64_t n, const float* positions, const float* betas,
               uint8_t* inside) const override;
+  bool has_teeth() const override { return true; }
   // positions [n, 3] world frame, betas [n, 53] -> observed, canonical [n, 3] world frame, unit or 0.
   bool Normals(const Executor& executor, int64_t n, const float* positions, const float* betas,
                float* observed, float* canonical) const override;

@@ -22,10 +22,12 @@ using testing_model::TinyModelConfig;
 using testing_model::TinySetup;
 
 // P(x, beta) - x = beta_0 (0.1 sin(3 y), -0.2, 0.05 x) + beta_1 (0, 0.1 z, 0); the cavity is a ball of
-// radius 0.1 beta_0 around (0, -0.2, 0.3).
+// radius 0.1 beta_0 around (0, -0.2, 0.3); with teeth, a ball of the same radius around (0.3, -0.2, 0.3)
+// is teeth; with air, the box |x + 0.3| < 0.1, |y + 0.2| < 0.1, z > 0.3 is air where beta_0 > 0.
 class TestPrior final : public DeformationPrior {
  public:
-  explicit TestPrior(int dims) : dims_(dims) {}
+  explicit TestPrior(int dims, bool teeth = false, bool air = false)
+      : dims_(dims), teeth_(teeth), air_(air) {}
   void Offsets(const Executor&, int64_t n, const float* x, const float* betas,
                float* offsets) const override {
     for (int64_t i = 0; i < n; ++i) {
@@ -40,9 +42,14 @@ class TestPrior final : public DeformationPrior {
               uint8_t* inside) const override {
     for (int64_t i = 0; i < n; ++i) {
       const Vec3f d = Vec3f(x[3 * i], x[3 * i + 1], x[3 * i + 2]) - Vec3f(0.f, -0.2f, 0.3f);
-      inside[i] = d.norm() < 0.1f * betas[i * dims_] ? 1 : 0;
+      inside[i] = d.norm() < 0.1f * betas[i * dims_] ? kMouthCavity : kField;
+      if (teeth_ && (d - Vec3f(0.3f, 0.f, 0.f)).norm() < 0.1f * betas[i * dims_]) inside[i] = kTeeth;
+      if (air_ && betas[i * dims_] > 0.f && std::abs(x[3 * i] + 0.3f) < 0.1f &&
+          std::abs(x[3 * i + 1] + 0.2f) < 0.1f && x[3 * i + 2] > 0.3f)
+        inside[i] = kAir;
     }
   }
+  bool has_teeth() const override { return teeth_; }
   // Normals: canonical (0.6, 0.8, 0) rotated about z by the sample's x, observed tilted further by
   // beta_0 (so beta = 0 leaves the shading as it is).
   bool Normals(const Executor&, int64_t n, const float* x, const float* betas, float* observed,
@@ -60,21 +67,23 @@ class TestPrior final : public DeformationPrior {
 
  private:
   int dims_;
+  bool teeth_, air_;
 };
 
 // A light along +z with strength 1.5: the prior shading scales the colour where beta_0 tilts the
 // observed normal towards it. With shading = false (model.prior_shading off) nothing is shaded.
 std::unique_ptr<AvatarModel> MakePriorModel(const std::string& method, float deform_scale,
                                             bool shading = true,
-                                            float density_bias = StaticFieldOptions{}.density_bias) {
+                                            float density_bias = StaticFieldOptions{}.density_bias,
+                                            bool teeth = false, bool air = false) {
   ModelConfig config = TinyModelConfig(method);
   config.deformation.output_init_scale = deform_scale;
   config.prior_shading = shading;
   config.static_field.density_bias = density_bias;
   ModelSetup setup = TinySetup();
   setup.prior_light = Vec3f(0.f, 0.3f, 1.5f);
-  auto model =
-      AvatarModel::Create(config, setup, Executor(2), std::make_unique<TestPrior>(setup.expression_dim));
+  auto model = AvatarModel::Create(config, setup, Executor(2),
+                                   std::make_unique<TestPrior>(setup.expression_dim, teeth, air));
   ICEF_CHECK(model.ok(), model.status().message());
   (*model)->Initialize(7);
   return std::move(model).value();
@@ -281,6 +290,87 @@ TEST(PriorGuidedTest, MouthCavityColourIsLearned) {
   auto icef = AvatarModel::Create(plain, TinySetup(), Executor(1));
   ASSERT_TRUE(icef.ok());
   EXPECT_LT((*icef)->store().FindBlock("cavity/colour"), 0);
+}
+
+// A prior with teeth gives the model a teeth colour, learned as the cavity's is: a render through
+// the teeth shows it (the start, off-white), its logits' gradient from rays through the teeth matches
+// central differences of the loss, and rays that miss the teeth pass it none. The cavity's colour
+// takes no gradient from the teeth.
+TEST(PriorGuidedTest, TeethColourIsLearned) {
+  auto model = MakePriorModel("icef-prior", 0.01f, true, StaticFieldOptions{}.density_bias, true);
+  ASSERT_TRUE(model->has_teeth());
+  nn::ParameterStore& store = model->store();
+  const int block = store.FindBlock("teeth/colour"), cavity = store.FindBlock("cavity/colour");
+  ASSERT_GE(block, 0);
+  EXPECT_NEAR(model->TeethColour(0), 0.86f, 1e-6f);
+  RenderOutput open;
+  model->Render(std::vector<Ray>{Ray{Vec3f(0.3f, -0.2f, 2.f), Vec3f(0, 0, -1)}},
+                std::vector<float>{1.5f, 0.f, 0.f}, Vec3f::Ones(), Executor(1), &open);
+  ASSERT_GT(open.opacity[0], 0.99f);
+  for (int a = 0; a < 3; ++a) EXPECT_NEAR(open.color[a], model->TeethColour(a), 0.03f) << a;
+
+  TrainRays through, past;
+  for (float dx : {-0.02f, 0.02f}) {
+    through.rays.push_back(Ray{Vec3f(0.3f + dx, -0.2f, 2.f), Vec3f(0, 0, -1)});
+    past.rays.push_back(Ray{Vec3f(dx, -0.2f, 2.f), Vec3f(0, 0, -1)});  // through the cavity instead
+    for (TrainRays* b : {&through, &past}) {
+      b->frame.push_back(0);  // beta_0 = 0.5: balls of radius 0.05
+      for (float target : {0.3f, 0.5f, 0.7f}) b->target_rgb.push_back(target);
+      b->target_alpha.push_back(1.f);
+    }
+  }
+  const Executor ex(1);
+  store.ZeroGrads();
+  model->TrainForwardBackward(through, LossWeights{}, 3, 0, ex);
+  const std::vector<float> grad(store.grads(block).begin(), store.grads(block).end());
+  for (int a = 0; a < 3; ++a) EXPECT_EQ(store.grads(cavity)[a], 0.f) << a;
+  for (int a = 0; a < 3; ++a) {
+    const float h = 1e-2f, start = store.params(block)[a];
+    double loss[2];
+    for (int s = 0; s < 2; ++s) {
+      store.params(block)[a] = start + (s == 0 ? h : -h);
+      store.ZeroGrads();
+      loss[s] = model->TrainForwardBackward(through, LossWeights{}, 3, 0, ex).total;
+    }
+    store.params(block)[a] = start;
+    const double numeric = (loss[0] - loss[1]) / (2.0 * h);
+    EXPECT_GT(std::abs(numeric), 1e-4) << a;
+    EXPECT_NEAR(grad[a], numeric, 0.03 * std::abs(numeric)) << a;
+  }
+  store.ZeroGrads();
+  model->TrainForwardBackward(past, LossWeights{}, 3, 0, ex);
+  for (int a = 0; a < 3; ++a) EXPECT_EQ(store.grads(block)[a], 0.f) << a;
+  // A prior without teeth: no block for them.
+  EXPECT_LT(MakePriorModel("icef-prior", 0.01f)->store().FindBlock("teeth/colour"), 0);
+}
+
+// Air (a prior's kAir: between parted lips) is empty whatever the static field holds there: a ray
+// through 0.2 of air before a dense field ends about 0.2 farther than the same model's without air,
+// at the expression that makes the air (beta_0 > 0) and not at rest; training rays through it pass
+// no gradient to the cavity's colour.
+TEST(PriorGuidedTest, AirIsEmpty) {
+  auto with = MakePriorModel("icef-prior", 1e-6f, false, 4.f, false, true);
+  auto without = MakePriorModel("icef-prior", 1e-6f, false, 4.f, false, false);
+  const std::vector<Ray> ray = {Ray{Vec3f(-0.3f, -0.2f, 2.f), Vec3f(0, 0, -1)}};
+  RenderOutput a, b, rest_a, rest_b;
+  const std::vector<float> open = {0.5f, 0.f, 0.f}, rest = {0.f, 0.f, 0.f};
+  with->Render(ray, open, Vec3f::Ones(), Executor(1), &a);
+  without->Render(ray, open, Vec3f::Ones(), Executor(1), &b);
+  with->Render(ray, rest, Vec3f::Ones(), Executor(1), &rest_a);
+  without->Render(ray, rest, Vec3f::Ones(), Executor(1), &rest_b);
+  ASSERT_GT(b.opacity[0], 0.99f);
+  EXPECT_LT(b.depth[0], 1.6f);  // the dense field from the aabb's face at z = 0.5 on
+  EXPECT_NEAR(a.depth[0] - b.depth[0], 0.2f, 0.05f);
+  EXPECT_EQ(rest_a.depth[0], rest_b.depth[0]);
+  TrainRays through;
+  through.rays = ray;
+  through.frame = {0};  // beta_0 = 0.5
+  through.target_rgb = {0.1f, 0.2f, 0.3f};
+  through.target_alpha = {1.f};
+  nn::ParameterStore& store = with->store();
+  store.ZeroGrads();
+  with->TrainForwardBackward(through, LossWeights{}, 3, 0, Executor(1));
+  for (float g : store.grads(store.FindBlock("cavity/colour"))) EXPECT_EQ(g, 0.f);
 }
 
 // The prior shading: colour times s = (1 + max(0, n_obs . v)) / (1 + max(0, n_can . v)) at every
