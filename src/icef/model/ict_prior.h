@@ -19,8 +19,8 @@
 // a centimetre behind the lips; inside = an odd count of crossings of a +z ray, found through a 2D
 // grid with tie rules that make the surface watertight), and (3) its closest posed surface point
 // is on mouth_socket or gums_tongue, on the side their normals point to (the air). Conservative:
-// points nearest the lips or the teeth are never inside, so the cavity does not hide the teeth, and
-// the air just between the lips (in front of the rim) is left to the warped static field.
+// points nearest the lips or the teeth are never inside, so the cavity does not hide the teeth; the
+// air just between the lips (in front of the rim) is the air rule's (below).
 //
 // Teeth (Cavity's kTeeth): when the expression parts the inner lips, S x lies inside the teeth when
 // its closest posed surface point is on ICT's teeth, on the side their normals point away from. The
