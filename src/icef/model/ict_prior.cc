@@ -280,9 +280,22 @@ struct IctPrior::Expression {
     const float weight = posed.warp().options().Weight(closest.distance);
     observed = weight * Interpolated(normals, t, b);
     canonical = weight * Interpolated(canonical_normals, t, b);
-    const std::vector<Vec3f>& mesh = posed.posed();
-    *anchor = b[0] * mesh[t[0]] + b[1] * mesh[t[1]] + b[2] * mesh[t[2]];
+    *anchor = SurfacePoint(closest);
     return true;
+  }
+
+  // The point of the posed surface at a closest point (closest.triangle >= 0), head frame.
+  Vec3f SurfacePoint(const face::IctWarpClosest& closest) const {
+    const std::array<uint32_t, 3>& t = posed.warp().triangles()[closest.triangle];
+    const Vec3f& b = closest.barycentric;
+    const std::vector<Vec3f>& mesh = posed.posed();
+    return b[0] * mesh[t[0]] + b[1] * mesh[t[1]] + b[2] * mesh[t[2]];
+  }
+  // Which side of the posed surface x lies on, and how far along its normal there: the interpolated
+  // vertex normal at x's closest point (closest.triangle >= 0) dotted with x minus that point.
+  float Side(const face::IctWarpClosest& closest, const Vec3f& x) const {
+    const std::array<uint32_t, 3>& t = posed.warp().triangles()[closest.triangle];
+    return Interpolated(normals, t, closest.barycentric).dot(x - SurfacePoint(closest));
   }
 
   // Offset and normals at x (head frame): the grid's where there is one.
@@ -470,9 +483,7 @@ void IctPrior::Cavity(const Executor& executor, int64_t n, const float* position
     const Vec3f& b = closest.barycentric;
     const int corner = b[0] >= b[1] && b[0] >= b[2] ? 0 : b[1] >= b[2] ? 1 : 2;
     const int part = labels[t[corner]];
-    const std::vector<Vec3f>& mesh = e.posed.posed();
-    const Vec3f p = b[0] * mesh[t[0]] + b[1] * mesh[t[1]] + b[2] * mesh[t[2]];
-    const float side = Interpolated(e.normals, t, b).dot(x - p);
+    const float side = e.Side(closest, x);
     const bool interior =
         part == mouth_surface_->teeth || part == mouth_surface_->socket || part == mouth_surface_->tongue;
     // Inside a tooth: behind the teeth's surface (their normals point out).
@@ -496,12 +507,7 @@ void IctPrior::Cavity(const Executor& executor, int64_t n, const float* position
     }
     const Vec3f canonical = x + e.posed.OffsetAt(x, closest);
     const face::IctWarpClosest rest = rest_->posed.Closest(canonical);
-    if (rest.triangle < 0) return;
-    const std::array<uint32_t, 3>& r = warp_->triangles()[rest.triangle];
-    const Vec3f& rb = rest.barycentric;
-    const std::vector<Vec3f>& neutral = rest_->posed.posed();
-    const Vec3f q = rb[0] * neutral[r[0]] + rb[1] * neutral[r[1]] + rb[2] * neutral[r[2]];
-    if (Interpolated(rest_->normals, r, rb).dot(canonical - q) < -kAirDepth) inside[i] = kAir;
+    if (rest.triangle >= 0 && rest_->Side(rest, canonical) < -kAirDepth) inside[i] = kAir;
   });
 }
 
