@@ -16,6 +16,15 @@ constexpr std::string_view kSurfaceParts[] = {
     "face",  "head_neck",   "mouth_socket", "eye_socket_left", "eye_socket_right", "gums_tongue",
     "teeth", "sclera_left", "iris_left",    "sclera_right",    "iris_right"};
 
+// The eyes of the lid slide (ict_warp.h): their scleras, and the parts that are not skin.
+constexpr std::string_view kScleras[2] = {"sclera_left", "sclera_right"};
+constexpr std::string_view kBlinks[2] = {"eyeBlink_L", "eyeBlink_R"};
+constexpr std::string_view kEyeballParts[] = {"sclera_left", "iris_left", "sclera_right", "iris_right"};
+constexpr float kLidTop = 1.5707963f;   // elevation straight up: the slide ends there
+constexpr float kOpeningReach = 3.f;    // cm: skin this far in front (+z) covers the eyeball
+constexpr float kOpeningStep = 0.025f;  // rad: elevations tried per column
+constexpr float kOpeningLimit = 1.4f;   // rad: elevations tried, -limit..limit
+
 // Most KD-tree points per triangle edge (a triangle gets at most kMaxSubdivisions^2).
 constexpr int kMaxSubdivisions = 64;
 
@@ -70,6 +79,73 @@ Vec3f ClosestBarycentric(const Vec3f& p, const Corners& c) {
   return {1 - v - w, v, w};
 }
 
+// Distance along the ray o + t d (t > 0) to triangle c, or infinity (Moller-Trumbore).
+float RayTriangle(const Vec3f& o, const Vec3f& d, const Corners& c) {
+  const Vec3f e1 = c[1] - c[0], e2 = c[2] - c[0], p = d.cross(e2);
+  const float det = e1.dot(p);
+  if (std::abs(det) < 1e-12f) return std::numeric_limits<float>::infinity();
+  const Vec3f s = o - c[0];
+  const float u = s.dot(p) / det;
+  if (u < 0.f || u > 1.f) return std::numeric_limits<float>::infinity();
+  const Vec3f q = s.cross(e1);
+  const float v = d.dot(q) / det;
+  if (v < 0.f || u + v > 1.f) return std::numeric_limits<float>::infinity();
+  const float t = e2.dot(q) / det;
+  return t > 0.f ? t : std::numeric_limits<float>::infinity();
+}
+
+// Hermite smoothstep: 0 at or below e0, 1 at or above e1.
+float SmoothStep(float e0, float e1, float x) {
+  const float t = std::clamp((x - e0) / (e1 - e0), 0.f, 1.f);
+  return t * t * (3.f - 2.f * t);
+}
+
+// One eye of the lid slide on the neutral: the sclera's sphere (least-squares centre, median
+// radius) and the rest opening by column (ict_warp.h). skin: the surface triangles that cover it.
+IctEye MeasureEye(const std::vector<Vec3f>& neutral, const std::vector<uint8_t>& labels, int sclera,
+                  const std::vector<std::array<uint32_t, 3>>& skin) {
+  IctEye eye;
+  // |p|^2 = 2 c . p + k, least squares over the sclera's vertices.
+  std::vector<Vec3f> points;
+  for (size_t v = 0; v < neutral.size(); ++v)
+    if (labels[v] == sclera) points.push_back(neutral[v]);
+  Eigen::MatrixXd a(points.size(), 4);
+  Eigen::VectorXd b(points.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3d p = points[i].cast<double>();
+    a.row(static_cast<Eigen::Index>(i)) << 2 * p.x(), 2 * p.y(), 2 * p.z(), 1;
+    b[static_cast<Eigen::Index>(i)] = p.squaredNorm();
+  }
+  eye.centre = a.colPivHouseholderQr().solve(b).head<3>().cast<float>();
+  std::vector<float> radii;
+  for (const Vec3f& p : points) radii.push_back((p - eye.centre).norm());
+  std::nth_element(radii.begin(), radii.begin() + radii.size() / 2, radii.end());
+  eye.radius = radii[radii.size() / 2];
+  std::vector<Corners> near;  // skin within reach of the eyeball
+  for (const auto& t : skin) {
+    const Corners c = TriangleCorners(neutral, t);
+    if (std::any_of(c.begin(), c.end(),
+                    [&](const Vec3f& p) { return (p - eye.centre).norm() < eye.radius + kOpeningReach; }))
+      near.push_back(c);
+  }
+  for (int k = 0; k < IctEye::kColumns; ++k) {
+    const float u = -1.f + (static_cast<float>(k) + 0.5f) * 2.f / IctEye::kColumns,
+                across = std::sqrt(1.f - u * u);
+    float lower = INFINITY, upper = -INFINITY;
+    for (float theta = -kOpeningLimit; theta <= kOpeningLimit; theta += kOpeningStep) {
+      const Vec3f d(u, across * std::sin(theta), across * std::cos(theta));
+      const Vec3f o = eye.centre + eye.radius * d;
+      const bool covered = std::any_of(near.begin(), near.end(), [&](const Corners& c) {
+        return RayTriangle(o, Vec3f::UnitZ(), c) <= kOpeningReach;
+      });
+      if (!covered) lower = std::min(lower, theta), upper = std::max(upper, theta);
+    }
+    if (lower > upper) lower = upper = 0.f;  // no opening
+    eye.lower[k] = lower, eye.upper[k] = upper;
+  }
+  return eye;
+}
+
 // An orthonormal frame of a triangle (first edge, in-plane perpendicular, face normal) and the
 // in-plane coordinates of its two edges from corner 0 (columns); false when degenerate.
 bool TriangleFrame(const Corners& c, Mat3f* frame, Eigen::Matrix2f* edges) {
@@ -111,6 +187,29 @@ Mat3f RotationOfSum(const Vec4f& q) {
 }
 
 }  // namespace
+
+std::pair<float, float> IctEye::Opening(float u) const {
+  const float s = std::clamp((u + 1.f) * kColumns / 2.f - 0.5f, 0.f, kColumns - 1.f);
+  const int k = std::min(static_cast<int>(s), kColumns - 2);
+  const float f = s - static_cast<float>(k);
+  return {(1.f - f) * lower[k] + f * lower[k + 1], (1.f - f) * upper[k] + f * upper[k + 1]};
+}
+
+Vec3f IctEye::Slide(const Vec3f& x, float blink) const {
+  const Vec3f q = x - centre;
+  if (!(blink > 0.f) || q.z() <= 0.f) return x;
+  const float r = q.norm(), u = q.x() / radius;
+  const float weight = SmoothStep(-0.6f, -0.3f, r - radius) * (1.f - SmoothStep(0.4f, 0.9f, r - radius));
+  if (weight <= 0.f || !(std::abs(u) < 1.f)) return x;
+  const auto [open_lower, open_upper] = Opening(u);
+  const float edge = open_upper - std::min(blink, 1.f) * (open_upper - open_lower);
+  const float theta = std::atan2(q.y(), q.z());
+  if (!(edge < open_upper) || theta < edge || theta > kLidTop) return x;
+  const float mapped = open_upper + (theta - edge) * (kLidTop - open_upper) / (kLidTop - edge);
+  const float a = weight * (mapped - theta), c = std::cos(a), sn = std::sin(a);
+  // Rotation about the x axis through the centre raising the elevation by a.
+  return centre + Vec3f(q.x(), q.y() * c + q.z() * sn, -q.y() * sn + q.z() * c);
+}
 
 float IctWarpOptions::Weight(float distance) const {
   if (distance <= inner_radius) return 1.f;
@@ -171,6 +270,15 @@ Result<IctWarp> IctWarp::Create(const IctModel& model, std::span<const float> id
   for (const auto& t : model.triangles())
     if (on_surface[labels[t[0]]] && on_surface[labels[t[1]]] && on_surface[labels[t[2]]])
       warp.triangles_.push_back(t);
+  std::vector<bool> eyeball(model.part_names().size(), false);
+  for (std::string_view part : kEyeballParts) eyeball[model.PartIndex(part)] = true;
+  std::vector<std::array<uint32_t, 3>> skin;
+  for (const auto& t : warp.triangles_)
+    if (!eyeball[labels[t[0]]] && !eyeball[labels[t[1]]] && !eyeball[labels[t[2]]]) skin.push_back(t);
+  for (int side = 0; side < 2; ++side) {
+    warp.eyes_[side] = MeasureEye(warp.neutral_, labels, model.PartIndex(kScleras[side]), skin);
+    warp.eyes_[side].blink = model.ExpressionIndex(kBlinks[side]);
+  }
   return warp;
 }
 
@@ -341,6 +449,13 @@ PosedIctWarp::PosedIctWarp(const IctWarp& warp, std::span<const float> expressio
   for (size_t e = 0; e < expression.size(); ++e) {
     ICEF_CHECK(std::isfinite(expression[e]), "expression weight " + std::to_string(e) + " is not finite");
     if (expression[e] == 0.f) continue;
+    bool blink = false;  // the lid slide's, not the mesh's
+    for (int side = 0; side < 2; ++side) {
+      if (warp.eyes_[side].blink != static_cast<int>(e)) continue;
+      blink_[side] = std::clamp(expression[e], 0.f, 1.f);
+      blink = true;
+    }
+    if (blink) continue;
     const std::span<const Vec3f> delta = model.ExpressionDelta(static_cast<int>(e));
     for (size_t v = 0; v < posed_.size(); ++v) posed_[v] += expression[e] * delta[v];
   }
@@ -381,7 +496,16 @@ IctWarpClosest PosedIctWarp::Closest(const Vec3f& x) const {
   return search.Result();
 }
 
-Vec3f PosedIctWarp::Offset(const Vec3f& x) const { return OffsetAt(x, Closest(x)); }
+Vec3f PosedIctWarp::LidSlide(const Vec3f& x) const {
+  Vec3f y = x;
+  for (int side = 0; side < 2; ++side) y = warp_->eyes_[side].Slide(y, blink_[side]);
+  return y;
+}
+
+Vec3f PosedIctWarp::Offset(const Vec3f& x) const {
+  const Vec3f y = LidSlide(x);
+  return (y - x) + OffsetAt(y, Closest(y));
+}
 
 Vec3f PosedIctWarp::OffsetAt(const Vec3f& x, const IctWarpClosest& closest) const {
   if (closest.triangle < 0) return Vec3f::Zero();

@@ -30,6 +30,22 @@
 // eye occlusion meshes (thin transparent overlays of the eyes) and the eyelashes (hair cards a few
 // millimetres from the lids: their closest points would pull the lids' surroundings along cards).
 //
+// Blinks (the lid slide): ICT's eyeBlink deltas are made on the mean face and do not close every
+// identity's lids (an identity with a larger or more prominent eye keeps part of its eyeball
+// uncovered; so may one fitted to a real subject). So the posed mesh M leaves eyeBlink_L/_R out, and
+// a blink is a slide of the space over each eyeball before the closest-point warp, measured on the
+// identity's own eye. Per eye: the eyeball's sphere (centre and median radius of the sclera) and its
+// rest opening, by column u = q.x / radius (q = x - centre, in kEyeColumns columns): the lowest and
+// highest elevation theta = atan2(q.y, q.z) whose radial ray leaves the eyeball without crossing skin
+// (any surface part other than the eyeballs) within 2 cm. At blink weight c (clamped to 0..1) the
+// upper lid's margin comes down to edge = upper - c (upper - lower), and a point over the eyeball at
+// elevation theta in [edge, pi/2] is rotated about the x axis through the centre to
+//   upper + (theta - edge) (pi/2 - upper) / (pi/2 - edge),
+// where the open lid is (the span the closing lid covers, mapped onto the open lid's), in full
+// within [-0.3, 0.4] cm of the sphere, fading out by -0.6 and 0.9 cm. At c = 1 the opening is
+// covered from top to bottom, whatever the identity. The slide is continuous except at the closing
+// margin (theta = edge), as the lid is.
+//
 // Cost: IctWarp holds the neutral for one identity; IctWarp::Pose(beta) builds the posed mesh, the
 // vertex rotations and a KD-tree over ~117k surface points once per expression (a training step with
 // K distinct expressions builds K). Measured (IctWarp.Timing, 2-core AMD EPYC host): Pose 28 ms;
@@ -42,6 +58,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "icef/core/parallel.h"
@@ -75,6 +92,22 @@ struct IctWarpClosest {
   std::string ToString() const;
 };
 
+// One eye of the lid slide (above), for one identity, head frame, cm.
+struct IctEye {
+  static constexpr int kColumns = 32;  // columns of the rest opening across the eyeball
+  int blink = -1;                      // expression index of its eyeBlink (-1: the model has none)
+  Vec3f centre{0, 0, 0};
+  float radius = 0;
+  // Rest opening of column k (u = -1 + (k + 0.5) 2 / kColumns): the lowest and the highest uncovered
+  // elevation (rad); equal (no opening) where no direction of the column is uncovered.
+  std::array<float, kColumns> lower{}, upper{};
+
+  // The opening at column u (-1..1), interpolated between column centres: {lower, upper}.
+  std::pair<float, float> Opening(float u) const;
+  // x slid from a lid closed to weight `blink` (0..1) back to the open lid's place; x elsewhere.
+  Vec3f Slide(const Vec3f& x, float blink) const;
+};
+
 class PosedIctWarp;
 
 // The warp for one identity; Pose() specialises it to one expression. Holds a pointer to the
@@ -98,6 +131,8 @@ class IctWarp {
   // The warp's surface: the model's triangles (vertex indices) whose three vertices lie on the parts
   // named above, in model order.
   const std::vector<std::array<uint32_t, 3>>& triangles() const { return triangles_; }
+  // The lid slide's eyes: the subject's left (+x, eyeBlink_L) and right.
+  const std::array<IctEye, 2>& eyes() const { return eyes_; }
   // Area-weighted vertex normals of that surface on `mesh` (a mesh of the model: the neutral or a
   // posed one), normalised: [mesh.size()], 0 at vertices off the surface.
   std::vector<Vec3f> VertexNormals(const std::vector<Vec3f>& mesh) const;
@@ -111,6 +146,7 @@ class IctWarp {
   IctWarpOptions options_;
   std::vector<Vec3f> neutral_;
   std::vector<std::array<uint32_t, 3>> triangles_;
+  std::array<IctEye, 2> eyes_;
 };
 
 // The warp at one expression: the posed mesh, its KD-tree, and the batched warp.
@@ -120,19 +156,24 @@ class PosedIctWarp {
   PosedIctWarp& operator=(PosedIctWarp&&) noexcept;
   ~PosedIctWarp();
 
-  // positions [n, 3] head frame cm (observed, at this expression) -> offsets [n, 3] cm: P(x) - x.
+  // positions [n, 3] head frame cm (observed, at this expression) -> offsets [n, 3] cm: P(x) - x
+  // (the lid slide, then the closest-point warp).
   // Parallel over points; each output depends on its point alone (the same for any thread count).
   void Offsets(const Executor& executor, int64_t n, const float* positions, float* offsets) const;
   // P(x) - x of one point.
   Vec3f Offset(const Vec3f& x) const;
-  // The closest point of x on the posed surface, when within outer_radius.
+  // The lid slide of x at this expression's blinks: x where neither eye blinks or x is off the
+  // eyeballs. Offset(x) = LidSlide(x) - x + OffsetAt(LidSlide(x), Closest(LidSlide(x))).
+  Vec3f LidSlide(const Vec3f& x) const;
+  // The closest point of x on the posed surface (without the blinks), when within outer_radius.
   IctWarpClosest Closest(const Vec3f& x) const;
-  // P(x) - x given x's closest point (Closest(x)): Offset(x) without a second search.
+  // The closest-point warp's part of P(x) - x given x's closest point (Closest(x)), without the lid
+  // slide; the whole of it where LidSlide(x) = x.
   Vec3f OffsetAt(const Vec3f& x, const IctWarpClosest& closest) const;
 
   const IctWarp& warp() const { return *warp_; }
   const std::vector<float>& expression() const { return expression_; }
-  // The posed mesh M: [num_vertices], head frame, cm.
+  // The posed mesh M (every expression but the blinks): [num_vertices], head frame, cm.
   const std::vector<Vec3f>& posed() const { return posed_; }
   // Rotation from M to N at each vertex of the surface: [num_vertices] quaternions (x, y, z, w),
   // w >= 0; the identity off the surface.
@@ -149,6 +190,7 @@ class PosedIctWarp {
   std::vector<float> expression_;
   std::vector<Vec3f> posed_;
   std::vector<Vec4f> vertex_rotations_;
+  std::array<float, 2> blink_{};  // the eyes' blink weights, 0..1
   float max_cover_ = 0;
   std::unique_ptr<Tree> tree_;
 };

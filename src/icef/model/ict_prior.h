@@ -18,7 +18,10 @@
 // mouth_socket bag and the lip triangles that join it to the face, closed by a fan over its rim about
 // a centimetre behind the lips; inside = an odd count of crossings of a +z ray, found through a 2D
 // grid with tie rules that make the surface watertight), and (3) its closest posed surface point
-// is on mouth_socket or gums_tongue, on the side their normals point to (the air). Conservative:
+// is on mouth_socket or gums_tongue, on the side their normals point to (the air); a point nearest
+// mouth_socket outside the teeth's dental arch (farther from the teeth's centre in the x-z plane than
+// any tooth at its height and bearing: between the lips' lining and the teeth) is air instead, so the
+// front of the teeth shows. Conservative:
 // points nearest the lips or the teeth are never inside, so the cavity does not hide the teeth; the
 // air just between the lips (in front of the rim) is the air rule's (below).
 //
@@ -34,6 +37,9 @@
 // When the lips are parted, a point within 1.5 cm of the inner lips' box that lies on the air side
 // of its closest posed surface and whose canonical point lies more than 0.1 cm behind the surface at
 // rest (on the side its normals point away from) is empty.
+//
+// Blinks: the warp's lid slide (ict_warp.h) comes first; offsets and normals are those of the slid
+// point (the normals are not turned by the slide).
 //
 // Normals: from the closest point of S x on the posed surface (triangle t, barycentric b): observed =
 // the posed mesh's interpolated vertex normal at (t, b), canonical = the neutral mesh's at (t, b),
