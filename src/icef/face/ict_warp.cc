@@ -24,6 +24,11 @@ constexpr float kLidTop = 1.5707963f;   // elevation straight up: the slide ends
 constexpr float kOpeningReach = 3.f;    // cm: skin this far in front (+z) covers the eyeball
 constexpr float kOpeningStep = 0.025f;  // rad: elevations tried per column
 constexpr float kOpeningLimit = 1.4f;   // rad: elevations tried, -limit..limit
+// rad: the slide covers the opening grown by this above and below: a real subject's eye, which the
+// fitted identity's lids only approximate, extends past the mesh's opening (the validation video's
+// fitted eyelid landmarks lie 0.02-0.05 rad outside it, and its avatar kept iris showing at
+// eyeBlink = 1 with no margin).
+constexpr float kLidMargin = 0.15f;
 
 // Most KD-tree points per triangle edge (a triangle gets at most kMaxSubdivisions^2).
 constexpr int kMaxSubdivisions = 64;
@@ -202,10 +207,14 @@ Vec3f IctEye::Slide(const Vec3f& x, float blink) const {
   const float weight = SmoothStep(-0.6f, -0.3f, r - radius) * (1.f - SmoothStep(0.4f, 0.9f, r - radius));
   if (weight <= 0.f || !(std::abs(u) < 1.f)) return x;
   const auto [open_lower, open_upper] = Opening(u);
-  const float edge = open_upper - std::min(blink, 1.f) * (open_upper - open_lower);
+  // The opening grown by the margin (less where the opening is lower than that, so that the slide
+  // fades out with the opening at the eye's corners).
+  const float margin = std::min(kLidMargin, open_upper - open_lower);
+  const float upper = open_upper + margin, lower = open_lower - margin;
+  const float edge = upper - std::min(blink, 1.f) * (upper - lower);
   const float theta = std::atan2(q.y(), q.z());
-  if (!(edge < open_upper) || theta < edge || theta > kLidTop) return x;
-  const float mapped = open_upper + (theta - edge) * (kLidTop - open_upper) / (kLidTop - edge);
+  if (!(edge < upper) || theta < edge || theta > kLidTop) return x;
+  const float mapped = upper + (theta - edge) * (kLidTop - upper) / (kLidTop - edge);
   const float a = weight * (mapped - theta), c = std::cos(a), sn = std::sin(a);
   // Rotation about the x axis through the centre raising the elevation by a.
   return centre + Vec3f(q.x(), q.y() * c + q.z() * sn, -q.y() * sn + q.z() * c);

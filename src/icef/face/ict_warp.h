@@ -35,11 +35,14 @@
 // uncovered; so may one fitted to a real subject). So the posed mesh M leaves eyeBlink_L/_R out, and
 // a blink is a slide of the space over each eyeball before the closest-point warp, measured on the
 // identity's own eye. Per eye: the eyeball's sphere (centre and median radius of the sclera) and its
-// rest opening, by column u = q.x / radius (q = x - centre, in kEyeColumns columns): the lowest and
-// highest elevation theta = atan2(q.y, q.z) whose radial ray leaves the eyeball without crossing skin
-// (any surface part other than the eyeballs) within 2 cm. At blink weight c (clamped to 0..1) the
-// upper lid's margin comes down to edge = upper - c (upper - lower), and a point over the eyeball at
-// elevation theta in [edge, pi/2] is rotated about the x axis through the centre to
+// rest opening, by column u = q.x / radius (q = x - centre, in IctEye::kColumns columns): the lowest and
+// highest elevation theta = atan2(q.y, q.z) of the sphere's points seen from the front past the skin
+// (any surface part other than the eyeballs) within 3 cm in front (+z). That opening is grown by a
+// margin m = min(0.15 rad, its height) above and below (a real subject's eye, which the fitted
+// identity's lids only approximate, reaches past it): upper += m, lower -= m. At blink weight c
+// (clamped to 0..1) the upper lid's margin comes down to edge = upper - c (upper - lower), and a
+// point over the eyeball at elevation theta in [edge, pi/2] is rotated about the x axis through the
+// centre to
 //   upper + (theta - edge) (pi/2 - upper) / (pi/2 - edge),
 // where the open lid is (the span the closing lid covers, mapped onto the open lid's), in full
 // within [-0.3, 0.4] cm of the sphere, fading out by -0.6 and 0.9 cm. At c = 1 the opening is
