@@ -228,58 +228,6 @@ bool MouthVolume::Inside(const Vec3f& x) const {
 // The grid's channels: offset (cm), observed normal, canonical normal; head frame.
 constexpr int kGridChannels = 9;
 
-// The posed teeth's dental arch as seen from above: about the teeth's centroid in the x-z plane, per
-// bin of height (kArchHeight) and of angle (kArchAngles), the farthest tooth vertex. A point farther
-// out than that less kArchSlack at its height and angle is outside the arch: in front of the teeth
-// (the vestibule between them and the lips' lining, or beside them under the cheeks). The slack
-// (teeth are 0.6-0.8 cm thick front to back) makes the thin space before a tooth that a bin's
-// farthest vertex overhangs (incisors lean forward) outside as well; within the teeth the teeth rule
-// comes first.
-constexpr float kArchHeight = 0.25f;  // cm
-constexpr int kArchAngles = 48;
-constexpr float kArchSlack = 0.3f;  // cm
-
-class TeethArch {
- public:
-  TeethArch(const std::vector<Vec3f>& mesh, const std::vector<uint32_t>& teeth) {
-    Vec2f sum = Vec2f::Zero();
-    float lo = INFINITY, hi = -INFINITY;
-    for (uint32_t v : teeth) {
-      sum += Vec2f(mesh[v].x(), mesh[v].z());
-      lo = std::min(lo, mesh[v].y()), hi = std::max(hi, mesh[v].y());
-    }
-    centre_ = sum / static_cast<float>(teeth.size());
-    y0_ = lo;
-    heights_ = static_cast<int>((hi - lo) / kArchHeight) + 1;
-    reach_.assign(static_cast<size_t>(heights_) * kArchAngles, -1.f);
-    for (uint32_t v : teeth) {
-      float& r = reach_[Bin(mesh[v])];
-      r = std::max(r, Radius(mesh[v]));
-    }
-  }
-
-  bool Outside(const Vec3f& x) const {
-    if (!(x.y() >= y0_) || !(x.y() < y0_ + heights_ * kArchHeight)) return false;
-    const float r = reach_[Bin(x)];
-    return r >= 0.f && Radius(x) > r - kArchSlack;
-  }
-
- private:
-  float Radius(const Vec3f& x) const { return (Vec2f(x.x(), x.z()) - centre_).norm(); }
-  size_t Bin(const Vec3f& x) const {
-    const int h = std::clamp(static_cast<int>((x.y() - y0_) / kArchHeight), 0, heights_ - 1);
-    const float angle = std::atan2(x.x() - centre_.x(), x.z() - centre_.y());  // 0: straight ahead
-    const int a = std::clamp(static_cast<int>((angle + kPi) / (2 * kPi) * kArchAngles), 0, kArchAngles - 1);
-    return static_cast<size_t>(h) * kArchAngles + a;
-  }
-
-  static constexpr float kPi = 3.14159265f;
-  Vec2f centre_;  // (x, z)
-  float y0_ = 0;
-  int heights_ = 0;
-  std::vector<float> reach_;  // [heights][angles], cm; -1: no tooth
-};
-
 struct IctPrior::Expression {
   Expression(const face::IctWarp& warp, const MouthSurface& surface,
              const std::vector<Vec3f>* neutral_normals, std::span<const float> beta,
@@ -287,8 +235,7 @@ struct IctPrior::Expression {
       : posed(warp.Pose(beta)),
         mouth(surface, posed.posed()),
         normals(warp.VertexNormals(posed.posed())),
-        canonical_normals(neutral_normals != nullptr ? *neutral_normals : normals),
-        arch(posed.posed(), surface.teeth_vertices) {
+        canonical_normals(neutral_normals != nullptr ? *neutral_normals : normals) {
     float gap = 0;
     for (const auto& [upper, lower] : surface.inner_lips)
       gap += (posed.posed()[upper] - posed.posed()[lower]).norm();
@@ -367,9 +314,8 @@ struct IctPrior::Expression {
   MouthVolume mouth;
   std::vector<Vec3f> normals;                   // of the posed warp surface: [num_vertices], head frame
   const std::vector<Vec3f>& canonical_normals;  // of the neutral (beta = 0)
-  TeethArch arch;
-  bool open = false;                           // the inner lips are parted (kOpenLipGap)
-  Vec3f teeth_lo = Vec3f::Constant(INFINITY);  // the posed teeth's bounding box, head frame
+  bool open = false;                            // the inner lips are parted (kOpenLipGap)
+  Vec3f teeth_lo = Vec3f::Constant(INFINITY);   // the posed teeth's bounding box, head frame
   Vec3f teeth_hi = Vec3f::Constant(-INFINITY);
   Vec3f lips_lo = Vec3f::Constant(INFINITY);  // the inner lips' box grown by kLipsReach
   Vec3f lips_hi = Vec3f::Constant(-INFINITY);
@@ -547,10 +493,9 @@ void IctPrior::Cavity(const Executor& executor, int64_t n, const float* position
       inside[i] = kTeeth;
       return;
     }
-    // On the air side of the socket or the gums and tongue (their normals point into the mouth): the
-    // cavity, but air outside the teeth's arch (before the teeth, whose front then shows).
+    // On the air side of the socket or the tongue (their normals point into the mouth): the cavity.
     if (in_mouth && (part == mouth_surface_->socket || part == mouth_surface_->tongue) && side > 0.f) {
-      inside[i] = e.arch.Outside(x) ? kAir : kMouthCavity;
+      inside[i] = kMouthCavity;
       return;
     }
     // Air in the parted lips: x on the air side of its closest surface (its normal points to x), and

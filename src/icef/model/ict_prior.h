@@ -18,10 +18,7 @@
 // mouth_socket bag and the lip triangles that join it to the face, closed by a fan over its rim about
 // a centimetre behind the lips; inside = an odd count of crossings of a +z ray, found through a 2D
 // grid with tie rules that make the surface watertight), and (3) its closest posed surface point
-// is on mouth_socket or gums_tongue, on the side their normals point to (the air); a point nearest
-// mouth_socket outside the teeth's dental arch (farther from the teeth's centre in the x-z plane than
-// any tooth at its height and bearing: between the lips' lining and the teeth) is air instead, so the
-// front of the teeth shows. Conservative:
+// is on mouth_socket or gums_tongue, on the side their normals point to (the air). Conservative:
 // points nearest the lips or the teeth are never inside, so the cavity does not hide the teeth; the
 // air just between the lips (in front of the rim) is the air rule's (below).
 //

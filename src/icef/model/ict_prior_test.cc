@@ -396,46 +396,6 @@ TEST(IctPrior, TeethOfAnOpenMouth) {
   EXPECT_LT(out_open, 0.1);
 }
 
-// Through lips parted to show the upper teeth (jawOpen 0.6, both upper lips raised), seen 30 degrees
-// from either side: orthographic rays 0.1 cm apart over the top 0.7 cm of the opening (x within
-// 1.5 cm of the middle), each ending at its first sample that is neither field nor air, end on the
-// teeth, not on the cavity. The cavity used to take the space between the lips' lining and the
-// teeth (8 and 10 such rays in these two views, at the corners of the mouth; 3 each with the dental
-// arch bounding it).
-TEST(IctPrior, TheUpperTeethShowThroughPartedLips) {
-  ICT_PRIOR_OR_SKIP(p);
-  const IctModel& m = *Model();
-  const std::vector<float> beta = Weights("jawOpen=0.6,mouthUpperUp_L=1,mouthUpperUp_R=1");
-  const std::vector<Vec3f> lm = m.Landmarks(m.Mesh({}, beta));
-  constexpr int kColumns = 31, kRows = 7, kSteps = 250;
-  for (const float degrees : {30.f, -30.f}) {
-    const float a = degrees * 3.14159265f / 180.f;
-    const Vec3f d(-std::sin(a), 0.f, -std::cos(a));  // into the face
-    std::vector<Vec3f> points;
-    for (int j = 0; j < kRows; ++j) {
-      for (int i = 0; i < kColumns; ++i) {
-        const Vec3f start = Vec3f(-1.5f + 0.1f * i, lm[62].y() - 0.1f * j, lm[62].z()) - 1.5f * d;
-        for (int k = 0; k < kSteps; ++k) points.push_back(start + 0.02f * k * d);
-      }
-    }
-    const Outputs out = Evaluate(p, ToWorld(points), Rows(beta, points.size()));
-    int teeth = 0, cavity = 0;
-    for (int r = 0; r < kRows * kColumns; ++r) {
-      for (int k = 0; k < kSteps; ++k) {
-        const uint8_t label = out.inside[static_cast<size_t>(r) * kSteps + k];
-        if (label == DeformationPrior::kField || label == DeformationPrior::kAir) continue;
-        teeth += label == DeformationPrior::kTeeth;
-        cavity += label == DeformationPrior::kMouthCavity;
-        break;
-      }
-    }
-    std::printf("[ teeth ] %g degrees: of %d rays, %d end on teeth, %d on the cavity\n", degrees,
-                kRows * kColumns, teeth, cavity);
-    EXPECT_GT(teeth, 150) << degrees;
-    EXPECT_LE(cavity, 4) << degrees;
-  }
-}
-
 TEST(IctPrior, NormalsAreThoseOfTheSurfaces) {
   ICT_PRIOR_OR_SKIP(p);
   const IctModel& m = *Model();
