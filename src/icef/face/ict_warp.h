@@ -49,7 +49,8 @@
 // covered from top to bottom, whatever the identity. The slide is continuous except at the closing
 // margin (theta = edge), as the lid is.
 //
-// Cost: IctWarp holds the neutral for one identity; IctWarp::Pose(beta) builds the posed mesh, the
+// Cost: IctWarp holds the neutral for one identity (IctWarp::Create measures its eyes once, ~50 ms on
+// the host below); IctWarp::Pose(beta) builds the posed mesh, the
 // vertex rotations and a KD-tree over ~117k surface points once per expression (a training step with
 // K distinct expressions builds K). Measured (IctWarp.Timing, 2-core AMD EPYC host): Pose 28 ms;
 // Offsets for 100k points 4.4 us/point on one thread uniform in the head's box, 6.4 us/point 0.5 cm

@@ -259,6 +259,9 @@ struct IctPrior::Expression {
     grid_options.zero_outside = true;   // the box holds every point within outer_radius of the surface
     std::fill_n(grid_options.tolerance.begin(), 3, options.offset_tolerance);
     grid_options.smooth_beyond = options.smooth_beyond;
+    grid_options.refine = options.grid_refine;
+    grid_options.group = {0, 0, 0, 1, 1,
+                          1, 1, 1, 1};  // offsets; normals (Offsets asks for the offsets alone)
     grid = std::make_unique<LazyGrid>(
         lo - margin, hi + margin, std::move(grid_options),
         [this](const Vec3f& x, float* values, Vec3f* anchor) { return Exact(x, values, anchor); });
@@ -300,14 +303,17 @@ struct IctPrior::Expression {
     return Interpolated(normals, t, closest.barycentric).dot(x - SurfacePoint(closest));
   }
 
-  // Offset and normals at x (head frame): the grid's where there is one.
-  void Sample(const Vec3f& x, float* values) const {
+  // Channels [first, first + count) of the offset and normals at x (head frame) into values[count]:
+  // the grid's where there is one.
+  void Sample(const Vec3f& x, int first, int count, float* values) const {
     if (grid != nullptr) {
-      grid->At(x, values);
+      grid->At(x, first, count, values);
       return;
     }
+    float all[kGridChannels];
     Vec3f anchor;
-    Exact(x, values, &anchor);
+    Exact(x, all, &anchor);
+    std::copy_n(all + first, count, values);
   }
 
   face::PosedIctWarp posed;
@@ -329,6 +335,8 @@ Status IctPriorOptions::Validate() const {
   if (!std::isfinite(offset_tolerance) || offset_tolerance < 0.f || !std::isfinite(normal_tolerance) ||
       normal_tolerance < 0.f)
     return Status::Error("offset_tolerance and normal_tolerance must be finite numbers >= 0");
+  if (grid_refine < 0 || grid_refine > 16)
+    return Status::Error("grid_refine must be in [0, 16], got " + std::to_string(grid_refine));
   if (!(smooth_beyond >= 0.f))
     return Status::Error("smooth_beyond must be >= 0 (cm; infinity: never), got " +
                          std::to_string(smooth_beyond));
@@ -339,7 +347,7 @@ std::string IctPriorOptions::ToString() const {
   std::ostringstream os;
   os << "IctPriorOptions(" << warp.ToString() << ", grid_cell=" << grid_cell
      << ", offset_tolerance=" << offset_tolerance << ", normal_tolerance=" << normal_tolerance
-     << ", smooth_beyond=" << smooth_beyond << ")";
+     << ", smooth_beyond=" << smooth_beyond << ", grid_refine=" << grid_refine << ")";
   return os.str();
 }
 
@@ -460,8 +468,8 @@ void IctPrior::ForEachSample(const Executor& executor, int64_t n, const float* p
 void IctPrior::Offsets(const Executor& executor, int64_t n, const float* positions, const float* betas,
                        float* offsets) const {
   ForEachSample(executor, n, positions, betas, [&](int64_t i, const Expression& e, const Vec3f& x) {
-    float values[kGridChannels];
-    e.Sample(x, values);
+    float values[3];
+    e.Sample(x, 0, 3, values);
     Eigen::Map<Vec3f>(offsets + 3 * i) = world_from_head_linear_ * Eigen::Map<const Vec3f>(values);
   });
 }
@@ -517,7 +525,7 @@ bool IctPrior::Normals(const Executor& executor, int64_t n, const float* positio
                        float* observed, float* canonical) const {
   ForEachSample(executor, n, positions, betas, [&](int64_t i, const Expression& e, const Vec3f& x) {
     float values[kGridChannels];
-    e.Sample(x, values);
+    e.Sample(x, 3, 6, values + 3);
     // Unit normals where the warp's weight is above 1e-3 (within ~2.96 of the 3 cm outer radius),
     // else 0 (the channels are the normals times the weight; interpolated ones are renormalised).
     const auto unit = [](const float* v) {
@@ -547,10 +555,12 @@ std::string IctPrior::ToString() const {
     if (entry.expression->grid == nullptr) continue;
     const LazyGrid::Counts c = entry.expression->grid->counts();
     grid.bricks += c.bricks, grid.cells += c.cells, grid.interpolated += c.interpolated;
+    grid.refined += c.refined, grid.fine_cells += c.fine_cells, grid.fine_interpolated += c.fine_interpolated;
   }
   if (grid.cells > 0)
     os << ", their grids: " << grid.bricks << " bricks, " << grid.interpolated << "/" << grid.cells
-       << " cells interpolated";
+       << " cells interpolated, " << grid.refined << " refined (" << grid.fine_interpolated << "/"
+       << grid.fine_cells << " fine cells interpolated)";
   os << ")";
   return os.str();
 }
