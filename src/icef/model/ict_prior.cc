@@ -260,8 +260,8 @@ struct IctPrior::Expression {
     std::fill_n(grid_options.tolerance.begin(), 3, options.offset_tolerance);
     grid_options.smooth_beyond = options.smooth_beyond;
     grid_options.refine = options.grid_refine;
-    grid_options.group = {0, 0, 0, 1, 1,
-                          1, 1, 1, 1};  // offsets; normals (Offsets asks for the offsets alone)
+    // Group 0 the offset, 1 both normals: Offsets asks for the offset alone.
+    grid_options.group = {0, 0, 0, 1, 1, 1, 1, 1, 1};
     grid = std::make_unique<LazyGrid>(
         lo - margin, hi + margin, std::move(grid_options),
         [this](const Vec3f& x, float* values, Vec3f* anchor) { return Exact(x, values, anchor); });
@@ -335,8 +335,9 @@ Status IctPriorOptions::Validate() const {
   if (!std::isfinite(offset_tolerance) || offset_tolerance < 0.f || !std::isfinite(normal_tolerance) ||
       normal_tolerance < 0.f)
     return Status::Error("offset_tolerance and normal_tolerance must be finite numbers >= 0");
-  if (grid_refine < 0 || grid_refine > 16)
-    return Status::Error("grid_refine must be in [0, 16], got " + std::to_string(grid_refine));
+  if (grid_refine < 0 || grid_refine > LazyGrid::kMaxRefine)
+    return Status::Error("grid_refine must be in [0, " + std::to_string(LazyGrid::kMaxRefine) + "], got " +
+                         std::to_string(grid_refine));
   if (!(smooth_beyond >= 0.f))
     return Status::Error("smooth_beyond must be >= 0 (cm; infinity: never), got " +
                          std::to_string(smooth_beyond));
@@ -524,8 +525,8 @@ void IctPrior::Cavity(const Executor& executor, int64_t n, const float* position
 bool IctPrior::Normals(const Executor& executor, int64_t n, const float* positions, const float* betas,
                        float* observed, float* canonical) const {
   ForEachSample(executor, n, positions, betas, [&](int64_t i, const Expression& e, const Vec3f& x) {
-    float values[kGridChannels];
-    e.Sample(x, 3, 6, values + 3);
+    float values[6];  // observed, canonical
+    e.Sample(x, 3, 6, values);
     // Unit normals where the warp's weight is above 1e-3 (within ~2.96 of the 3 cm outer radius),
     // else 0 (the channels are the normals times the weight; interpolated ones are renormalised).
     const auto unit = [](const float* v) {
@@ -533,8 +534,8 @@ bool IctPrior::Normals(const Executor& executor, int64_t n, const float* positio
       const float norm = n.norm();
       return norm > 1e-3f ? Vec3f(n / norm) : Vec3f::Zero();
     };
-    Eigen::Map<Vec3f>(observed + 3 * i) = world_from_head_rotation_ * unit(values + 3);
-    Eigen::Map<Vec3f>(canonical + 3 * i) = world_from_head_rotation_ * unit(values + 6);
+    Eigen::Map<Vec3f>(observed + 3 * i) = world_from_head_rotation_ * unit(values);
+    Eigen::Map<Vec3f>(canonical + 3 * i) = world_from_head_rotation_ * unit(values + 3);
   });
   return true;
 }

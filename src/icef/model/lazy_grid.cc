@@ -58,7 +58,8 @@ LazyGrid::LazyGrid(const Vec3f& lo, const Vec3f& hi, Options options, Function f
              "LazyGrid: 1 to kMaxChannels channels");
   for (float t : options_.tolerance) ICEF_CHECK(std::isfinite(t) && t >= 0.f, "LazyGrid: bad tolerance");
   ICEF_CHECK(options_.smooth_beyond >= 0.f, "LazyGrid: smooth_beyond must be >= 0");
-  ICEF_CHECK(options_.refine >= 0 && options_.refine <= 16, "LazyGrid: refine must be in [0, 16]");
+  ICEF_CHECK(options_.refine >= 0 && options_.refine <= kMaxRefine,
+             "LazyGrid: refine must be in [0, kMaxRefine]");
   ICEF_CHECK(options_.group.empty() || options_.group.size() == options_.tolerance.size(),
              "LazyGrid: one group per channel");
   for (int g : options_.group) ICEF_CHECK(g >= 0 && g < 8, "LazyGrid: groups are 0 to 7");

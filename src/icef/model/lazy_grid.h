@@ -39,6 +39,7 @@ class LazyGrid {
  public:
   static constexpr int kBrickCells = 8;    // cells per brick side
   static constexpr int kMaxChannels = 16;  // the most channels f may give
+  static constexpr int kMaxRefine = 16;    // the most fine cells per side of a refined cell
 
   // f(x, values[channels], anchor) -> whether f has an anchor at x (then *anchor is set).
   using Function = std::function<bool(const Vec3f& x, float* values, Vec3f* anchor)>;
@@ -55,7 +56,7 @@ class LazyGrid {
     // jumps of f included. Infinity: never.
     float smooth_beyond = INFINITY;
     // Fine cells per side of a refined cell (0 or 1: failing cells are not refined). A refined cell
-    // costs f at (refine + 1)^3 corners and refine^3 centres, once.
+    // costs f at (refine + 1)^3 corners and refine^3 centres, once. At most kMaxRefine.
     int refine = 0;
     // Per channel: its group (0 to 7), or empty: one group. A cell passes the tolerance test for a
     // group when every channel of that group does, and At() interpolates the channels it is asked
